@@ -1,0 +1,92 @@
+"""The ``phdesign`` command line: argument parsing and printing only.
+
+Each command lives in a module of this package that exposes ``register(subparsers)``;
+the heavy numeric imports happen inside the command handlers, so ``phdesign ports``
+and ``phdesign classify`` start without numpy-heavy backends, control or matplotlib.
+
+Exit status: 0 on success, 2 on bad input with exactly one line on stderr
+(``phdesign: error: ...``), never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from phdesign.errors import PhdesignError
+
+__all__ = ["build_parser", "main", "run"]
+
+#: Command modules, in the order their commands appear in ``phdesign --help``.
+COMMAND_MODULES = (
+    "phdesign.cli.model_commands",
+    "phdesign.cli.classify_command",
+    "phdesign.cli.numeric_commands",
+)
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        raise _UsageError(f"{self.prog}: {message}")
+
+
+class _UsageError(Exception):
+    pass
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the parser with every available command registered."""
+    parser = _Parser(
+        prog="phdesign",
+        description="Boundary observers for boundary-controlled port-Hamiltonian systems.",
+    )
+    from phdesign import __version__
+
+    parser.add_argument("--version", action="version", version=f"phdesign {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    subparsers.required = True
+    for name in COMMAND_MODULES:
+        try:
+            module = importlib.import_module(name)
+        except ModuleNotFoundError as error:
+            if error.name != name:  # a missing dependency is a real failure
+                raise
+            continue
+        module.register(subparsers)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line and return the exit status."""
+    try:
+        args = build_parser().parse_args(argv)
+        return int(args.handler(args) or 0)
+    except _UsageError as error:
+        return _fail(str(error))
+    except (PhdesignError, ValueError, TypeError) as error:
+        return _fail(str(error))
+    except OSError as error:
+        return _fail(
+            f"{error.strerror or error}: {error.filename}" if error.filename else str(error)
+        )
+    except KeyboardInterrupt:
+        return _fail("interrupted")
+    except RecursionError:
+        return _fail("input is nested too deeply")
+
+
+def _fail(message: str) -> int:
+    line = " ".join(message.split())
+    if not line.startswith("phdesign"):
+        line = f"phdesign: error: {line}"
+    print(line, file=sys.stderr)
+    return 2
+
+
+def run() -> None:
+    """Console-script entry point."""
+    sys.exit(main())

@@ -1,0 +1,124 @@
+"""Arguments and output helpers shared by the commands."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from phdesign.errors import ObserverError, ParameterError
+from phdesign.symbolic.model import BCPHS
+
+__all__ = [
+    "add_json_argument",
+    "add_model_argument",
+    "add_observer_arguments",
+    "emit",
+    "emit_json",
+    "load_model",
+    "observer_matrices",
+    "parse_parameter_overrides",
+    "write_output",
+]
+
+
+def add_model_argument(parser: argparse.ArgumentParser) -> None:
+    """Add MODEL (built-in name or TOML path) and the repeatable ``--param name=value``."""
+    parser.add_argument("model", metavar="MODEL", help="built-in model name or TOML file path")
+    parser.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="override a parameter's default value (repeatable)",
+    )
+
+
+def add_json_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--json``: print machine-readable JSON instead of a table."""
+    parser.add_argument("--json", action="store_true", help="print JSON (see DESIGN.md)")
+
+
+def parse_parameter_overrides(items: list[str]) -> dict[str, str]:
+    """Split ``name=value`` items; values stay text and are checked by the model."""
+    overrides: dict[str, str] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        name, value = name.strip(), value.strip()
+        if not sep or not name or not value:
+            raise ParameterError(f"--param expects NAME=VALUE; found {item!r}")
+        if name in overrides:
+            raise ParameterError(f"--param {name} is given twice")
+        overrides[name] = value
+    return overrides
+
+
+def load_model(args: argparse.Namespace) -> BCPHS:
+    """Load MODEL: a built-in name, else a TOML file; then apply ``--param``."""
+    from phdesign.io import read_model
+    from phdesign.models import builtin_names, load_builtin
+
+    name = args.model
+    if name in builtin_names():
+        model = load_builtin(name)
+    elif Path(name).suffix == ".toml" or Path(name).exists():
+        model = read_model(name)
+    else:
+        model = load_builtin(name)  # raises the error listing built-in names
+    overrides = parse_parameter_overrides(getattr(args, "param", []))
+    return model.with_parameters(overrides) if overrides else model
+
+
+def add_observer_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``--sensors`` / ``--cm`` (exclusive) and ``--gain``."""
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument(
+        "--sensors", metavar="I,J", help="measured outputs, 1-based indices, e.g. 3,4"
+    )
+    group.add_argument("--cm", metavar="ROWS", help="C_m in full, e.g. '[[0,0,1,0]]'")
+    parser.add_argument(
+        "--gain",
+        metavar="L",
+        help="observer gain: '0.1,1' (diagonal), '[[..]]' (full) or 'symbolic'",
+    )
+
+
+def observer_matrices(args: argparse.Namespace, model: BCPHS) -> tuple[Any, Any] | None:
+    """Return ``(C_m, L)`` from ``--sensors``/``--cm`` and ``--gain``, or ``None``.
+
+    Without ``--gain`` the gain is the identity.
+    """
+    from phdesign.symbolic import observer
+
+    n_outputs = model.order * model.size
+    if args.sensors is not None:
+        C_m = observer.parse_sensors(args.sensors, n_outputs)
+    elif args.cm is not None:
+        C_m = observer.parse_cm(args.cm, n_outputs)
+    else:
+        if getattr(args, "gain", None) is not None:
+            raise ObserverError("--gain needs --sensors or --cm to say which outputs are measured")
+        return None
+    q = C_m.shape[0]
+    gain = args.gain if args.gain is not None else ",".join(["1"] * q)
+    return C_m, observer.parse_gain(gain, q)
+
+
+def emit(text: str) -> None:
+    """Print ``text`` on stdout."""
+    sys.stdout.write(text if text.endswith("\n") else text + "\n")
+
+
+def emit_json(value: Any) -> None:
+    """Print ``value`` as JSON; sympy values become exact strings."""
+    from phdesign.io import dumps_json
+
+    emit(dumps_json(value))
+
+
+def write_output(path: str, text: str | bytes, force: bool) -> None:
+    """Write an output file atomically, refusing to overwrite unless ``force``."""
+    from phdesign.io import atomic_write
+
+    atomic_write(path, text, force=force)

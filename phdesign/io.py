@@ -1,0 +1,278 @@
+"""Model files (TOML) in and out, JSON encoding, and atomic file writes.
+
+A model file holds exactly the keys below; ``[matrices]`` entries are numbers or
+expression strings in ``z`` and the parameters, and omitted ``P_k`` are zero::
+
+    name = "Euler-Bernoulli beam, clamped at 0, free at 1"
+    description = "optional text"
+    interval = [0, 1]
+    order = 2
+    states = ["momentum", "curvature"]        # optional
+    [parameters]
+    d = 0.2
+    [matrices]
+    P0 = [["-d", 0], [0, 0]]
+    P2 = [[0, -1], [1, 0]]
+    H  = [[1, 0], [0, 1]]
+    [ports]
+    inputs  = ["e1(0)", "e1'(0)", "e2(1)", "e2'(1)"]
+    outputs = ["e2'(0)", "-e2(0)", "e1'(1)", "-e1(1)"]
+    [displacement]                             # optional
+    component = 2
+    integrations = 2
+
+Every model phdesign can read it can write, and ``read(write(model)) == model``.
+
+Examples
+--------
+>>> from phdesign.models import load_builtin
+>>> beam = load_builtin("euler-bernoulli")
+>>> model_from_toml(model_to_toml(beam)) == beam
+True
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import sympy
+import tomli_w
+
+from phdesign.errors import ModelFileError, OutputFileError
+from phdesign.symbolic.expressions import format_expression
+from phdesign.symbolic.model import BCPHS, Displacement
+
+__all__ = [
+    "atomic_write",
+    "json_value",
+    "model_from_dict",
+    "model_from_toml",
+    "model_to_dict",
+    "model_to_toml",
+    "read_model",
+    "write_model",
+]
+
+_REQUIRED = ("name", "interval", "order", "matrices", "ports")
+_OPTIONAL = ("description", "states", "parameters", "displacement")
+
+
+def read_model(path: str | os.PathLike[str]) -> BCPHS:
+    """Read a model file.
+
+    Raises
+    ------
+    ModelFileError
+        If the file cannot be read or is not valid TOML or lacks keys; model errors
+        (:class:`~phdesign.errors.ModelError`, ...) propagate with their own messages.
+    """
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise ModelFileError(f"cannot read model file {str(path)!r}: {_reason(error)}") from None
+    return model_from_toml(text, source=str(path))
+
+
+def _reason(error: Exception) -> str:
+    return error.strerror if isinstance(error, OSError) and error.strerror else str(error)
+
+
+def model_from_toml(text: str, source: str = "model file") -> BCPHS:
+    """Build a model from the text of a TOML model file."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise ModelFileError(f"{source} is not valid TOML: {error}") from None
+    return model_from_dict(data, source=source)
+
+
+def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPHS:
+    """Build a model from the parsed content of a model file."""
+    if not isinstance(data, Mapping):
+        raise ModelFileError(f"{source} must be a table; found {type(data).__name__}")
+    missing = [key for key in _REQUIRED if key not in data]
+    if missing:
+        raise ModelFileError(f"{source} lacks the key(s) {', '.join(missing)}")
+    unknown = sorted(set(data) - set(_REQUIRED) - set(_OPTIONAL))
+    if unknown:
+        raise ModelFileError(
+            f"{source} has unknown key(s) {', '.join(unknown)}; "
+            f"expected only {', '.join(_REQUIRED + _OPTIONAL)}"
+        )
+    matrices = _table(data, "matrices", source)
+    ports = _table(data, "ports", source)
+    parameters = _table(data, "parameters", source) if "parameters" in data else {}
+    order = data["order"]
+    P = {}
+    for key, value in matrices.items():
+        if key == "H":
+            continue
+        if not (key.startswith("P") and key[1:].isdigit()):
+            raise ModelFileError(
+                f"{source}: unknown matrix {key!r} in [matrices]; expected H and P0..P<order>"
+            )
+        P[int(key[1:])] = value
+    if "H" not in matrices:
+        raise ModelFileError(f"{source}: [matrices] lacks H")
+    bad_ports = sorted(set(ports) - {"inputs", "outputs"})
+    if bad_ports or "inputs" not in ports or "outputs" not in ports:
+        raise ModelFileError(
+            f"{source}: [ports] must hold exactly inputs and outputs; found "
+            f"{', '.join(sorted(ports)) or 'nothing'}"
+        )
+    displacement = None
+    if "displacement" in data:
+        table = _table(data, "displacement", source)
+        if set(table) != {"component", "integrations"} or not all(
+            isinstance(v, int) and not isinstance(v, bool) for v in table.values()
+        ):
+            raise ModelFileError(
+                f"{source}: [displacement] must hold integers component and integrations; "
+                f"found {dict(table)}"
+            )
+        displacement = Displacement(table["component"], table["integrations"])
+    states = data.get("states", ())
+    if "states" in data and not (
+        isinstance(states, list) and all(isinstance(s, str) for s in states)
+    ):
+        raise ModelFileError(f"{source}: states must be a list of names; found {states!r}")
+    for key in ("name", "description"):
+        if key in data and not isinstance(data[key], str):
+            raise ModelFileError(f"{source}: {key} must be text; found {data[key]!r}")
+    return BCPHS.define(
+        name=data["name"],
+        description=data.get("description", ""),
+        interval=data["interval"],
+        order=order,
+        P=P,
+        H=matrices["H"],
+        parameters=parameters,
+        inputs=ports["inputs"],
+        outputs=ports["outputs"],
+        state_names=tuple(states),
+        displacement=displacement,
+    )
+
+
+def _table(data: Mapping[str, Any], key: str, source: str) -> Mapping[str, Any]:
+    value = data[key]
+    if not isinstance(value, Mapping):
+        raise ModelFileError(f"{source}: {key} must be a table; found {value!r}")
+    return value
+
+
+def _toml_number(value: sympy.Expr) -> int | float | str:
+    """Write exact numbers as TOML ints or floats when that is exact, else as strings."""
+    if value.is_Integer:
+        return int(value)
+    if value.is_Rational:
+        as_float = float(value)
+        if sympy.Rational(repr(as_float)) == value:
+            return as_float
+    return str(value)
+
+
+def model_to_dict(model: BCPHS) -> dict[str, Any]:
+    """Return the content of the model file of ``model``."""
+    data: dict[str, Any] = {"name": model.name}
+    if model.description:
+        data["description"] = model.description
+    data["interval"] = [_toml_number(p) for p in model.interval]
+    data["order"] = model.order
+    if model.state_names != tuple(f"x{i + 1}" for i in range(model.size)):
+        data["states"] = list(model.state_names)
+    if model.parameters:
+        data["parameters"] = {s.name: _toml_number(v) for s, v in model.parameters}
+
+    def rows(matrix: sympy.MatrixBase) -> list[list[int | float | str]]:
+        return [
+            [_toml_number(x) if x.is_number else str(x) for x in row] for row in matrix.tolist()
+        ]
+
+    matrices: dict[str, Any] = {}
+    for k, P_k in enumerate(model.P):
+        if not P_k.is_zero_matrix:
+            matrices[f"P{k}"] = rows(P_k)
+    matrices["H"] = rows(model.H)
+    data["matrices"] = matrices
+    data["ports"] = {
+        "inputs": [format_expression(e, model.interval) for e in model.inputs],
+        "outputs": [format_expression(e, model.interval) for e in model.outputs],
+    }
+    if model.displacement is not None:
+        data["displacement"] = {
+            "component": model.displacement.component,
+            "integrations": model.displacement.integrations,
+        }
+    return data
+
+
+def model_to_toml(model: BCPHS) -> str:
+    """Return the text of the TOML model file of ``model``."""
+    return tomli_w.dumps(model_to_dict(model))
+
+
+def write_model(model: BCPHS, path: str | os.PathLike[str], force: bool = False) -> None:
+    """Write ``model`` as a TOML file (atomically; refuses to overwrite unless ``force``)."""
+    atomic_write(path, model_to_toml(model), force=force)
+
+
+def atomic_write(path: str | os.PathLike[str], text: str | bytes, force: bool = False) -> None:
+    """Write a file through a temporary file in the same folder and a rename.
+
+    Raises
+    ------
+    OutputFileError
+        If the file exists and ``force`` is false, or the folder is not writable.
+    """
+    target = Path(path)
+    if target.exists() and not force:
+        raise OutputFileError(f"output file {str(target)!r} exists; pass --force to overwrite it")
+    if target.is_dir():
+        raise OutputFileError(f"output path {str(target)!r} is a folder; expected a file name")
+    folder = target.parent if str(target.parent) else Path(".")
+    data = text.encode("utf-8") if isinstance(text, str) else text
+    try:
+        handle, temporary = tempfile.mkstemp(dir=folder, prefix=f".{target.name}.", suffix=".tmp")
+    except OSError as error:
+        raise OutputFileError(f"cannot write {str(target)!r}: {_reason(error)}") from None
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.replace(temporary, target)
+    except OSError as error:
+        Path(temporary).unlink(missing_ok=True)
+        raise OutputFileError(f"cannot write {str(target)!r}: {_reason(error)}") from None
+
+
+def json_value(value: Any) -> Any:
+    """Convert sympy, numpy and dataclass-free containers to JSON-ready values.
+
+    Exact sympy expressions become strings; sympy numbers that are integers become
+    ints; floats that are not finite become ``None``.
+    """
+    if isinstance(value, sympy.MatrixBase):
+        return [[str(x) for x in row] for row in value.tolist()]
+    if isinstance(value, sympy.Basic):
+        return str(value)
+    if isinstance(value, Mapping):
+        return {str(k): json_value(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_value(v) for v in value]
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if hasattr(value, "tolist"):  # numpy arrays and scalars
+        return json_value(value.tolist())
+    return value
+
+
+def dumps_json(value: Any) -> str:
+    """Serialize ``value`` (through :func:`json_value`) as indented JSON."""
+    return json.dumps(json_value(value), indent=2, ensure_ascii=False)

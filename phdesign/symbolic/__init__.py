@@ -1,0 +1,1 @@
+"""The symbolic layer: model, expressions, ports, observer and propositions (sympy only)."""
