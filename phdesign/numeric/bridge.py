@@ -1,0 +1,431 @@
+r"""The one crossing from the symbolic layer to the numeric one.
+
+:func:`to_numeric` takes a validated symbolic :class:`~phdesign.symbolic.model.BCPHS`,
+substitutes its parameters (defaults, overridden by the caller), refuses any symbol
+left free, and returns a :class:`NumericModel`: floats and a vectorized callable for
+the Hamiltonian density, nothing symbolic.  Everything else in :mod:`phdesign.numeric`
+works on :class:`NumericModel` only, so this is the one module of the numeric layer
+that imports sympy (and it does so lazily, inside functions).
+
+The port matrices follow the fixed trace ordering of the contract,
+
+.. math::
+
+    v = (\phi(b); \phi(a)), \quad
+    \phi = (e, e', \dots, e^{(N-1)}), \quad u = U v, \quad y = Y v,
+
+so that the index of :math:`e_i^{(k)}(\text{side})` in ``v`` is
+``(0 if side == "b" else N*n) + k*n + (i - 1)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from phdesign.errors import ModelError, NumericError, ParameterError, check_shape
+
+__all__ = [
+    "DisplacementSpec",
+    "NumericModel",
+    "constant_H",
+    "gain_to_numeric",
+    "initial_state_function",
+    "to_numeric",
+    "trace_index",
+]
+
+
+def trace_index(i: int, k: int, side: str, order: int, size: int) -> int:
+    r"""Return the 0-based index of :math:`e_i^{(k)}(\text{side})` in the trace vector.
+
+    Examples
+    --------
+    >>> trace_index(2, 1, "a", order=2, size=2)   # e2'(a) for the beam
+    7
+    """
+    return (0 if side == "b" else order * size) + k * size + (i - 1)
+
+
+@dataclass(frozen=True)
+class DisplacementSpec:
+    """Physical displacement: ``integrations`` integrals of state ``component`` from a.
+
+    ``component`` is 1-based (a component of x, not of e).  The beam has x2 = w_zz,
+    so ``DisplacementSpec(2, 2)`` gives w(z) = ∫_a^z ∫_a^s x2(r) dr ds.
+    """
+
+    component: int
+    integrations: int
+
+
+@dataclass(frozen=True)
+class NumericModel:
+    r"""A BC-PHS with every parameter substituted: the numeric layer's input.
+
+    .. math::
+
+        \partial_t x = \sum_{k=0}^N P_k \partial_z^k (H(z) x), \quad
+        u = U v, \quad y = Y v,
+
+    with ``P[k]`` of shape ``(n, n)``, ``U`` and ``Y`` of shape ``(N n, 2 N n)`` over the
+    trace vector ``v`` (see the module docstring) and ``H(z)`` a vectorized callable that
+    maps an array of ``m`` points to an array of shape ``(m, n, n)``.
+
+    Parameters
+    ----------
+    name : str
+        Model name (for labels).
+    interval : tuple of float
+        ``(a, b)`` with ``a < b``.
+    order, size : int
+        N and n.
+    P : tuple of ndarray
+        ``P_0 .. P_N``.
+    H : callable
+        ``H(z) -> (m, n, n)``; symmetric positive definite at every point.
+    U, Y : ndarray
+        Input and output maps over the trace vector.
+    input_labels, output_labels, state_names : tuple of str
+        Names used in exports and CSV headers.
+    displacement : DisplacementSpec or None
+        How to reconstruct a physical displacement, if the model has one.
+    H_constant : bool
+        True when H does not depend on z (lets discretizations skip quadrature work).
+    """
+
+    name: str
+    interval: tuple[float, float]
+    order: int
+    size: int
+    P: tuple[np.ndarray, ...]
+    H: Callable[[np.ndarray], np.ndarray]
+    U: np.ndarray
+    Y: np.ndarray
+    input_labels: tuple[str, ...] = ()
+    output_labels: tuple[str, ...] = ()
+    state_names: tuple[str, ...] = ()
+    displacement: DisplacementSpec | None = None
+    H_constant: bool = False
+    extra: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        a, b = (float(s) for s in self.interval)
+        if not a < b:
+            raise ModelError(f"interval must satisfy a < b; found a = {a}, b = {b}")
+        N, n = int(self.order), int(self.size)
+        if N < 1 or n < 1:
+            raise ModelError(f"order and size must be >= 1; found N = {N}, n = {n}")
+        if len(self.P) != N + 1:
+            raise ModelError(f"expected {N + 1} matrices P_0..P_{N}; found {len(self.P)}")
+        for k, Pk in enumerate(self.P):
+            check_shape(f"P{k}", np.asarray(Pk), (n, n))
+        check_shape("U", np.asarray(self.U), (N * n, 2 * N * n))
+        check_shape("Y", np.asarray(self.Y), (N * n, 2 * N * n))
+        object.__setattr__(self, "interval", (a, b))
+        object.__setattr__(self, "P", tuple(np.asarray(Pk, dtype=float) for Pk in self.P))
+        object.__setattr__(self, "U", np.asarray(self.U, dtype=float))
+        object.__setattr__(self, "Y", np.asarray(self.Y, dtype=float))
+        if not self.input_labels:
+            object.__setattr__(self, "input_labels", tuple(f"u{i + 1}" for i in range(N * n)))
+        if not self.output_labels:
+            object.__setattr__(self, "output_labels", tuple(f"y{i + 1}" for i in range(N * n)))
+        if not self.state_names:
+            object.__setattr__(self, "state_names", tuple(f"x{i + 1}" for i in range(n)))
+
+    @property
+    def n_ports(self) -> int:
+        """Number of inputs (= number of outputs) ``N n``."""
+        return self.order * self.size
+
+    def H_at(self, z: np.ndarray | float) -> np.ndarray:
+        """Evaluate H at the points ``z``; returns shape ``(m, n, n)``."""
+        zz = np.atleast_1d(np.asarray(z, dtype=float))
+        out = np.asarray(self.H(zz), dtype=float)
+        n = self.size
+        if out.shape != (zz.size, n, n):
+            out = np.broadcast_to(out, (zz.size, n, n)).copy()
+        return out
+
+
+def constant_H(
+    matrix: Sequence[Sequence[float]] | np.ndarray,
+) -> Callable[[np.ndarray], np.ndarray]:
+    """Return a vectorized callable for a constant Hamiltonian density.
+
+    Examples
+    --------
+    >>> constant_H([[1.0, 0.0], [0.0, 2.0]])(np.array([0.0, 0.5])).shape
+    (2, 2, 2)
+    """
+    Hm = np.asarray(matrix, dtype=float)
+
+    def H(z: np.ndarray) -> np.ndarray:
+        zz = np.atleast_1d(np.asarray(z, dtype=float))
+        return np.broadcast_to(Hm, (zz.size, *Hm.shape)).copy()
+
+    return H
+
+
+def _free_symbols_message(what: str, symbols: set[Any]) -> str:
+    names = ", ".join(sorted(str(s) for s in symbols))
+    return (
+        f"{what} still contains free symbols after substitution: {names}; give them with --param"
+    )
+
+
+def _parameter_values(model: Any, parameters: Mapping[str, Any] | None) -> dict[Any, Any]:
+    """Defaults of ``model`` overridden by ``parameters`` (keys by name)."""
+    import sympy
+
+    values: dict[Any, Any] = dict(model.parameter_defaults)
+    by_name = {str(s): s for s in values}
+    for key, val in (parameters or {}).items():
+        name = str(key)
+        if name not in by_name:
+            known = ", ".join(sorted(by_name)) or "none"
+            raise ParameterError(f"unknown parameter {name!r}; the model's parameters: {known}")
+        try:
+            expr = sympy.sympify(val) if not isinstance(val, sympy.Basic) else val
+        except (sympy.SympifyError, TypeError) as exc:
+            raise ParameterError(f"parameter {name!r}: cannot read value {val!r}") from exc
+        values[by_name[name]] = expr
+    return values
+
+
+def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> NumericModel:
+    """Substitute parameters into a symbolic BC-PHS and return a :class:`NumericModel`.
+
+    Parameters
+    ----------
+    model : phdesign.symbolic.model.BCPHS
+        The validated symbolic model.
+    parameters : mapping of str to number or expression, optional
+        Overrides of the model's parameter defaults, by name.
+
+    Returns
+    -------
+    NumericModel
+
+    Raises
+    ------
+    ParameterError
+        When a parameter is unknown or a symbol other than z stays free (the message
+        names them).
+    """
+    import sympy
+
+    from phdesign.symbolic.model import Z
+    from phdesign.symbolic.ports import derive_ports
+
+    values = _parameter_values(model, parameters)
+    N, n = int(model.order), int(model.size)
+
+    def subs_matrix(name: str, mat: Any, allow_z: bool) -> Any:
+        out = sympy.ImmutableMatrix(mat).subs(values)
+        free = set(out.free_symbols) - ({Z} if allow_z else set())
+        if free:
+            raise ParameterError(_free_symbols_message(name, free))
+        return out
+
+    a_s, b_s = (sympy.sympify(s).subs(values) for s in model.interval)
+    for nm_, s in (("interval start a", a_s), ("interval end b", b_s)):
+        if s.free_symbols:
+            raise ParameterError(_free_symbols_message(nm_, set(s.free_symbols)))
+    P = [
+        np.array(subs_matrix(f"P{k}", Pk, False).evalf(), dtype=float)
+        for k, Pk in enumerate(model.P)
+    ]
+    Hs = subs_matrix("H", model.H, True)
+    ports = derive_ports(model)
+    U = np.array(subs_matrix("U", ports.U, False).evalf(), dtype=float)
+    Y = np.array(subs_matrix("Y", ports.Y, False).evalf(), dtype=float)
+
+    H_constant = Z not in Hs.free_symbols
+    if H_constant:
+        Hfun = constant_H(np.array(Hs.evalf(), dtype=float))
+    else:
+        entries = [
+            sympy.lambdify(Z, Hs[i, j], modules="numpy") for i in range(n) for j in range(n)
+        ]
+
+        def Hfun(z: np.ndarray) -> np.ndarray:
+            zz = np.atleast_1d(np.asarray(z, dtype=float))
+            vals = [np.broadcast_to(np.asarray(f(zz), dtype=float), zz.shape) for f in entries]
+            return np.stack(vals, axis=-1).reshape(zz.size, n, n)
+
+    disp = None
+    d = getattr(model, "displacement", None)
+    if d is not None:
+        disp = DisplacementSpec(int(d.component), int(d.integrations))
+    in_labels = tuple(str(e) for e in model.inputs)
+    out_labels = tuple(str(e) for e in model.outputs)
+    nm = NumericModel(
+        name=str(model.name),
+        interval=(float(a_s), float(b_s)),
+        order=N,
+        size=n,
+        P=tuple(P),
+        H=Hfun,
+        U=U,
+        Y=Y,
+        input_labels=in_labels,
+        output_labels=out_labels,
+        state_names=tuple(model.state_names),
+        displacement=disp,
+        H_constant=H_constant,
+    )
+    # H must be positive definite after substitution (the symbolic check used defaults).
+    zs = np.linspace(nm.interval[0], nm.interval[1], 33)
+    Hv = nm.H_at(zs)
+    if not np.all(np.isfinite(Hv)):
+        raise ParameterError("H is not finite on the interval for these parameter values")
+    if np.min(np.linalg.eigvalsh(0.5 * (Hv + Hv.transpose(0, 2, 1)))) <= 0:
+        raise ParameterError(
+            "H is not positive definite on the interval for these parameter values"
+        )
+    return nm
+
+
+def gain_to_numeric(matrix: Any, name: str = "L") -> np.ndarray:
+    """Convert a sympy (or nested list) matrix of numbers to a float array.
+
+    Raises :class:`ParameterError` when a symbol is left (e.g. ``--gain symbolic``).
+    """
+    try:
+        import sympy
+
+        if isinstance(matrix, sympy.MatrixBase):
+            if matrix.free_symbols:
+                raise ParameterError(_free_symbols_message(name, set(matrix.free_symbols)))
+            return np.array(matrix.evalf(), dtype=float)
+    except ImportError:  # pragma: no cover - sympy is a hard dependency
+        pass
+    try:
+        return np.array(matrix, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"{name}: cannot convert to a numeric matrix ({exc})") from exc
+
+
+def initial_state_function(
+    text: str | None,
+    nm: NumericModel,
+    parameters: Mapping[str, Any] | None = None,
+    model: Any = None,
+) -> Callable[[np.ndarray], np.ndarray]:
+    """Parse an initial state ``'x1: 0, x2: z - 0.9'`` into a vectorized callable.
+
+    Syntax: comma-separated ``name: expression`` pairs.  A name is a state name of the
+    model (``x1``, ...) or ``e<i>`` for the effort ``(H x)_i``; an expression is a
+    formula in ``z`` and the model's parameters (``sin(pi*z)``, ``z - 0.9``).  Components
+    not mentioned are zero.  Expressions are parsed with the symbolic layer's safe parser
+    (no ``eval`` of user text).  Efforts and states cannot be mixed.
+
+    Returns
+    -------
+    callable
+        ``f(z) -> (m, n)``, the state x at the points z.
+
+    Examples
+    --------
+    >>> from phdesign.numeric.bridge import NumericModel, constant_H
+    >>> import numpy as np
+    >>> P = (np.zeros((1, 1)), np.ones((1, 1)))
+    >>> U = np.array([[0.0, 1.0]]); Y = np.array([[1.0, 0.0]])
+    >>> nm = NumericModel("t", (0.0, 1.0), 1, 1, P, constant_H([[2.0]]), U, Y)
+    >>> initial_state_function("e1: 2*z", nm)(np.array([0.5]))
+    array([[0.5]])
+    """
+    n = nm.size
+    if text is None or not text.strip():
+        return lambda z: np.zeros((np.atleast_1d(z).size, n))
+    import sympy
+
+    names = {s: i for i, s in enumerate(nm.state_names)}
+    efforts = {f"e{i + 1}": i for i in range(n)}
+    exprs: dict[int, Any] = {}
+    kind: str | None = None
+    for part in _split_top_level(text):
+        if ":" not in part:
+            raise ParameterError(
+                f"initial state item {part.strip()!r}: expected 'name: expression', "
+                f"e.g. '{nm.state_names[0]}: z - 0.9'"
+            )
+        key, expr_text = (s.strip() for s in part.split(":", 1))
+        if key in names:
+            this, idx = "x", names[key]
+        elif key in efforts:
+            this, idx = "e", efforts[key]
+        else:
+            known = ", ".join([*nm.state_names, *efforts])
+            raise ParameterError(
+                f"initial state: unknown component {key!r}; expected one of {known}"
+            )
+        if kind is not None and this != kind:
+            raise ParameterError(
+                "initial state: give either state components or efforts, not both"
+            )
+        kind = this
+        if idx in exprs:
+            raise ParameterError(f"initial state: component {key!r} given twice")
+        exprs[idx] = _parse_z_expression(expr_text, model, parameters)
+    from phdesign.symbolic.model import Z
+
+    funcs = {i: sympy.lambdify(Z, e, modules="numpy") for i, e in exprs.items()}
+
+    def x0(z: np.ndarray) -> np.ndarray:
+        zz = np.atleast_1d(np.asarray(z, dtype=float))
+        out = np.zeros((zz.size, n))
+        for i, f in funcs.items():
+            out[:, i] = np.broadcast_to(np.asarray(f(zz), dtype=float), zz.shape)
+        if kind == "e":
+            out = np.linalg.solve(nm.H_at(zz), out[:, :, None])[:, :, 0]
+        return out
+
+    return x0
+
+
+def _split_top_level(text: str) -> list[str]:
+    """Split on commas that are not inside parentheses or brackets."""
+    parts, depth, cur = [], 0, []
+    for ch in text:
+        if ch in "([":
+            depth += 1
+        elif ch in ")]":
+            depth -= 1
+        if ch == "," and depth == 0:
+            parts.append("".join(cur))
+            cur = []
+        else:
+            cur.append(ch)
+    parts.append("".join(cur))
+    return [p for p in parts if p.strip()]
+
+
+def _parse_z_expression(text: str, model: Any, parameters: Mapping[str, Any] | None) -> Any:
+    """Parse an expression in z (and parameters) safely and substitute parameter values."""
+    import sympy
+
+    from phdesign.symbolic import expressions as ex
+    from phdesign.symbolic.model import Z
+
+    parser = getattr(ex, "parse_expression", None) or getattr(ex, "parse_scalar", None)
+    if parser is None:
+        raise NumericError("the symbolic layer offers no safe expression parser")
+    allowed = {"z": Z}
+    values: dict[Any, Any] = {}
+    if model is not None:
+        values = _parameter_values(model, parameters)
+        allowed.update({str(s): s for s in values})
+    try:
+        expr = parser(text, allowed)
+    except TypeError:
+        expr = parser(text)
+    expr = sympy.sympify(expr).subs(values)
+    free = set(expr.free_symbols) - {Z}
+    if free:
+        raise ParameterError(_free_symbols_message(f"initial state expression {text!r}", free))
+    return expr
