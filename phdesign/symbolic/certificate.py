@@ -1,0 +1,269 @@
+r"""The certificate of one variant: does it hold, with which best constant :math:`\kappa^*`.
+
+On the admissible traces :math:`v = K\tilde y` of the error system (see
+:mod:`phdesign.symbolic.observer`) a variant asks for :math:`\kappa > 0` with
+
+.. math::
+
+    \mathrm{LHS}(v) = \tfrac12 \tilde y_m^\top (L + L^\top) \tilde y_m
+    \;\ge\; \kappa\, \mathrm{RHS}(v) = \kappa \|S v\|^2 ,
+
+:math:`S` selecting the traces of the variant.  Both sides are positive
+semidefinite quadratic forms in :math:`\tilde y`, so a :math:`\kappa > 0` exists iff
+:math:`\ker \mathrm{LHS} \subseteq \ker \mathrm{RHS}`, and then the best one is
+
+.. math::
+
+    \kappa^* = \inf_{\mathrm{RHS}(v) > 0} \frac{\mathrm{LHS}(v)}{\mathrm{RHS}(v)}
+             = \frac{1}{\mu_{\max}}, \qquad
+    \det(B_r - \mu A_r) = 0 ,
+
+with the pencil reduced to a complement of :math:`\ker\mathrm{LHS}`.
+
+*Decision.*  Since :math:`L + L^\top \succ 0`, :math:`\ker\mathrm{LHS} = \{\tilde y :
+C_m\tilde y = 0\}`, and there :math:`C_m^\top L C_m \tilde y = 0`, so
+:math:`v = T^{-1}(0; \tilde y)`: the kernel does not depend on :math:`L`.  The
+variant holds iff :math:`S\,T^{-1}(0; N_C) = 0` for a basis :math:`N_C` of
+:math:`\ker C_m` — an exact, gain-free test.  (For unit-row sensors, :math:`N_C`
+is the unit vectors of the unmeasured outputs: an unmeasured output :math:`j`
+whose column of :math:`T^{-1}` touches a selected trace breaks the variant.)
+A failing variant returns that :math:`v` as witness: LHS = 0, RHS > 0.
+
+*Constant.*  Parametrize the complement by the measurement :math:`z = \tilde y_m`:
+:math:`\tilde y = C_m^\top (C_m C_m^\top)^{-1} z`, :math:`v = K_m z`,
+:math:`A_r = \mathrm{sym}(L)`, :math:`B_r = (S K_m)^\top (S K_m)`.  Exact path:
+largest real root of :math:`\det(B_r - \mu A_r)` (rational or algebraic).  Float
+path: Cholesky :math:`A_r = R R^\top`, :math:`\mu_{\max} =
+\lambda_{\max}(R^{-1} B_r R^{-\top})` with numpy.  Symbolic gains: the pencil is
+factored over :math:`\mathbb Q(l_1, \dots)`, :math:`\kappa^* = \min_i 1/\mu_i` over
+the non-zero root branches.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import sympy
+from sympy.polys.matrices import DomainMatrix
+
+from phdesign.symbolic.observer import ErrorSystem
+
+__all__ = ["Certificate", "certify", "float_kappa"]
+
+_MU = sympy.Symbol("mu")
+
+
+@dataclass(frozen=True)
+class Certificate:
+    r"""Outcome of :func:`certify` for one right-hand side.
+
+    Attributes
+    ----------
+    holds : bool
+        Whether :math:`\ker\mathrm{LHS}|_{\mathcal K} \subseteq \ker\mathrm{RHS}|_{\mathcal K}`.
+    kappa : sympy.Expr or None
+        Exact :math:`\kappa^*` (a number, or an expression in the gains); ``None``
+        when the variant fails, when RHS vanishes on :math:`\mathcal K` (unbounded),
+        or when only the float path was run.
+    kappa_float : float or None
+        :math:`\kappa^*` in floating point (``None`` as above, or for symbolic gains).
+    unbounded : bool
+        RHS vanishes identically on :math:`\mathcal K` (holds with any :math:`\kappa`).
+    witness : tuple of sympy.Expr or None
+        A trace vector :math:`v \in \mathcal K` with LHS = 0 < RHS when the variant fails.
+    free : tuple of int
+        Indices (in :math:`v`) of selected traces that the witness leaves non-zero.
+    path : str
+        ``"exact"``, ``"float"`` or ``"symbolic"``: how :math:`\kappa^*` was computed
+        (the decision itself is always exact).
+    conditions : str or None
+        For symbolic gains, the range of gains the answer is valid for.
+    """
+
+    holds: bool
+    kappa: sympy.Expr | None
+    kappa_float: float | None
+    unbounded: bool
+    witness: tuple[sympy.Expr, ...] | None
+    free: tuple[int, ...]
+    path: str
+    conditions: str | None = None
+    # reduced pencil, kept for the minimizer (not part of equality)
+    pencil: tuple[Any, Any, Any] | None = field(default=None, compare=False, repr=False)
+
+    def minimizer(self) -> Any:
+        r"""Return a trace vector :math:`v \in \mathcal K` attaining :math:`\kappa^*` (numpy).
+
+        ``None`` when the variant fails, is unbounded, or has symbolic gains.
+        """
+        if not self.holds or self.unbounded or self.pencil is None:
+            return None
+        import numpy as np
+
+        A_r, B_r, K_m = (np.array(M.evalf(17).tolist(), dtype=float) for M in self.pencil)
+        _, z = _top_eig(A_r, B_r)
+        return K_m @ z
+
+
+def _nullspace(M: sympy.MatrixBase) -> list[sympy.Matrix]:
+    if M.rows == 0:
+        return [sympy.eye(M.cols)[:, j] for j in range(M.cols)]
+    try:
+        dm = DomainMatrix.from_Matrix(M).to_field()
+        basis = dm.nullspace().to_Matrix()
+        return [basis[i, :].T for i in range(basis.rows)]
+    except Exception:  # algebraic domains DomainMatrix cannot handle: sympy fallback
+        return list(M.nullspace())
+
+
+def certify(
+    es: ErrorSystem,
+    selected: Sequence[int],
+    method: str = "auto",
+) -> Certificate:
+    """Decide one variant and compute its best constant.
+
+    Parameters
+    ----------
+    es : ErrorSystem
+        The error system (sensors, gain, admissible traces).
+    selected : sequence of int
+        Indices in the trace vector :math:`v` of the traces the right-hand side sums.
+    method : {"auto", "exact", "float"}
+        ``auto``: exact for numeric gains whose pencil has a computable exact root,
+        else float; symbolic gains are always symbolic.
+
+    Returns
+    -------
+    Certificate
+    """
+    nn = es.order * es.size
+    rows = list(selected)
+    # ---- decision (exact, independent of L)
+    W = es.T_inv[:, nn:]
+    for n_c in _nullspace(es.C_m):
+        v = W * n_c
+        sv = [sympy.simplify(v[i]) for i in rows]
+        if any(x != 0 for x in sv):
+            free = tuple(i for i, x in zip(rows, sv, strict=True) if x != 0)
+            witness = tuple(sympy.simplify(x) for x in v)
+            return Certificate(False, None, None, False, witness, free, "exact")
+    # ---- constant
+    C_m, L = es.C_m, es.L
+    right_inverse = C_m.T * (C_m * C_m.T).inv()
+    K_m = sympy.ImmutableMatrix(es.K * right_inverse)
+    SK = K_m.extract(rows, list(range(K_m.cols))) if rows else sympy.zeros(0, K_m.cols)
+    B_r = sympy.ImmutableMatrix(SK.T * SK)
+    A_r = sympy.ImmutableMatrix((L + L.T) / 2)
+    symbolic = bool(L.free_symbols)
+    if symbolic:
+        B_r = B_r.applyfunc(sympy.cancel)
+    if B_r.is_zero_matrix:
+        return Certificate(True, None, None, True, None, (), "symbolic" if symbolic else "exact")
+    pencil = (A_r, B_r, K_m)
+    if symbolic:
+        kappa, conditions = _symbolic_kappa(A_r, B_r)
+        return Certificate(True, kappa, None, False, None, (), "symbolic", conditions, pencil)
+    if method in ("auto", "exact"):
+        exact = _exact_kappa(A_r, B_r)
+        if exact is not None:
+            value = float(exact.evalf(30))
+            return Certificate(True, exact, value, False, None, (), "exact", None, pencil)
+        if method == "exact":
+            raise ValueError("no exact root available for this pencil; use method='float'")
+    value = float_kappa(A_r, B_r)
+    return Certificate(True, None, value, False, None, (), "float", None, pencil)
+
+
+def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | None:
+    r"""Exact :math:`1/\mu_{\max}`, or ``None`` if the roots cannot be isolated exactly."""
+    try:
+        dA = DomainMatrix.from_Matrix(A_r).to_field()
+        dB = DomainMatrix.from_Matrix(B_r).to_field()
+        unify = dA.unify(dB)
+        dA, dB = unify if isinstance(unify, tuple) else (dA, dB)
+        M = dA.inv() * dB
+        coefficients = M.charpoly()
+        domain = M.domain
+        poly = sympy.Poly([domain.to_sympy(c) for c in coefficients], _MU)
+    except Exception:
+        poly = sympy.Poly((B_r - _MU * A_r).det(method="berkowitz"), _MU)
+    try:
+        roots = sympy.real_roots(poly)
+    except (sympy.PolynomialError, NotImplementedError, sympy.DomainError):
+        try:
+            roots = [r for r in sympy.roots(poly, _MU) if r.is_real]
+        except Exception:
+            return None
+        if sum(sympy.roots(poly, _MU).values()) != poly.degree():
+            return None
+    if not roots:
+        return None
+    mu_max = max(roots, key=lambda r: float(r.evalf(30)))
+    if mu_max == 0:
+        return None
+    return sympy.nsimplify(1 / mu_max) if mu_max.is_rational else 1 / mu_max
+
+
+def _symbolic_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> tuple[sympy.Expr | None, str]:
+    r""":math:`\kappa^* = \min_i 1/\mu_i` over the non-zero root branches of the pencil."""
+    det = sympy.factor((B_r - _MU * A_r).det(method="berkowitz"))
+    branches: list[sympy.Expr] = []
+    unresolved = False
+    _, factors = sympy.factor_list(det, _MU)
+    for factor, _multiplicity in factors:
+        degree = sympy.degree(factor, _MU)
+        if degree == 0:
+            continue
+        if degree > 2:
+            unresolved = True
+            continue
+        for root in sympy.roots(sympy.Poly(factor, _MU)):
+            root = sympy.simplify(root)
+            if root != 0:
+                branches.append(sympy.simplify(1 / root))
+    gains = sorted(A_r.free_symbols | B_r.free_symbols, key=str)
+    names = ", ".join(map(str, gains))
+    if unresolved:
+        return None, (
+            f"holds for all positive {names}; κ* is 1/(largest root) of a pencil "
+            "factor of degree > 2 (no closed form)"
+        )
+    if not branches:
+        return None, f"holds for all positive {names}; RHS vanishes on K"
+    kappa = branches[0] if len(branches) == 1 else sympy.Min(*branches)
+    return kappa, f"holds for all positive {names}"
+
+
+def _top_eig(A: Any, B: Any) -> tuple[float, Any]:
+    r"""Largest :math:`\mu` with :math:`\det(B - \mu A) = 0` and its eigenvector (numpy)."""
+    import numpy as np
+
+    R = np.linalg.cholesky(A)
+    R_inv = np.linalg.inv(R)
+    C = R_inv @ B @ R_inv.T
+    w, V = np.linalg.eigh((C + C.T) / 2)
+    z = R_inv.T @ V[:, -1]
+    return float(w[-1]), z
+
+
+def float_kappa(A_r: Any, B_r: Any) -> float | None:
+    r"""Floating-point :math:`\kappa^* = 1/\mu_{\max}` (``None`` when :math:`B_r = 0`)."""
+    import numpy as np
+
+    A = (
+        np.array(sympy.Matrix(A_r).evalf(17).tolist(), dtype=float)
+        if hasattr(A_r, "evalf")
+        else np.asarray(A_r, float)
+    )
+    B = (
+        np.array(sympy.Matrix(B_r).evalf(17).tolist(), dtype=float)
+        if hasattr(B_r, "evalf")
+        else np.asarray(B_r, float)
+    )
+    if not np.any(B):
+        return None
+    mu, _ = _top_eig(A, B)
+    return 1.0 / mu

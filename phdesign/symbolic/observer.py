@@ -1,0 +1,406 @@
+r"""The boundary observer and its error system.
+
+The observer copies the plant and corrects its input with the measured outputs,
+
+.. math::
+
+    \hat u = u + C_m^\top L\, (y_m - \hat y_m), \qquad y_m = C_m y,
+    \qquad L + L^\top \succ 0 ,
+
+so the error :math:`\tilde x = x - \hat x` is the same BC-PHS with the boundary condition
+
+.. math::
+
+    \tilde u = -C_m^\top L C_m \tilde y
+    \quad\Longleftrightarrow\quad
+    (U + C_m^\top L C_m Y)\, v = 0 ,
+
+where :math:`u = U v`, :math:`y = Y v` over the trace vector :math:`v` (ports layer).
+The admissible traces form :math:`\mathcal K = \ker(U + C_m^\top L C_m Y)`.
+Because :math:`T = \begin{pmatrix} U \\ Y \end{pmatrix}` is invertible (the port
+identities make :math:`(W_B; W_C)` invertible), :math:`\mathcal K` has the explicit basis
+
+.. math::
+
+    K = T^{-1} \begin{pmatrix} -C_m^\top L C_m \\ I \end{pmatrix}
+    \qquad (v = K \tilde y),
+
+parametrized by the error output :math:`\tilde y` itself, for every gain: no rank
+decision on :math:`L` is involved, so a symbolic gain cannot hide a generic-rank
+answer here.  :math:`\dim \mathcal K = Nn` is still checked.
+
+Examples
+--------
+>>> sensor_matrix([3, 4], n_outputs=4)
+Matrix([
+[0, 0, 1, 0],
+[0, 0, 0, 1]])
+>>> parse_gain("0.1, 1", q=2)
+Matrix([
+[1/10, 0],
+[   0, 1]])
+>>> parse_gain("symbolic", q=2)
+Matrix([
+[l1,  0],
+[ 0, l2]])
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import sympy
+from sympy.polys.matrices import DomainMatrix
+
+from phdesign.errors import ExpressionError, ObserverError, check_shape
+from phdesign.symbolic.expressions import exact_number
+from phdesign.symbolic.model import BCPHS
+
+__all__ = [
+    "ErrorSystem",
+    "ObserverDesign",
+    "error_system",
+    "gain_symbols",
+    "parse_cm",
+    "parse_gain",
+    "parse_sensors",
+    "port_matrices",
+    "sensor_matrix",
+]
+
+
+# --------------------------------------------------------------------------- sensors
+def sensor_matrix(indices: Sequence[int], n_outputs: int) -> sympy.ImmutableMatrix:
+    """Return :math:`C_m` whose rows are the unit rows picking outputs ``indices`` (1-based).
+
+    Raises
+    ------
+    ObserverError
+        If an index is out of ``1..n_outputs``, repeated, or the list is empty.
+    """
+    picked = list(indices)
+    if not picked:
+        raise ObserverError("sensors: expected at least one output index; found none")
+    seen: set[int] = set()
+    for index in picked:
+        if isinstance(index, bool) or not isinstance(index, int):
+            raise ObserverError(f"sensors: expected integer output indices; found {index!r}")
+        if not 1 <= index <= n_outputs:
+            raise ObserverError(
+                f"sensors: output index {index} is out of range; expected 1..{n_outputs}"
+            )
+        if index in seen:
+            raise ObserverError(
+                f"sensors: output index {index} is repeated; expected distinct indices"
+            )
+        seen.add(index)
+    return sympy.ImmutableMatrix(
+        len(picked), n_outputs, lambda r, c: 1 if c == picked[r] - 1 else 0
+    )
+
+
+def parse_sensors(text: str, n_outputs: int) -> sympy.ImmutableMatrix:
+    """Parse ``"3,4"`` into :math:`C_m` (see :func:`sensor_matrix`)."""
+    parts = [p.strip() for p in str(text).split(",")]
+    indices = []
+    for part in parts:
+        try:
+            indices.append(int(part))
+        except ValueError:
+            raise ObserverError(
+                f"--sensors: expected comma-separated output indices like 3,4; "
+                f"found {part!r} in {text!r}"
+            ) from None
+    return sensor_matrix(indices, n_outputs)
+
+
+def _numbers_from_json(text: str, what: str) -> object:
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as error:
+        raise ObserverError(
+            f"{what}: expected a JSON list of rows like [[0, 1], [1, 0]]; found {text!r} "
+            f"({error.msg} at character {error.pos})"
+        ) from None
+
+
+def _exact_matrix(rows: object, what: str) -> sympy.ImmutableMatrix:
+    if not isinstance(rows, list) or not rows or not all(isinstance(r, list) and r for r in rows):
+        raise ObserverError(f"{what}: expected a non-empty list of non-empty rows; found {rows!r}")
+    width = len(rows[0])  # type: ignore[arg-type]
+    for i, row in enumerate(rows):  # type: ignore[arg-type]
+        if len(row) != width:
+            raise ObserverError(
+                f"{what}: row {i + 1} has {len(row)} entries; expected {width} like row 1"
+            )
+    try:
+        entries = [
+            [exact_number(x, f"{what}[{i + 1}][{j + 1}]") for j, x in enumerate(row)]
+            for i, row in enumerate(rows)  # type: ignore[arg-type]
+        ]
+    except ExpressionError as error:
+        raise ObserverError(str(error)) from None
+    return sympy.ImmutableMatrix(entries)
+
+
+def parse_cm(text: str, n_outputs: int) -> sympy.ImmutableMatrix:
+    """Parse ``"[[0,0,1,0]]"`` into :math:`C_m` (``q x n_outputs``), exactly."""
+    C_m = _exact_matrix(_numbers_from_json(text, "--cm"), "--cm")
+    if C_m.shape[1] != n_outputs:
+        raise ObserverError(
+            f"--cm: Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) "
+            f"but found {C_m.shape}"
+        )
+    return C_m
+
+
+@lru_cache(maxsize=64)
+def gain_symbols(q: int) -> tuple[sympy.Symbol, ...]:
+    """Return the positive symbols ``l1 .. lq`` used for symbolic gains."""
+    return tuple(sympy.Symbol(f"l{i + 1}", positive=True) for i in range(q))
+
+
+def parse_gain(text: str, q: int) -> sympy.ImmutableMatrix:
+    r"""Parse a gain: ``"0.1,1"`` (diagonal), ``"[[..]]"`` (full) or ``"symbolic"``.
+
+    A single diagonal value is used for every sensor.  Numbers are read exactly
+    (``0.1`` is :math:`1/10`).  ``symbolic`` gives :math:`L = \mathrm{diag}(l_1..l_q)`
+    with positive symbols.
+    """
+    text = str(text).strip()
+    if text == "symbolic":
+        return sympy.ImmutableMatrix(sympy.diag(*gain_symbols(q)))
+    if text.startswith("["):
+        L = _exact_matrix(_numbers_from_json(text, "--gain"), "--gain")
+        if L.shape != (q, q):
+            raise ObserverError(
+                f"--gain: Incompatible dimensions of L matrix; expected {(q, q)} "
+                f"(one row and column per sensor) but found {L.shape}"
+            )
+        return L
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        values = [exact_number(p, f"--gain entry {p!r}") for p in parts]
+    except ExpressionError as error:
+        raise ObserverError(f"--gain: {error}") from None
+    if len(values) == 1:
+        values = values * q
+    if len(values) != q:
+        raise ObserverError(
+            f"--gain: expected {q} diagonal values (one per sensor) or a single one; "
+            f"found {len(values)} in {text!r}"
+        )
+    return sympy.ImmutableMatrix(sympy.diag(*values))
+
+
+# --------------------------------------------------------------------------- checks
+def _check_cm(C_m: sympy.MatrixBase, n_outputs: int) -> sympy.ImmutableMatrix:
+    C_m = sympy.ImmutableMatrix(C_m)
+    if C_m.rows < 1 or C_m.rows > n_outputs:
+        raise ObserverError(
+            f"Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) with "
+            f"1 <= q <= {n_outputs} but found {C_m.shape}"
+        )
+    try:
+        check_shape("C_m", C_m, (C_m.rows, n_outputs))
+    except ValueError as error:
+        raise ObserverError(str(error)) from None
+    C_m = _exactify_entries(C_m, "C_m")
+    if C_m.free_symbols:
+        raise ObserverError(
+            f"C_m must be numeric; found symbols {sorted(map(str, C_m.free_symbols))}"
+        )
+    rank = C_m.rank()
+    if rank != C_m.rows:
+        raise ObserverError(
+            f"C_m must have full row rank (independent measurements); expected rank "
+            f"{C_m.rows} but found {rank}"
+        )
+    return C_m
+
+
+def _exactify_entries(M: sympy.MatrixBase, what: str) -> sympy.ImmutableMatrix:
+    entries = []
+    for i in range(M.rows):
+        row = []
+        for j in range(M.cols):
+            x = M[i, j]
+            if isinstance(x, sympy.Basic) and x.free_symbols:
+                row.append(x)
+                continue
+            try:
+                row.append(
+                    exact_number(
+                        x if isinstance(x, sympy.Basic) else _py(x), f"{what}[{i + 1}][{j + 1}]"
+                    )
+                )
+            except ExpressionError as error:
+                raise ObserverError(str(error)) from None
+        entries.append(row)
+    return sympy.ImmutableMatrix(entries)
+
+
+def _py(x: object) -> object:
+    # numpy scalars -> python numbers, without importing numpy
+    item = getattr(x, "item", None)
+    return item() if callable(item) else x
+
+
+def _check_gain(L: sympy.MatrixBase, q: int) -> sympy.ImmutableMatrix:
+    L = sympy.ImmutableMatrix(L)
+    try:
+        check_shape("L", L, (q, q))
+    except ValueError as error:
+        raise ObserverError(f"{error} (one row and column per sensor)") from None
+    L = _exactify_entries(L, "L")
+    sym = (L + L.T) / 2
+    if L.free_symbols:
+        # Symbolic gains: only a diagonal of positive expressions is decidable for all values.
+        off = [sym[i, j] for i in range(q) for j in range(q) if i != j and sym[i, j] != 0]
+        if off or not all(sym[i, i].is_positive for i in range(q)):
+            raise ObserverError(
+                "symbolic L must be diagonal with positive entries (e.g. --gain symbolic) "
+                "so that L + Lᵀ > 0 holds for every value; found "
+                f"{L.tolist()}"
+            )
+        return L
+    # Exact Sylvester test on leading principal minors (q is small).
+    for k in range(1, q + 1):
+        minor = sympy.simplify(sym[:k, :k].det()) if k > 1 else sym[0, 0]
+        if not minor.is_positive:
+            raise ObserverError(
+                f"L + Lᵀ must be positive definite; expected every leading principal minor "
+                f"> 0 but found minor {k} = {2**k * minor}"
+            )
+    return L
+
+
+# --------------------------------------------------------------------------- design
+@lru_cache(maxsize=64)
+def port_matrices(model: BCPHS) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix]:
+    r"""Return :math:`(U, Y)` of ``model`` with the parameter defaults substituted.
+
+    The classification lives in trace coordinates: only :math:`U` and :math:`Y`
+    enter it (not :math:`\mathcal H`, and :math:`P_k` only through Assumption 3.1).
+    """
+    from phdesign.symbolic.ports import derive_ports
+
+    ports = derive_ports(model)
+    defaults = model.parameter_defaults
+    U, Y = (sympy.ImmutableMatrix(M.xreplace(defaults)) for M in (ports.U, ports.Y))
+    return U, Y
+
+
+@lru_cache(maxsize=64)
+def _inverse(T: sympy.ImmutableMatrix) -> sympy.ImmutableMatrix:
+    dm = DomainMatrix.from_Matrix(T).to_field()
+    return sympy.ImmutableMatrix(dm.inv().to_Matrix())
+
+
+@dataclass(frozen=True)
+class ErrorSystem:
+    r"""The boundary data of the observer error system.
+
+    Attributes
+    ----------
+    order, size : int
+        :math:`N` and :math:`n`.
+    U, Y : sympy.ImmutableMatrix
+        :math:`u = U v`, :math:`y = Y v` (parameters substituted).
+    T_inv : sympy.ImmutableMatrix
+        :math:`T^{-1}`, :math:`T = (U; Y)`: the trace vector with inputs ``u`` and
+        outputs ``y`` is :math:`v = T^{-1}(u; y)`.
+    C_m, L : sympy.ImmutableMatrix
+        Sensors and gain.
+    boundary_matrix : sympy.ImmutableMatrix
+        :math:`U + C_m^\top L C_m Y`, whose kernel is :math:`\mathcal K`.
+    K : sympy.ImmutableMatrix
+        Basis of :math:`\mathcal K`, :math:`2Nn \times Nn`, coordinates :math:`\tilde y`.
+    """
+
+    order: int
+    size: int
+    U: sympy.ImmutableMatrix
+    Y: sympy.ImmutableMatrix
+    T_inv: sympy.ImmutableMatrix
+    C_m: sympy.ImmutableMatrix
+    L: sympy.ImmutableMatrix
+    boundary_matrix: sympy.ImmutableMatrix
+    K: sympy.ImmutableMatrix
+
+    @property
+    def lhs_matrix(self) -> sympy.ImmutableMatrix:
+        r"""Return :math:`M = C_m^\top \mathrm{sym}(L) C_m` (LHS is its quadratic form in ỹ)."""
+        return sympy.ImmutableMatrix(self.C_m.T * (self.L + self.L.T) / 2 * self.C_m)
+
+
+def error_system(
+    order: int,
+    size: int,
+    U: sympy.MatrixBase,
+    Y: sympy.MatrixBase,
+    C_m: sympy.MatrixBase,
+    L: sympy.MatrixBase,
+) -> ErrorSystem:
+    r"""Build the error boundary condition and the admissible traces.
+
+    Raises
+    ------
+    ObserverError
+        If ``C_m`` or ``L`` is malformed, or :math:`\dim \mathcal K \ne Nn`.
+    """
+    nn = order * size
+    C_m = _check_cm(C_m, nn)
+    L = _check_gain(L, C_m.rows)
+    U = sympy.ImmutableMatrix(U)
+    Y = sympy.ImmutableMatrix(Y)
+    T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
+    G = C_m.T * L * C_m
+    boundary = sympy.ImmutableMatrix(U + G * Y)
+    K = sympy.ImmutableMatrix(T_inv * sympy.Matrix.vstack(-G, sympy.eye(nn)))
+    # dim K = Nn: K has Nn columns and its lower part through Y is the identity
+    # (Y K = I), so the columns are independent; K solves the boundary condition.
+    residual = (boundary * K).applyfunc(sympy.simplify) if L.free_symbols else boundary * K
+    if not residual.is_zero_matrix or sympy.eye(nn) != (Y * K):
+        raise ObserverError(
+            f"the admissible traces K = ker(U + C_mᵀ L C_m Y) must have dimension Nn = {nn}; "
+            "the port matrices are inconsistent"
+        )
+    return ErrorSystem(order, size, U, Y, T_inv, C_m, L, boundary, K)
+
+
+@dataclass(frozen=True)
+class ObserverDesign:
+    r"""A sensor set and gain for a model: the observer of the module docstring.
+
+    Parameters
+    ----------
+    model : BCPHS
+        The plant.
+    C_m : sympy matrix
+        ``q x Nn``, full row rank.
+    L : sympy matrix
+        ``q x q`` with :math:`L + L^\top > 0` (checked), or diagonal positive symbols.
+    """
+
+    model: BCPHS
+    C_m: sympy.ImmutableMatrix
+    L: sympy.ImmutableMatrix
+
+    def __post_init__(self) -> None:
+        nn = self.model.order * self.model.size
+        object.__setattr__(self, "C_m", _check_cm(self.C_m, nn))
+        object.__setattr__(self, "L", _check_gain(self.L, self.C_m.rows))
+
+    @property
+    def error_boundary_matrix(self) -> sympy.ImmutableMatrix:
+        r""":math:`U + C_m^\top L C_m Y` (``Nn x 2Nn``)."""
+        return self.error_system().boundary_matrix
+
+    def error_system(self) -> ErrorSystem:
+        """Return the :class:`ErrorSystem` of this design."""
+        U, Y = port_matrices(self.model)
+        return error_system(self.model.order, self.model.size, U, Y, self.C_m, self.L)
