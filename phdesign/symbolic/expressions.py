@@ -44,6 +44,7 @@ from phdesign.errors import ExpressionError
 __all__ = [
     "Trace",
     "Z",
+    "canonical",
     "exact_number",
     "format_expression",
     "linear_coefficients",
@@ -189,6 +190,16 @@ def exact_number(value: object, what: str) -> sympy.Expr:
         expr = parse_scalar(value, parameters=(), allow_z=False)
         return exact_number(expr, what)
     raise ExpressionError(f"{what} must be a number; found {type(value).__name__} {value!r}")
+
+
+def canonical(expr: sympy.Expr) -> sympy.Expr:
+    """Simplify an exact expression, cheaply when it is a number or expands to zero."""
+    if expr.is_Number:
+        return expr
+    expanded = sympy.expand(expr)
+    if expanded.is_Number:
+        return expanded
+    return sympy.simplify(expanded)
 
 
 def exactify(expr: sympy.Expr) -> sympy.Expr:

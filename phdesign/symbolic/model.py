@@ -35,6 +35,7 @@ import sympy
 from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
 from phdesign.symbolic.expressions import (
     Z,
+    canonical,
     check_parameter_name,
     exact_number,
     exactify,
@@ -329,7 +330,7 @@ def _validate(model: BCPHS) -> list[str]:
     defaults = model.parameter_defaults
     for k in range(1, N + 1):
         sign = (-1) ** (k - 1)
-        residual = (model.P[k].T - sign * model.P[k]).applyfunc(sympy.simplify)
+        residual = (model.P[k].T - sign * model.P[k]).applyfunc(canonical)
         if not residual.is_zero_matrix:
             relation = f"P{k}^T = P{k}" if sign == 1 else f"P{k}^T = -P{k}"
             raise ModelError(
@@ -339,7 +340,7 @@ def _validate(model: BCPHS) -> list[str]:
     checks.append("P_k symmetry: exact")
     checks.append(_check_semidefinite(model.P[0] + model.P[0].T, defaults))
     checks.append(_check_invertible(model.P[N], f"P{N}", defaults))
-    residual = (model.H - model.H.T).applyfunc(sympy.simplify)
+    residual = (model.H - model.H.T).applyfunc(canonical)
     if not residual.is_zero_matrix:
         raise ModelError(f"H must be symmetric; found H - H^T = {residual.tolist()}")
     checks.append(_check_positive_definite(model.H, model.interval, defaults))

@@ -52,7 +52,7 @@ from typing import TYPE_CHECKING
 import sympy
 
 from phdesign.errors import PortError
-from phdesign.symbolic.expressions import Trace, linear_coefficients, trace_symbol
+from phdesign.symbolic.expressions import Trace, canonical, linear_coefficients, trace_symbol
 
 if TYPE_CHECKING:
     from phdesign.symbolic.model import BCPHS
@@ -213,8 +213,8 @@ def derive_ports(model: BCPHS) -> Ports:
                 f"{'W_B' if name == 'inputs' else 'W_C'} "
                 f"is {rank}, expected N*n = {N * n}"
             )
-    W_B = (U * R_inv).applyfunc(sympy.simplify)
-    W_C = (Y * R_inv).applyfunc(sympy.simplify)
+    W_B = (U * R_inv).applyfunc(canonical)
+    W_C = (Y * R_inv).applyfunc(canonical)
     Sigma = sigma_matrix(N * n)
     residuals = {
         "WB_Sigma_WBt": W_B * Sigma * W_B.T,
@@ -228,7 +228,7 @@ def derive_ports(model: BCPHS) -> Ports:
     }
     identities: dict[str, sympy.Expr] = {}
     for key in IDENTITY_NAMES:
-        residual = residuals[key].applyfunc(sympy.simplify)
+        residual = residuals[key].applyfunc(canonical)
         largest = _max_abs(residual, defaults)
         identities[key] = largest
         if not residual.is_zero_matrix:

@@ -1,0 +1,30 @@
+"""Shared fixtures: floating-point errors raise, and a seeded random generator."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, settings
+
+# CI runs a bounded budget; set HYPOTHESIS_PROFILE=nightly for the long fuzzing run.
+settings.register_profile(
+    "ci", max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
+settings.register_profile(
+    "nightly", max_examples=10_000, deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
+settings.load_profile(__import__("os").environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+
+@pytest.fixture(autouse=True)
+def _raise_on_floating_point_errors():
+    """Turn silent NaN/overflow into errors, as py-pde does; underflow stays quiet."""
+    old = np.seterr(all="raise", under="ignore")
+    yield
+    np.seterr(**old)
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    """A seeded generator, so failures reproduce."""
+    return np.random.default_rng(20230503)
