@@ -111,9 +111,9 @@ class AssumptionCheck:
 def _is_zero(expr: sympy.Expr) -> bool:
     # Structural zero first (fast); otherwise simplify: an entry must vanish
     # identically (in z and in the parameters), not only at the default values.
-    if expr == 0:
-        return True
-    return bool(sympy.simplify(expr) == 0)
+    from phdesign.symbolic.observer import vanishes
+
+    return vanishes(expr)
 
 
 def check_assumption(
@@ -194,10 +194,8 @@ def check_assumption(
         if not lower_ok:
             reasons.append("Q1/Q2 not symmetric for any pairing")
             continue
-        det = sympy.simplify(Q2.det())
-        if det.free_symbols:
-            det = sympy.simplify(det.subs(values))
-        if det == 0:
+        det = Q2.det()
+        if _is_zero(det) or (det.free_symbols and _is_zero(det.subs(values))):
             reasons.append("Q2 singular")
             continue
         found.append(

@@ -48,7 +48,7 @@ from typing import Any
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
-from phdesign.symbolic.observer import ErrorSystem
+from phdesign.symbolic.observer import ErrorSystem, vanishes
 
 __all__ = ["Certificate", "certify", "float_kappa"]
 
@@ -145,10 +145,10 @@ def certify(
     W = es.T_inv[:, nn:]
     for n_c in _nullspace(es.C_m):
         v = W * n_c
-        sv = [sympy.simplify(v[i]) for i in rows]
-        if any(x != 0 for x in sv):
-            free = tuple(i for i, x in zip(rows, sv, strict=True) if x != 0)
-            witness = tuple(sympy.simplify(x) for x in v)
+        zero = [vanishes(v[i]) for i in rows]
+        if not all(zero):
+            free = tuple(i for i, z in zip(rows, zero, strict=True) if not z)
+            witness = tuple(sympy.S.Zero if vanishes(x) else sympy.expand(x) for x in v)
             return Certificate(False, None, None, False, witness, free, "exact")
     # ---- constant
     C_m, L = es.C_m, es.L

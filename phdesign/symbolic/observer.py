@@ -69,7 +69,30 @@ __all__ = [
     "parse_sensors",
     "port_matrices",
     "sensor_matrix",
+    "vanishes",
 ]
+
+
+def vanishes(expr: object) -> bool:
+    """Decide exactly whether ``expr`` is identically zero, cheaply when possible.
+
+    Rational functions (in the gains or parameters) and algebraic numbers are
+    settled by ``cancel(expand(.))``; :func:`sympy.simplify` is the last resort
+    (it is slow, and drags in ``sympy.physics`` on first use).
+    """
+    e = sympy.sympify(expr)
+    if e == 0:
+        return True
+    if e.is_Number:
+        return False
+    e = sympy.cancel(sympy.expand(e))
+    if e == 0:
+        return True
+    if e.is_number and e.is_zero is not None:
+        return bool(e.is_zero)
+    if e.is_rational_function():
+        return False
+    return bool(sympy.simplify(e) == 0)
 
 
 # --------------------------------------------------------------------------- sensors
@@ -182,6 +205,11 @@ def parse_gain(text: str, q: int) -> sympy.ImmutableMatrix:
             )
         return L
     parts = [p.strip() for p in text.split(",")]
+    for i, part in enumerate(parts):
+        if part.lower().lstrip("+-") in ("nan", "inf", "infinity"):
+            raise ObserverError(
+                f"--gain: entry {i + 1} must be a finite positive number; found {part!r}"
+            )
     try:
         values = [exact_number(p, f"--gain entry {p!r}") for p in parts]
     except ExpressionError as error:
@@ -269,7 +297,7 @@ def _check_gain(L: sympy.MatrixBase, q: int) -> sympy.ImmutableMatrix:
         return L
     # Exact Sylvester test on leading principal minors (q is small).
     for k in range(1, q + 1):
-        minor = sympy.simplify(sym[:k, :k].det()) if k > 1 else sym[0, 0]
+        minor = sympy.expand(sym[:k, :k].det()) if k > 1 else sym[0, 0]
         if not minor.is_positive:
             raise ObserverError(
                 f"L + Lᵀ must be positive definite; expected every leading principal minor "
@@ -363,8 +391,8 @@ def error_system(
     K = sympy.ImmutableMatrix(T_inv * sympy.Matrix.vstack(-G, sympy.eye(nn)))
     # dim K = Nn: K has Nn columns and its lower part through Y is the identity
     # (Y K = I), so the columns are independent; K solves the boundary condition.
-    residual = (boundary * K).applyfunc(sympy.simplify) if L.free_symbols else boundary * K
-    if not residual.is_zero_matrix or sympy.eye(nn) != (Y * K):
+    residual = boundary * K
+    if not all(vanishes(x) for x in residual) or sympy.eye(nn) != (Y * K):
         raise ObserverError(
             f"the admissible traces K = ker(U + C_mᵀ L C_m Y) must have dimension Nn = {nn}; "
             "the port matrices are inconsistent"

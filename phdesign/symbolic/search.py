@@ -1,0 +1,377 @@
+r"""Sensor search: classify every non-empty subset of the outputs.
+
+For unit-row sensors the decision of :mod:`phdesign.symbolic.certificate` is
+combinatorial and exact.  Let :math:`t_j = T^{-1}(0; e_j)` be the trace vector with
+all inputs and outputs zero except :math:`\tilde y_j = 1`, and :math:`\mathcal S` the
+traces a variant selects.  The variant holds for the sensor set :math:`M` iff every
+unmeasured output :math:`j \notin M` has :math:`t_j` vanishing on :math:`\mathcal S`,
+i.e. iff :math:`M \supseteq B_{\text{variant}} = \{j : \operatorname{supp} t_j \cap
+\mathcal S \ne \emptyset\}`.  So each variant has exactly one minimal sensor set,
+:math:`B_{\text{variant}}`, computed once from the exact :math:`T^{-1}`, and the
+2^(Nn) - 1 subsets are decided with bit masks.
+
+The constants use the float path: with :math:`L = \mathrm{diag}(g_M)`,
+:math:`K_m = T^{-1}(-C_m^\top L; C_m^\top)` and :math:`\kappa^* =
+1/\sigma_{\max}(S K_m L^{-1/2})^2`, batched over subsets with numpy.
+
+A set is *minimal* for a verdict when it has that verdict and no proper subset has.
+
+Examples
+--------
+>>> from phdesign.models import load_builtin
+>>> found = search_sensors(load_builtin("euler-bernoulli"))
+>>> found.minimal["exponential"]
+((3, 4),)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
+
+import sympy
+
+from phdesign.errors import ObserverError
+from phdesign.symbolic.assumption import Partition, check_assumption
+from phdesign.symbolic.expressions import exact_number
+from phdesign.symbolic.model import BCPHS
+from phdesign.symbolic.observer import _inverse, port_matrices, vanishes
+from phdesign.symbolic.propositions import VARIANTS, Variant
+
+__all__ = ["Candidate", "SensorSearch", "SubsetResult", "candidates", "search_sensors"]
+
+#: Above this many subsets the search reports progress (when a callback is given).
+PROGRESS_THRESHOLD = 512
+
+
+@dataclass(frozen=True)
+class Candidate:
+    r"""One (variant, partition) pair with the unique minimal sensor set that makes it hold.
+
+    Attributes
+    ----------
+    variant : Variant
+    partition : Partition or None
+    selected : tuple of int
+        Indices in :math:`v` of the traces the right-hand side selects.
+    required : tuple of int
+        1-based outputs that must be measured (:math:`B_{\text{variant}}`).
+    """
+
+    variant: Variant
+    partition: Partition | None
+    selected: tuple[int, ...]
+    required: tuple[int, ...]
+
+    @property
+    def name(self) -> str:
+        """``"3.4.3"``-style name."""
+        return f"{self.variant.proposition}.{self.variant.variant}"
+
+
+@dataclass(frozen=True)
+class SubsetResult:
+    """Classification of one sensor subset.
+
+    Attributes
+    ----------
+    sensors : tuple of int
+        1-based measured outputs.
+    verdict : str
+    best : str or None
+        Strongest holding variant (``"3.3.3"``), largest κ* among the same kind.
+    kappa : float or None
+        κ* of ``best`` (``None`` when unbounded, symbolic gains, or nothing holds).
+    unbounded : bool
+    holding : tuple of str
+        Every holding variant.
+    partition : tuple of (tuple, tuple) or None
+        The partition (x1, x2) of ``best`` when it is a 3.4 variant.
+    """
+
+    sensors: tuple[int, ...]
+    verdict: str
+    best: str | None
+    kappa: float | None
+    unbounded: bool
+    holding: tuple[str, ...]
+    partition: tuple[tuple[int, ...], tuple[int, ...]] | None = None
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """JSON form of one subset."""
+        out: dict[str, Any] = {
+            "sensors": list(self.sensors),
+            "verdict": self.verdict,
+            "best": self.best,
+            "kappa": self.kappa,
+            "unbounded": self.unbounded,
+            "holding": list(self.holding),
+        }
+        if self.partition is not None:
+            out["partition"] = {"x1": list(self.partition[0]), "x2": list(self.partition[1])}
+        return out
+
+
+@dataclass(frozen=True)
+class SensorSearch:
+    """Result of :func:`search_sensors`.
+
+    Attributes
+    ----------
+    model : str
+    order, size : int
+    gains : tuple of str
+        Diagonal gain per output (reused for every subset that measures it).
+    candidates : tuple of Candidate
+        The variants tried, each with its minimal sensor set.
+    subsets : tuple of SubsetResult
+        Every non-empty subset, by size then lexicographically.
+    minimal : dict
+        For each verdict, the minimal sensor sets reaching it.
+    """
+
+    model: str
+    order: int
+    size: int
+    gains: tuple[str, ...]
+    candidates: tuple[Candidate, ...]
+    subsets: tuple[SubsetResult, ...]
+    minimal: dict[str, tuple[tuple[int, ...], ...]]
+
+    def subset(self, sensors: Sequence[int]) -> SubsetResult:
+        """Return the result of one sensor set."""
+        key = tuple(sorted(sensors))
+        for s in self.subsets:
+            if s.sensors == key:
+                return s
+        raise KeyError(f"no subset {key}")
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """JSON: every subset with its verdict, and the minimal sets per verdict."""
+        return {
+            "model": self.model,
+            "order": self.order,
+            "size": self.size,
+            "gain": list(self.gains),
+            "decision_path": "exact (combinatorial, gain-independent)",
+            "kappa_path": "float",
+            "required": {c.name + _partition_suffix(c): list(c.required) for c in self.candidates},
+            "subsets": [s.to_json_dict() for s in self.subsets],
+            "minimal": {k: [list(s) for s in v] for k, v in self.minimal.items()},
+        }
+
+
+def _partition_suffix(c: Candidate) -> str:
+    if c.partition is None:
+        return ""
+    return f" x1={list(c.partition.x1)}"
+
+
+@lru_cache(maxsize=32)
+def candidates(model: BCPHS) -> tuple[Candidate, ...]:
+    """Return every applicable (variant, partition) of ``model`` with its minimal sensor set."""
+    order, size = model.order, model.size
+    nn = order * size
+    U, Y = port_matrices(model)
+    T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
+    support = [{i for i in range(2 * nn) if not vanishes(T_inv[i, nn + j])} for j in range(nn)]
+    partitions: tuple[Partition | None, ...] = (None,)
+    found: list[Candidate] = []
+    assumption = None
+    if order == 2:
+        assumption = check_assumption(model.P[1], model.P[2], model.H, model.parameter_defaults)
+    for variant in VARIANTS:
+        if not variant.applicable_order(order):
+            continue
+        if variant.needs_partition:
+            if assumption is None or not assumption.holds:
+                continue
+            partitions = assumption.partitions
+        else:
+            partitions = (None,)
+        for partition in partitions:
+            blocks = None if partition is None else (partition.x1, partition.x2)
+            selected = variant.indices(order, size, blocks)
+            required = tuple(j + 1 for j in range(nn) if support[j] & set(selected))
+            found.append(Candidate(variant, partition, selected, required))
+    return tuple(found)
+
+
+def _gain_vector(gain: Any, nn: int) -> tuple[sympy.Expr, ...] | None:
+    """Diagonal gain per output; ``None`` for symbolic gains (constants not computed)."""
+    if gain is None:
+        return (sympy.Integer(1),) * nn
+    if isinstance(gain, str):
+        text = gain.strip()
+        if text == "symbolic":
+            return None
+        if text.startswith("["):
+            raise ObserverError(
+                "--all-sensors takes diagonal gains ('0.5' or one value per output); "
+                f"found a full matrix {text!r}"
+            )
+        gain = [p.strip() for p in text.split(",")]
+    values = list(gain) if isinstance(gain, Sequence) else [gain]
+    try:
+        exact = [exact_number(v, "gain") for v in values]
+    except ValueError as error:
+        raise ObserverError(f"--gain: {error}") from None
+    if len(exact) == 1:
+        exact = exact * nn
+    if len(exact) != nn:
+        raise ObserverError(
+            f"--gain with --all-sensors: expected 1 or {nn} diagonal values (one per output); "
+            f"found {len(exact)}"
+        )
+    for i, value in enumerate(exact):
+        if not value.is_positive:
+            raise ObserverError(
+                f"--gain: diagonal gain of output {i + 1} must be > 0 so that L + Lᵀ > 0; "
+                f"found {value}"
+            )
+    return tuple(exact)
+
+
+def search_sensors(
+    model: BCPHS,
+    gain: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> SensorSearch:
+    """Classify every non-empty subset of the outputs of ``model``.
+
+    Parameters
+    ----------
+    model : BCPHS
+        The plant.
+    gain : None, str or sequence of numbers
+        Diagonal gains: ``None`` (identity), one value for every output, or one per
+        output (``"0.5,1,1,2"``); ``"symbolic"`` skips the constants (the verdicts do
+        not depend on the gain).
+    progress : callable(done, total), optional
+        Called as the subsets are processed, when there are more than
+        :data:`PROGRESS_THRESHOLD` of them.
+
+    Returns
+    -------
+    SensorSearch
+    """
+    import numpy as np
+
+    order, size = model.order, model.size
+    nn = order * size
+    gains = _gain_vector(gain, nn)
+    cands = candidates(model)
+    total = 2**nn - 1
+    masks = np.arange(1, total + 1, dtype=np.int64)
+    required = np.array([sum(1 << (j - 1) for j in c.required) for c in cands], dtype=np.int64)
+    holds = (required[:, None] & ~masks[None, :]) == 0  # (candidates, subsets)
+    kappa = np.full(holds.shape, np.nan)
+    unbounded = np.zeros(holds.shape, dtype=bool)
+    if gains is not None:
+        U, Y = port_matrices(model)
+        T_inv_exact = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
+        T_inv = np.array(T_inv_exact.evalf(17).tolist(), dtype=float)
+        g = np.array([float(x) for x in gains])
+        # column r of K_m for output j: -g_j T_inv[:, j] + T_inv[:, Nn + j], scaled by g^-1/2
+        columns = (-g * T_inv[:, :nn] + T_inv[:, nn:]) / np.sqrt(g)
+        bits = (masks[:, None] >> np.arange(nn)[None, :]) & 1
+        counts = bits.sum(axis=1)
+        done = 0
+        for q in range(1, nn + 1):
+            idx = np.nonzero(counts == q)[0]
+            chosen = np.nonzero(bits[idx])[1].reshape(len(idx), q)  # outputs, 0-based
+            for c, cand in enumerate(cands):
+                rows = np.array(cand.selected)
+                sub = idx[holds[c, idx]]
+                if sub.size == 0:
+                    continue
+                pick = chosen[holds[c, idx]]
+                M = columns[rows][:, pick].transpose(1, 0, 2)  # (subsets, |S|, q)
+                B = np.einsum("kia,kib->kab", M, M)
+                top = np.linalg.eigvalsh(B)[:, -1]
+                scale = np.abs(M).max(axis=(1, 2))
+                zero = scale <= 1e-13 * max(1.0, np.abs(columns).max())
+                unbounded[c, sub] = zero
+                kappa[c, sub] = np.where(zero, np.nan, 1.0 / np.where(zero, 1.0, top))
+            done += len(idx)
+            if progress is not None and total > PROGRESS_THRESHOLD:
+                progress(done, total)
+    exponential = np.array([c.variant.convergence == "exponential" for c in cands])
+    verdict_code = np.where(
+        (holds & exponential[:, None]).any(axis=0), 0, np.where(holds.any(axis=0), 1, 2)
+    )
+    names = ("exponential", "asymptotic", "inconclusive")
+    results = []
+    order_of = sorted(
+        range(total), key=lambda k: (bin(int(masks[k])).count("1"), _members(int(masks[k])))
+    )
+    for k in order_of:
+        members = _members(int(masks[k]))
+        holding = [c for c in range(len(cands)) if holds[c, k]]
+        best = None
+        if holding:
+
+            def strength(c: int, k: int = k) -> tuple[int, float]:
+                value = np.inf if unbounded[c, k] else kappa[c, k]
+                return (int(exponential[c]), -1.0 if np.isnan(value) else float(value))
+
+            best = max(holding, key=strength)
+        results.append(
+            SubsetResult(
+                sensors=members,
+                verdict=names[int(verdict_code[k])],
+                best=None if best is None else cands[best].name,
+                kappa=None if best is None or np.isnan(kappa[best, k]) else float(kappa[best, k]),
+                unbounded=bool(best is not None and unbounded[best, k]),
+                holding=tuple(dict.fromkeys(cands[c].name for c in holding)),
+                partition=None
+                if best is None or cands[best].partition is None
+                else (cands[best].partition.x1, cands[best].partition.x2),  # type: ignore[union-attr]
+            )
+        )
+    minimal = _minimal_sets(masks, verdict_code, names, nn)
+    return SensorSearch(
+        model=model.name,
+        order=order,
+        size=size,
+        gains=tuple("symbolic" for _ in range(nn)) if gains is None else tuple(map(str, gains)),
+        candidates=cands,
+        subsets=tuple(results),
+        minimal=minimal,
+    )
+
+
+def _members(mask: int) -> tuple[int, ...]:
+    return tuple(j + 1 for j in range(mask.bit_length()) if mask >> j & 1)
+
+
+def _minimal_sets(
+    masks: Any, verdict_code: Any, names: tuple[str, ...], nn: int
+) -> dict[str, tuple[tuple[int, ...], ...]]:
+    """Return the sets with a verdict no proper subset has (DP over bit masks)."""
+    total = 1 << nn
+    verdict = [-1] * total  # -1 for the empty set
+    for k, mask in enumerate(masks):
+        verdict[int(mask)] = int(verdict_code[k])
+    # below[v][m]: some proper non-empty subset of m has verdict v
+    minimal: dict[str, list[tuple[int, ...]]] = {name: [] for name in names}
+    below = [[False] * total for _ in names]
+    for m in range(1, total):
+        for v in range(len(names)):
+            flag = False
+            sub = m
+            j = 0
+            while sub:
+                if sub & 1:
+                    smaller = m & ~(1 << j)
+                    if smaller and (verdict[smaller] == v or below[v][smaller]):
+                        flag = True
+                        break
+                sub >>= 1
+                j += 1
+            below[v][m] = flag
+        if not below[verdict[m]][m]:
+            minimal[names[verdict[m]]].append(_members(m))
+    return {k: tuple(sorted(v, key=lambda s: (len(s), s))) for k, v in minimal.items()}
