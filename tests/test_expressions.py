@@ -99,6 +99,9 @@ def test_scalar_is_exact():
         ("e1(0)/0", "division by zero"),
         ("2**1000*e1(0)", "exponent"),
         ("e1(x)", "point"),
+        ("1e999*e1(0)", "out of range"),
+        ("((10**64)**64)**64*e1(0)", "out of range"),
+        ("1" * 80 + "*e1(0)", "out of range"),
         ("(" * 300 + "e1(0)" + ")" * 300, "nested"),
     ],
 )

@@ -63,6 +63,8 @@ Z = sympy.Symbol("z", real=True)
 MAX_LENGTH = 10_000
 MAX_DEPTH = 100
 MAX_EXPONENT = 64
+#: Largest bit length of the numerator or denominator of an exact number (about 1e300).
+MAX_NUMBER_BITS = 1000
 
 _FUNCTIONS: dict[str, Callable[[sympy.Expr], sympy.Expr]] = {
     "sqrt": sympy.sqrt,
@@ -312,8 +314,18 @@ class _Parser:
         value = self.term()
         while (op := self.take("+", "-")) is not None:
             rhs = self.term()
-            value = value + rhs if op.text == "+" else value - rhs
+            value = self.bounded(value + rhs if op.text == "+" else value - rhs)
         self.depth -= 1
+        return value
+
+    def bounded(self, value: sympy.Expr) -> sympy.Expr:
+        """Refuse exact numbers too large to print or compute with (about 1e300)."""
+        for number in value.atoms(sympy.Rational):
+            if max(abs(number.p).bit_length(), number.q.bit_length()) > MAX_NUMBER_BITS:
+                raise ExpressionError(
+                    f"a number in {self.context.text!r} is out of range; "
+                    "expected magnitudes between 1e-300 and 1e300"
+                )
         return value
 
     def term(self) -> sympy.Expr:
@@ -321,11 +333,11 @@ class _Parser:
         while (op := self.take("*", "/")) is not None:
             rhs = self.unary()
             if op.text == "*":
-                value = value * rhs
+                value = self.bounded(value * rhs)
             else:
                 if rhs == 0:
                     raise ExpressionError(f"division by zero in {self.context.text!r}")
-                value = value / rhs
+                value = self.bounded(value / rhs)
         return value
 
     def unary(self) -> sympy.Expr:
@@ -349,7 +361,7 @@ class _Parser:
                 )
             if base == 0 and exponent.is_number and exponent.is_nonpositive:
                 raise ExpressionError(f"division by zero in {self.context.text!r}")
-            return base**exponent
+            return self.bounded(base**exponent)
         return base
 
     def atom(self) -> sympy.Expr:
@@ -358,6 +370,12 @@ class _Parser:
             raise ExpressionError(f"cannot read {self.context.text!r}: it ends too early")
         self.index += 1
         if token.kind == "number":
+            mantissa, _, exponent = token.text.lower().partition("e")
+            if len(mantissa) > 60 or (exponent and abs(int(exponent)) > 300):
+                raise ExpressionError(
+                    f"number {token.text!r} is out of range; expected magnitudes between "
+                    "1e-300 and 1e300 with at most 60 digits"
+                )
             return sympy.Rational(token.text)
         if token.kind == "trace":
             if self.context.trace_factory is None:
@@ -514,7 +532,7 @@ _POINT_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?:/\d+)?\
 def _side_of(point: str, a: object, b: object, trace_text: str) -> Side:
     if point in ("a", "b"):
         return point  # type: ignore[return-value]
-    if not _POINT_NUMBER.match(point):
+    if not _POINT_NUMBER.match(point) or len(point) > 40:
         raise ExpressionError(
             f"point of {trace_text!r} must be a, b or an endpoint value; found {point!r}"
         )
