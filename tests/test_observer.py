@@ -1,0 +1,167 @@
+"""Observer layer: sensors, gains, error boundary condition and admissible traces K."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy
+
+from phdesign.errors import ObserverError, PhdesignError
+from phdesign.models import load_builtin
+from phdesign.symbolic.observer import (
+    ObserverDesign,
+    error_system,
+    gain_symbols,
+    parse_cm,
+    parse_gain,
+    parse_sensors,
+    port_matrices,
+    sensor_matrix,
+    vanishes,
+)
+from phdesign.symbolic.propositions import trace_index
+from phdesign.symbolic.ports import trace_index as ports_trace_index
+
+
+@pytest.fixture(scope="module")
+def beam():
+    return load_builtin("euler-bernoulli")
+
+
+def test_trace_index_agrees_with_ports_layer():
+    # the ordering is fixed by the API contract; both layers must use the same one
+    for N, n in [(1, 2), (2, 2), (3, 1), (2, 3)]:
+        for side in "ab":
+            for k in range(N):
+                for i in range(1, n + 1):
+                    assert trace_index(i, k, side, N, n) == ports_trace_index(i, k, side, N, n)
+
+
+def test_sensor_matrix_picks_unit_rows():
+    C = sensor_matrix([2, 4], 4)
+    assert C == sympy.Matrix([[0, 1, 0, 0], [0, 0, 0, 1]])
+    assert parse_sensors(" 2, 4", 4) == C
+
+
+def test_parse_gain_forms():
+    assert parse_gain("0.1,1", 2) == sympy.diag(sympy.Rational(1, 10), 1)  # exact decimal
+    assert parse_gain("2", 3) == sympy.diag(2, 2, 2)  # one value reused per sensor
+    assert parse_gain("[[1, 0.5], [0, 1]]", 2) == sympy.Matrix([[1, sympy.Rational(1, 2)], [0, 1]])
+    L = parse_gain("symbolic", 2)
+    assert L == sympy.diag(*gain_symbols(2))
+    assert all(s.is_positive for s in gain_symbols(2))
+
+
+def test_parse_cm_exact():
+    assert parse_cm("[[0, 0, 1, 0], [0, 0, 0.5, 1]]", 4) == sympy.Matrix(
+        [[0, 0, 1, 0], [0, 0, sympy.Rational(1, 2), 1]]
+    )
+
+
+# (callable, args, regex): every path of the sensor/gain checks
+BAD_INPUTS = [
+    (sensor_matrix, ([5], 4), r"output index 5 is out of range; expected 1\.\.4"),
+    (sensor_matrix, ([0], 4), r"output index 0 is out of range"),
+    (sensor_matrix, ([3, 3], 4), r"output index 3 is repeated"),
+    (sensor_matrix, ([], 4), r"expected at least one output index"),
+    (parse_sensors, ("3,x", 4), r"expected comma-separated output indices.*'x'"),
+    (parse_cm, ("[[1,0]", 2), r"--cm: expected a JSON list of rows"),
+    (parse_cm, ("[[1,0,0]]", 2), r"C_m matrix; expected \(q, 2\) but found \(1, 3\)"),
+    (parse_cm, ("[[1,0],[1]]", 2), r"row 2 has 1 entries; expected 2"),
+    (parse_cm, ("[[NaN, 0]]", 2), r"finite number; found nan"),
+    (parse_gain, ("1,2,3", 2), r"expected 2 diagonal values .* found 3"),
+    (parse_gain, ("nan", 2), r"entry 1 must be a finite positive number; found 'nan'"),
+    (parse_gain, ("[[1,0],[0,1],[0,0]]", 2), r"L matrix; expected \(2, 2\).*found \(3, 2\)"),
+    (parse_gain, ("[[1,0]", 2), r"--gain: expected a JSON list of rows"),
+]
+
+
+@pytest.mark.parametrize(("function", "args", "message"), BAD_INPUTS)
+def test_bad_sensor_and_gain_text(function, args, message):
+    with pytest.raises(ObserverError, match=message):
+        function(*args)
+
+
+BAD_DESIGNS = [
+    # (C_m, L, regex)
+    (
+        sympy.Matrix([[1, 0, 0, 0], [2, 0, 0, 0]]),
+        sympy.eye(2),
+        r"full row rank.*expected rank 2 but found 1",
+    ),
+    (sympy.Matrix([[1, 0, 0]]), sympy.eye(1), r"C_m matrix; expected \(1, 4\) but found \(1, 3\)"),
+    (sympy.zeros(0, 4), sympy.eye(0), r"1 <= q <= 4"),
+    (sensor_matrix([3, 4], 4), sympy.eye(3), r"L matrix; expected \(2, 2\) but found \(3, 3\)"),
+    (sensor_matrix([3, 4], 4), sympy.diag(1, -1), r"positive definite.*minor 2 = -4"),
+    # L + L^T = [[2, 3], [3, 2]] is indefinite although the diagonal is positive
+    (sensor_matrix([3, 4], 4), sympy.Matrix([[1, 3], [0, 1]]), r"minor 2 = -5"),
+    (sensor_matrix([3, 4], 4), sympy.Matrix([[1, 0], [0, float("nan")]]), r"finite"),
+    (
+        sensor_matrix([3, 4], 4),
+        sympy.Matrix([[sympy.Symbol("k"), 0], [0, 1]]),
+        r"symbolic L must be diagonal with positive entries",
+    ),
+    (
+        np.array([[0.0, 0.0, 1.0, 0.0]]),
+        np.array([[np.inf]]),
+        r"L\[1\]\[1\] must be a finite number; found oo",
+    ),
+]
+
+
+@pytest.mark.parametrize(("C_m", "L", "message"), BAD_DESIGNS)
+def test_bad_designs(beam, C_m, L, message):
+    with pytest.raises(ObserverError, match=message) as info:
+        ObserverDesign(beam, C_m, L)
+    assert isinstance(info.value, PhdesignError) and isinstance(info.value, ValueError)
+
+
+def test_numpy_inputs_are_read_exactly(beam):
+    design = ObserverDesign(beam, np.array([[0, 0, 1, 0]]), np.array([[0.1]]))
+    assert design.L == sympy.Matrix([[sympy.Rational(1, 10)]])
+
+
+def test_beam_error_boundary_condition(beam):
+    # Paper §IV-D with L = diag(l1, l2): the error inputs are
+    # ũ = -C_mᵀ L C_m ỹ = (0, 0, -l1 ỹ3, -l2 ỹ4) with ỹ3 = e1'(1), ỹ4 = -e1(1):
+    # e1(0) = 0, e1'(0) = 0, e2(1) = -l1 e1'(1), e2'(1) = l2 e1(1).
+    l1, l2 = gain_symbols(2)
+    es = ObserverDesign(beam, sensor_matrix([3, 4], 4), parse_gain("symbolic", 2)).error_system()
+    v = sympy.Matrix(sympy.symbols("v0:8"))
+    idx = {
+        name: trace_index(i, k, s, 2, 2)
+        for name, (i, k, s) in {
+            "e1(1)": (1, 0, "b"),
+            "e2(1)": (2, 0, "b"),
+            "e1'(1)": (1, 1, "b"),
+            "e2'(1)": (2, 1, "b"),
+            "e1(0)": (1, 0, "a"),
+            "e1'(0)": (1, 1, "a"),
+        }.items()
+    }
+    expected = [
+        v[idx["e1(0)"]],
+        v[idx["e1'(0)"]],
+        v[idx["e2(1)"]] + l1 * v[idx["e1'(1)"]],
+        v[idx["e2'(1)"]] - l2 * v[idx["e1(1)"]],
+    ]
+    got = es.boundary_matrix * v
+    assert all(sympy.expand(g - e) == 0 for g, e in zip(got, expected, strict=True))
+
+
+@pytest.mark.parametrize("name", ["wave", "timoshenko", "euler-bernoulli", "airy"])
+def test_admissible_traces_have_dimension_Nn(name):
+    model = load_builtin(name)
+    nn = model.order * model.size
+    es = ObserverDesign(model, sensor_matrix([1], nn), parse_gain("3/2", 1)).error_system()
+    assert es.K.shape == (2 * nn, nn)
+    assert es.K.rank() == nn  # dim K = Nn
+    assert all(vanishes(x) for x in es.boundary_matrix * es.K)  # K solves the error BC
+    # Y K = I: the basis is parametrized by the error output ỹ
+    assert es.Y * es.K == sympy.eye(nn)
+
+
+def test_port_matrices_substitute_parameters(beam):
+    U, Y = port_matrices(beam)
+    assert not U.free_symbols and not Y.free_symbols
+    assert error_system(2, 2, U, Y, sensor_matrix([4], 4), sympy.eye(1)).K.shape == (8, 4)
