@@ -53,7 +53,8 @@ def test_three_sensors_paper_IV_C_symbolic(beam):
     result = classify(beam, sensor_matrix([2, 3, 4], 4), parse_gain("symbolic", 3))
     assert result.verdict == "exponential"
     r = result.result("3.3", 3)
-    assert r.holds and r.path == "symbolic"
+    assert r.holds
+    assert r.path == "symbolic"
     assert same(r.kappa, sympy.Min(l1, l2 / (1 + l2**2), l3 / (1 + l3**2)))
     assert r.conditions == "holds for all positive l1, l2, l3"
     # variants 1, 2, 4 of 3.3 need e'(a), i.e. e2'(0), which only y1 measures
@@ -66,8 +67,10 @@ def test_three_sensors_paper_IV_C_numeric(beam):
     # L = diag(2, 3, 1/2): κ* = min(2, 3/10, (1/2)/(5/4)) = 3/10 exactly
     result = classify(beam, sensor_matrix([2, 3, 4], 4), sympy.diag(2, 3, R(1, 2)))
     r = result.result("3.3", 3)
-    assert r.kappa == R(3, 10) and r.path == "exact"
-    assert result.best is not None and result.verdict == "exponential"
+    assert r.kappa == R(3, 10)
+    assert r.path == "exact"
+    assert result.best is not None
+    assert result.verdict == "exponential"
 
 
 # ----------------------------------------------------------------- paper §IV-D
@@ -88,7 +91,9 @@ def test_two_sensors_paper_IV_D_symbolic(beam):
     #   = e1(1)^2 + l1^2 e1'(1)^2 + e1'(1)^2 + 0 = e1(1)^2 + (1 + l1^2) e1'(1)^2,
     # so κ* = min(l2, l1/(1 + l1^2)); the paper writes (1 + l2^2) where l1 belongs.
     r34 = result.result("3.4", 3)
-    assert r34.holds and r34.partition is not None and r34.partition.x1 == (1,)
+    assert r34.holds
+    assert r34.partition is not None
+    assert r34.partition.x1 == (1,)
     assert same(r34.kappa, sympy.Min(l2, l1 / (1 + l1**2)))
     assert not same(r34.kappa, sympy.Min(l2, l1 / (1 + l2**2)))  # the printed typo differs
     assert result.verdict == "exponential"
@@ -178,7 +183,8 @@ def test_exact_and_float_kappa_agree(name, sensors, L):
     for a, b in zip(exact.results, floating.results, strict=True):
         assert a.holds == b.holds
         if a.holds and not a.unbounded:
-            assert a.path == "exact" and b.path == "float"
+            assert a.path == "exact"
+            assert b.path == "float"
             # κ* from the exact root vs Cholesky + eigh: agree to 1e-12 (relative)
             assert b.kappa_float == pytest.approx(float(a.kappa), rel=1e-12, abs=0)
 
@@ -204,7 +210,10 @@ def test_unbounded_when_rhs_vanishes(beam):
     # selecting only e1(0), e1'(0): both are unmeasured inputs, forced to 0 on K
     es = ObserverDesign(beam, sensor_matrix([3, 4], 4), sympy.eye(2)).error_system()
     cert = certify(es, [4, 6])
-    assert cert.holds and cert.unbounded and cert.kappa is None and cert.minimizer() is None
+    assert cert.holds
+    assert cert.unbounded
+    assert cert.kappa is None
+    assert cert.minimizer() is None
 
 
 # ----------------------------------------------------------------- other models
@@ -217,7 +226,8 @@ def test_wave_damper_at_either_end_is_exponential(sensor, variant):
     result = classify(load_builtin("wave"), sensor_matrix([sensor], 2), sympy.Matrix([[k]]))
     assert result.verdict == "exponential"
     r = result.result("3.2", variant)
-    assert r.holds and r.kappa == k / (1 + k**2)
+    assert r.holds
+    assert r.kappa == k / (1 + k**2)
     assert result.result("3.2", 3 - variant).holds is False
 
 
@@ -245,6 +255,8 @@ def test_json_keys(beam):
         "holds": True,
     }
     # κ* = min(l2, l1/(1 + l1^2)) at (1, 2) = min(2, 1/2) = 1/2
-    assert entry["kappa"] == 0.5 and entry["kappa_exact"] == "1/2"
+    assert entry["kappa"] == 0.5
+    assert entry["kappa_exact"] == "1/2"
     not_applicable = data["results"][2]
-    assert not_applicable["applicable"] is False and not_applicable["kappa"] is None
+    assert not_applicable["applicable"] is False
+    assert not_applicable["kappa"] is None

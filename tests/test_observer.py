@@ -19,8 +19,8 @@ from phdesign.symbolic.observer import (
     sensor_matrix,
     vanishes,
 )
-from phdesign.symbolic.propositions import trace_index
 from phdesign.symbolic.ports import trace_index as ports_trace_index
+from phdesign.symbolic.propositions import trace_index
 
 
 @pytest.fixture(scope="module")
@@ -39,7 +39,7 @@ def test_trace_index_agrees_with_ports_layer():
 
 def test_sensor_matrix_picks_unit_rows():
     C = sensor_matrix([2, 4], 4)
-    assert C == sympy.Matrix([[0, 1, 0, 0], [0, 0, 0, 1]])
+    assert sympy.Matrix([[0, 1, 0, 0], [0, 0, 0, 1]]) == C
     assert parse_sensors(" 2, 4", 4) == C
 
 
@@ -48,7 +48,7 @@ def test_parse_gain_forms():
     assert parse_gain("2", 3) == sympy.diag(2, 2, 2)  # one value reused per sensor
     assert parse_gain("[[1, 0.5], [0, 1]]", 2) == sympy.Matrix([[1, sympy.Rational(1, 2)], [0, 1]])
     L = parse_gain("symbolic", 2)
-    assert L == sympy.diag(*gain_symbols(2))
+    assert sympy.diag(*gain_symbols(2)) == L
     assert all(s.is_positive for s in gain_symbols(2))
 
 
@@ -113,12 +113,13 @@ BAD_DESIGNS = [
 def test_bad_designs(beam, C_m, L, message):
     with pytest.raises(ObserverError, match=message) as info:
         ObserverDesign(beam, C_m, L)
-    assert isinstance(info.value, PhdesignError) and isinstance(info.value, ValueError)
+    assert isinstance(info.value, PhdesignError)
+    assert isinstance(info.value, ValueError)
 
 
 def test_numpy_inputs_are_read_exactly(beam):
     design = ObserverDesign(beam, np.array([[0, 0, 1, 0]]), np.array([[0.1]]))
-    assert design.L == sympy.Matrix([[sympy.Rational(1, 10)]])
+    assert sympy.Matrix([[sympy.Rational(1, 10)]]) == design.L
 
 
 def test_beam_error_boundary_condition(beam):
@@ -158,10 +159,11 @@ def test_admissible_traces_have_dimension_Nn(name):
     assert es.K.rank() == nn  # dim K = Nn
     assert all(vanishes(x) for x in es.boundary_matrix * es.K)  # K solves the error BC
     # Y K = I: the basis is parametrized by the error output ỹ
-    assert es.Y * es.K == sympy.eye(nn)
+    assert sympy.eye(nn) == es.Y * es.K
 
 
 def test_port_matrices_substitute_parameters(beam):
     U, Y = port_matrices(beam)
-    assert not U.free_symbols and not Y.free_symbols
+    assert not U.free_symbols
+    assert not Y.free_symbols
     assert error_system(2, 2, U, Y, sensor_matrix([4], 4), sympy.eye(1)).K.shape == (8, 4)

@@ -7,7 +7,7 @@ import sympy
 
 from phdesign.models import load_builtin
 from phdesign.symbolic.assumption import check_assumption
-from phdesign.symbolic.expressions import Z, Trace
+from phdesign.symbolic.expressions import Trace, Z
 from phdesign.symbolic.propositions import VARIANTS, applicable_variants
 
 
@@ -93,7 +93,9 @@ def test_assumption_finds_a_permutation():
     P1p, P2p = _permuted(P1s, perm), _permuted(P2s, perm)
     assert P1p == sympy.Matrix(sympy.BlockMatrix([[zero, first.Q1], [first.Q1, zero]]))
     assert P2p == sympy.Matrix(sympy.BlockMatrix([[zero, -first.Q2], [first.Q2, zero]]))
-    assert first.Q1 == first.Q1.T and first.Q2 == first.Q2.T and first.Q2.det() != 0
+    assert first.Q1 == first.Q1.T
+    assert first.Q2 == first.Q2.T
+    assert first.Q2.det() != 0
 
 
 def test_assumption_needs_a_pairing_not_only_a_split():
@@ -111,8 +113,8 @@ def test_assumption_needs_a_pairing_not_only_a_split():
     assert check.holds
     first = check.partitions[0]
     assert (first.x1, first.x2) == ((2, 1), (3, 4))
-    assert first.Q1 == sympy.diag(0, 1)
-    assert first.Q2 == sympy.Matrix([[0, 1], [1, 0]])
+    assert sympy.diag(0, 1) == first.Q1
+    assert sympy.Matrix([[0, 1], [1, 0]]) == first.Q2
 
 
 @pytest.mark.parametrize(
@@ -130,10 +132,12 @@ def test_assumption_needs_a_pairing_not_only_a_split():
 )
 def test_assumption_failures_name_the_condition(P1, P2, H, reason):
     check = check_assumption(P1, P2, H)
-    assert not check.holds and reason in check.reason
+    assert not check.holds
+    assert reason in check.reason
 
 
 def test_assumption_singular_Q2():
     # P2 = [[0, 0], [0, 0]] has zero diagonal blocks and symmetric Q2 = 0, but Q2 is singular
     check = check_assumption(sympy.zeros(2), sympy.zeros(2), sympy.eye(2))
-    assert not check.holds and "Q2 singular" in check.reason
+    assert not check.holds
+    assert "Q2 singular" in check.reason
