@@ -233,10 +233,10 @@ def atomic_write(path: str | os.PathLike[str], text: str | bytes, force: bool = 
         If the file exists and ``force`` is false, or the folder is not writable.
     """
     target = Path(path)
-    if target.exists() and not force:
-        raise OutputFileError(f"output file {str(target)!r} exists; pass --force to overwrite it")
     if target.is_dir():
         raise OutputFileError(f"output path {str(target)!r} is a folder; expected a file name")
+    if target.exists() and not force:
+        raise OutputFileError(f"output file {str(target)!r} exists; pass --force to overwrite it")
     folder = target.parent if str(target.parent) else Path(".")
     data = text.encode("utf-8") if isinstance(text, str) else text
     try:

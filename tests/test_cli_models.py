@@ -70,30 +70,6 @@ def test_model_from_a_file(capsys, tmp_path):
     assert json.loads(out)["size"] == 2
 
 
-BAD_COMMANDS = [
-    (["ports", "nosuch"], "unknown model 'nosuch'"),
-    (["ports", "missing.toml"], "cannot read model file 'missing.toml'"),
-    (["ports", "wave", "--param", "rho"], "--param expects NAME=VALUE; found 'rho'"),
-    (["ports", "wave", "--param", "mass=1"], "unknown parameter 'mass'"),
-    (["ports", "wave", "--param", "rho=-1"], "H must be positive definite"),
-    (["ports", "wave", "--param", "rho=abc"], "unknown symbol 'abc'"),
-    (["ports", "wave", "--param", "rho=1", "--param", "rho=2"], "given twice"),
-    (["ports", "wave", "--param", "rho=__import__('os')"], "unexpected character"),
-    (["ports"], "required"),
-    (["frobnicate"], "invalid choice"),
-    (["ports", "wave", "--nope"], "unrecognized arguments"),
-]
-
-
-@pytest.mark.parametrize(("argv", "message"), BAD_COMMANDS)
-def test_bad_input_exits_2_with_one_line(capsys, argv, message):
-    status, _, err = run(capsys, *argv)
-    assert status == 2
-    assert err.count("\n") == 1
-    assert message in err
-    assert "Traceback" not in err
-
-
 def test_existing_output_is_not_overwritten(capsys, tmp_path):
     target = tmp_path / "mine.toml"
     target.write_text("precious")

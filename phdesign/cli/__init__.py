@@ -60,14 +60,25 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line and return the exit status."""
+def main(argv: Sequence[str] | None = None, *, reraise: bool = False) -> int:
+    """Run the command line and return the exit status.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments (default: ``sys.argv[1:]``).
+    reraise : bool
+        Let library errors propagate instead of printing them (for tests that check
+        which exception the library raises behind a message).
+    """
     try:
         args = build_parser().parse_args(argv)
         return int(args.handler(args) or 0)
     except _UsageError as error:
         return _fail(str(error))
     except (PhdesignError, ValueError, TypeError) as error:
+        if reraise:
+            raise
         return _fail(str(error))
     except OSError as error:
         return _fail(

@@ -328,6 +328,9 @@ def _validate(model: BCPHS) -> list[str]:
     _check_symbols(model.H, "H", symbols | {Z})
 
     defaults = model.parameter_defaults
+    for k, P_k in enumerate(model.P):
+        _check_finite(P_k, f"P{k}", defaults)
+    _check_finite(model.H, "H", defaults)
     for k in range(1, N + 1):
         sign = (-1) ** (k - 1)
         residual = (model.P[k].T - sign * model.P[k]).applyfunc(canonical)
@@ -357,6 +360,22 @@ def _validate(model: BCPHS) -> list[str]:
     derive_ports(model)
     checks.append("port identities: exact")
     return checks
+
+
+def _check_finite(
+    matrix: sympy.MatrixBase, name: str, defaults: Mapping[sympy.Symbol, sympy.Expr]
+) -> None:
+    """Refuse entries that are infinite or undefined at the parameter defaults (1/rho, rho = 0)."""
+    for (i, j), entry in sympy.ImmutableMatrix(matrix).todok().items():
+        value = entry.xreplace(dict(defaults))
+        if value.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan):
+            values = ", ".join(
+                f"{s} = {v}" for s, v in defaults.items() if s in entry.free_symbols
+            )
+            raise ModelError(
+                f"{name}[{i + 1},{j + 1}] = {entry} is not finite at the parameter defaults "
+                f"({values or 'no parameters'}); expected a finite value"
+            )
 
 
 def _check_symbols(matrix: sympy.MatrixBase, name: str, allowed: set[sympy.Symbol]) -> None:

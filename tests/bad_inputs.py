@@ -1,0 +1,157 @@
+"""Bad model files shared by the library tests and the command-line table.
+
+Each row: (changes to the beam's model file, the exception the library raises, a regex
+that the message must match: it names the culprit and gives expected against found).
+"""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+
+from phdesign.errors import (
+    ExpressionError,
+    ModelError,
+    ModelFileError,
+    PortError,
+    ShapeError,
+)
+from phdesign.models import builtin_toml
+
+BEAM = tomllib.loads(builtin_toml("euler-bernoulli"))
+
+
+def beam_with(**changes):
+    """The beam's model-file content with keys replaced; a value None deletes the key."""
+    data = copy.deepcopy(BEAM)
+    for path, value in changes.items():
+        keys = path.split("__")
+        table = data
+        for key in keys[:-1]:
+            table = table[key]
+        if value is None:
+            del table[keys[-1]]
+        else:
+            table[keys[-1]] = value
+    return data
+
+
+# (changes to the beam file, exception, regex naming the culprit)
+BAD_MODELS = [
+    ({"order": 0}, ModelError, "order must be an integer N >= 1; found 0"),
+    ({"order": "2"}, ModelError, "order must be an integer"),
+    ({"interval": [1, 0]}, ModelError, r"a < b; found \[1, 0\]"),
+    ({"interval": [0]}, ModelError, r"interval must be a pair"),
+    ({"interval": [0, "nan"]}, ExpressionError, "unknown symbol 'nan'"),
+    ({"interval": [0, float("inf")]}, ExpressionError, "finite number"),
+    ({"matrices__P2": [[0, 1], [1, 0]]}, ModelError, r"P2 must satisfy P2\^T = -P2"),
+    ({"matrices__P1": [[0, 1], [0, 0]]}, ModelError, r"P1 must satisfy P1\^T = P1"),
+    (
+        {"matrices__P0": [[1, 0], [0, 0]]},
+        ModelError,
+        "P0 \\+ P0\\^T must be negative semidefinite",
+    ),
+    (
+        {"matrices__P0": [["d", 0], [0, 0]]},
+        ModelError,
+        "negative semidefinite \\(exact at the parameter defaults\\)",
+    ),
+    (
+        {"matrices__P2": [[0, 0], [0, 0]]},
+        ModelError,
+        r"P2 must be invertible; found det\(P2\) = 0",
+    ),
+    ({"matrices__P3": [[0, 0], [0, 0]]}, ModelError, "P3 is not a matrix of an order-2 model"),
+    ({"matrices__Q": [[1]]}, ModelFileError, "unknown matrix 'Q'"),
+    ({"matrices__H": None}, ModelFileError, "lacks H"),
+    ({"matrices__H": [[1, 1], [0, 1]]}, ModelError, "H must be symmetric"),
+    ({"matrices__H": [[1, 0], [0, -1]]}, ModelError, "H must be positive definite"),
+    (
+        {"matrices__H": [["z - 0.5", 0], [0, 1]]},
+        ModelError,
+        r"positive definite on \[0.0, 1.0\]; found smallest eigenvalue -0.5 at z = 0",
+    ),
+    ({"matrices__H": [["1/z", 0], [0, 1]]}, ModelError, "bounded on"),
+    (
+        {"matrices__H": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]},
+        ShapeError,
+        r"P0 matrix; expected \(3, 3\) but found \(2, 2\)",
+    ),
+    ({"matrices__H": [[1, 0], [0]]}, ModelError, "H row 2 has 1 entries; expected 2"),
+    ({"matrices__H": [["1/rho", 0], [0, "EJ"]]}, ExpressionError, "unknown symbol 'EJ'"),
+    (
+        {"matrices__P2": [[0, "-z"], ["z", 0]]},
+        ExpressionError,
+        "spatial variable z is not allowed",
+    ),
+    (
+        {"matrices__P0": [["-d", 0], [0, True]]},
+        ExpressionError,
+        r"P0\[2,2\] must be a number; found the boolean",
+    ),
+    ({"parameters__d": "abc"}, ExpressionError, "unknown symbol 'abc'"),
+    ({"parameters__z": 1.0}, ExpressionError, "parameter name 'z' is reserved"),
+    ({"parameters__e1": 1.0}, ExpressionError, "parameter name 'e1' is reserved"),
+    ({"parameters__rho": -1}, ModelError, "H must be positive definite"),
+    (
+        {"ports__inputs": ["e1(0)", "e1'(0)", "e2(1)"]},
+        ModelError,
+        "needs N\\*n = 4 inputs; found 3",
+    ),
+    (
+        {"ports__outputs": ["e2'(0)", "-e2(0)", "e1'(1)", "-e1(1)", "e1(0)"]},
+        ModelError,
+        "4 outputs; found 5",
+    ),
+    (
+        {"ports__inputs": ["e1(0)", "e1''(0)", "e2(1)", "e2'(1)"]},
+        ExpressionError,
+        r"inputs\[2\].*derivative order 2",
+    ),
+    ({"ports__inputs": ["e1(0)", "e1'(0.5)", "e2(1)", "e2'(1)"]}, ExpressionError, "interior"),
+    (
+        {"ports__inputs": ["e1(0)", "e3'(0)", "e2(1)", "e2'(1)"]},
+        ExpressionError,
+        r"expected 1..2, found 3",
+    ),
+    (
+        {"ports__inputs": ["e1(0)*e1(1)", "e1'(0)", "e2(1)", "e2'(1)"]},
+        ExpressionError,
+        "not linear",
+    ),
+    (
+        {"ports__inputs": ["e1(0)", "e1'(0)", "e2(1)", "os.system('x')"]},
+        ExpressionError,
+        "unexpected character",
+    ),
+    (
+        {"ports__outputs": ["e2'(0)", "e2(0)", "e1'(1)", "-e1(1)"]},
+        PortError,
+        r"W_C Σ W_Bᵀ = I fails",
+    ),
+    (
+        {"ports__outputs": ["e2'(0)", "e2'(0)", "e1'(1)", "-e1(1)"]},
+        PortError,
+        "outputs are linearly dependent",
+    ),
+    ({"ports__inputs": "e1(0)"}, ModelError, "inputs must be a list"),
+    (
+        {"ports__extra": ["e1(0)"]},
+        ModelFileError,
+        r"\[ports\] must hold exactly inputs and outputs",
+    ),
+    ({"name": None}, ModelFileError, "lacks the key\\(s\\) name"),
+    ({"colour": "blue"}, ModelFileError, "unknown key\\(s\\) colour"),
+    ({"matrices": [1, 2]}, ModelFileError, "matrices must be a table"),
+    (
+        {"displacement": {"component": 3, "integrations": 2}},
+        ModelError,
+        "displacement must name a component in 1..2",
+    ),
+    (
+        {"displacement": {"component": "x2"}},
+        ModelFileError,
+        r"\[displacement\] must hold integers",
+    ),
+    ({"states": ["a"]}, ModelError, "state_names must hold 2 labels; found 1"),
+]
