@@ -1,0 +1,121 @@
+"""``phdesign classify``: JSON contract, readable table, bad input (exit 2, one line)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from phdesign.cli import main
+
+
+def run(capsys, *argv):
+    status = main(list(argv))
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_json_contract_two_tip_sensors(capsys):
+    status, out, err = run(
+        capsys, "classify", "euler-bernoulli", "--sensors", "3,4", "--gain", "1,2", "--json"
+    )
+    assert status == 0
+    assert err == ""
+    data = json.loads(out)
+    for key in (
+        "model",
+        "order",
+        "size",
+        "sensors",
+        "gain",
+        "partitioned",
+        "results",
+        "verdict",
+    ):
+        assert key in data
+    assert (data["model"], data["order"], data["size"]) == ("euler-bernoulli", 2, 2)
+    assert data["sensors"] == [[0, 0, 1, 0], [0, 0, 0, 1]]
+    assert data["gain"] == [[1, 0], [0, 2]]
+    assert data["partitioned"] is True
+    assert data["verdict"] == "exponential"
+    names = [(r["proposition"], r["variant"]) for r in data["results"]]
+    assert names[:4] == [("3.1", 1), ("3.1", 2), ("3.2", 1), ("3.2", 2)]
+    r34 = data["results"][10]
+    # §IV-D corrected: κ* = min(l2, l1/(1 + l1^2)) = min(2, 1/2) = 1/2
+    assert (r34["proposition"], r34["variant"], r34["holds"], r34["kappa"]) == (
+        "3.4",
+        3,
+        True,
+        0.5,
+    )
+    assert all({"proposition", "variant", "applicable", "holds", "kappa"} <= set(r) for r in
+               data["results"])  # fmt: skip
+    # not applicable (3.2 for N = 2): holds and kappa null
+    assert data["results"][2]["applicable"] is False
+    assert data["results"][2]["holds"] is None
+    assert data["results"][2]["kappa"] is None
+
+
+def test_symbolic_gain_json(capsys):
+    status, out, _ = run(
+        capsys, "classify", "euler-bernoulli", "--sensors", "3,4", "--gain", "symbolic", "--json"
+    )
+    assert status == 0
+    data = json.loads(out)
+    r34 = data["results"][10]
+    assert r34["holds"] is True
+    assert r34["kappa"] is None  # no number for symbolic gains; the expression is exact
+    assert r34["kappa_exact"] == "Min(l2, l1/(l1**2 + 1))"
+    assert r34["conditions"] == "holds for all positive l1, l2"
+
+
+def test_cm_in_full_equals_sensors(capsys):
+    _, by_sensors, _ = run(capsys, "classify", "wave", "--sensors", "2", "--json")
+    _, by_cm, _ = run(capsys, "classify", "wave", "--cm", "[[0, 1]]", "--json")
+    assert json.loads(by_sensors) == json.loads(by_cm)
+
+
+def test_table(capsys):
+    status, out, _ = run(capsys, "classify", "euler-bernoulli", "--sensors", "3,4")
+    assert status == 0
+    assert "Assumption 3.1 holds" in out
+    assert "ẽ2(0) is left free by these sensors" in out
+    assert out.strip().splitlines()[-1] == (
+        "verdict: exponential (best: Proposition 3.4 variant 3)"
+    )
+
+
+def test_all_sensors(capsys):
+    status, out, _ = run(capsys, "classify", "euler-bernoulli", "--all-sensors", "--json")
+    assert status == 0
+    data = json.loads(out)
+    assert len(data["subsets"]) == 15
+    assert data["minimal"]["exponential"] == [[2], [4]]  # derived in test_search.py
+    status, out, _ = run(capsys, "classify", "wave", "--all-sensors")
+    assert "minimal exponential sets: {1}, {2}" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["wave", "--sensors", "3"], "output index 3 is out of range; expected 1..2"),
+        (["wave", "--sensors", "1,1"], "output index 1 is repeated"),
+        (["wave", "--sensors", "1", "--gain", "1,2"], "expected 1 diagonal values"),
+        (["wave", "--sensors", "1", "--gain", "nan"], "must be a finite positive number"),
+        (["wave", "--sensors", "1", "--gain", "-1"], "L + Lᵀ must be positive definite"),
+        (["wave", "--cm", "[[1, 0]"], "--cm: expected a JSON list of rows"),
+        (["wave", "--cm", "[[1, 0, 0]]"], "expected (q, 2) but found (1, 3)"),
+        (["wave"], "classify needs --sensors, --cm or --all-sensors"),
+        (["wave", "--all-sensors", "--sensors", "1"], "drop --sensors/--cm"),
+        (["wave", "--all-sensors", "--gain", "1,2,3"], "expected 1 or 2 diagonal values"),
+        (["no-such-model", "--sensors", "1"], "unknown model"),
+        (["wave", "--sensors", "1", "--cm", "[[1,0]]"], "not allowed with argument"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(capsys, argv, message):
+    status, out, err = run(capsys, "classify", *argv)
+    assert status == 2
+    assert out == ""
+    assert len(err.strip().splitlines()) == 1
+    assert err.startswith("phdesign")
+    assert message in err
