@@ -12,7 +12,10 @@ i.e. iff :math:`M \supseteq B_{\text{variant}} = \{j : \operatorname{supp} t_j \
 
 The constants use the float path: with :math:`L = \mathrm{diag}(g_M)`,
 :math:`K_m = T^{-1}(-C_m^\top L; C_m^\top)` and :math:`\kappa^* =
-1/\sigma_{\max}(S K_m L^{-1/2})^2`, batched over subsets with numpy.
+1/\sigma_{\max}(S K_m L^{-1/2})^2`: Jacobi rotations in pure Python for small
+searches (numpy would cost more to import than the work), batched LAPACK
+``eigvalsh`` over subsets otherwise.  "Unbounded" (RHS ≡ 0 on K) is read from the
+exact zero pattern, never from a tolerance.
 
 A set is *minimal* for a verdict when it has that verdict and no proper subset has.
 
@@ -21,11 +24,14 @@ Examples
 >>> from phdesign.models import load_builtin
 >>> found = search_sensors(load_builtin("euler-bernoulli"))
 >>> found.minimal["exponential"]
-((3, 4),)
+((2,), (4,))
+>>> found.subset([4]).best, found.subset([4]).kappa
+('3.4.4', 0.5)
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
@@ -257,81 +263,55 @@ def search_sensors(
     -------
     SensorSearch
     """
-    import numpy as np
-
     order, size = model.order, model.size
     nn = order * size
     gains = _gain_vector(gain, nn)
     cands = candidates(model)
     total = 2**nn - 1
-    masks = np.arange(1, total + 1, dtype=np.int64)
-    required = np.array([sum(1 << (j - 1) for j in c.required) for c in cands], dtype=np.int64)
-    holds = (required[:, None] & ~masks[None, :]) == 0  # (candidates, subsets)
-    kappa = np.full(holds.shape, np.nan)
-    unbounded = np.zeros(holds.shape, dtype=bool)
+    required = [sum(1 << (j - 1) for j in c.required) for c in cands]
+    exponential = [c.variant.convergence == "exponential" for c in cands]
+    # decision: exact and combinatorial (module docstring)
+    holds = [[required[c] & ~mask == 0 for c in range(len(cands))] for mask in range(total + 1)]
+    kappa: dict[tuple[int, int], float | None] = {}  # (mask, candidate) -> κ*, None = unbounded
     if gains is not None:
-        U, Y = port_matrices(model)
-        T_inv_exact = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
-        T_inv = np.array(T_inv_exact.evalf(17).tolist(), dtype=float)
-        g = np.array([float(x) for x in gains])
-        # column r of K_m for output j: -g_j T_inv[:, j] + T_inv[:, Nn + j], scaled by g^-1/2
-        columns = (-g * T_inv[:, :nn] + T_inv[:, nn:]) / np.sqrt(g)
-        bits = (masks[:, None] >> np.arange(nn)[None, :]) & 1
-        counts = bits.sum(axis=1)
-        done = 0
-        for q in range(1, nn + 1):
-            idx = np.nonzero(counts == q)[0]
-            chosen = np.nonzero(bits[idx])[1].reshape(len(idx), q)  # outputs, 0-based
-            for c, cand in enumerate(cands):
-                rows = np.array(cand.selected)
-                sub = idx[holds[c, idx]]
-                if sub.size == 0:
-                    continue
-                pick = chosen[holds[c, idx]]
-                M = columns[rows][:, pick].transpose(1, 0, 2)  # (subsets, |S|, q)
-                B = np.einsum("kia,kib->kab", M, M)
-                top = np.linalg.eigvalsh(B)[:, -1]
-                scale = np.abs(M).max(axis=(1, 2))
-                zero = scale <= 1e-13 * max(1.0, np.abs(columns).max())
-                unbounded[c, sub] = zero
-                kappa[c, sub] = np.where(zero, np.nan, 1.0 / np.where(zero, 1.0, top))
-            done += len(idx)
-            if progress is not None and total > PROGRESS_THRESHOLD:
-                progress(done, total)
-    exponential = np.array([c.variant.convergence == "exponential" for c in cands])
-    verdict_code = np.where(
-        (holds & exponential[:, None]).any(axis=0), 0, np.where(holds.any(axis=0), 1, 2)
-    )
+        jobs = [
+            (mask, c) for mask in range(1, total + 1) for c in range(len(cands)) if holds[mask][c]
+        ]
+        kappa = _kappas(model, gains, cands, jobs, progress, total)
     names = ("exponential", "asymptotic", "inconclusive")
+    verdict_code = [2] * (total + 1)
     results = []
-    order_of = sorted(
-        range(total), key=lambda k: (bin(int(masks[k])).count("1"), _members(int(masks[k])))
-    )
-    for k in order_of:
-        members = _members(int(masks[k]))
-        holding = [c for c in range(len(cands)) if holds[c, k]]
+    for mask in sorted(range(1, total + 1), key=lambda m: (bin(m).count("1"), _members(m))):
+        holding = [c for c in range(len(cands)) if holds[mask][c]]
+        if any(exponential[c] for c in holding):
+            verdict_code[mask] = 0
+        elif holding:
+            verdict_code[mask] = 1
         best = None
         if holding:
 
-            def strength(c: int, k: int = k) -> tuple[int, float]:
-                value = np.inf if unbounded[c, k] else kappa[c, k]
-                return (int(exponential[c]), -1.0 if np.isnan(value) else float(value))
+            def strength(c: int, mask: int = mask) -> tuple[int, float]:
+                if (mask, c) not in kappa:
+                    return int(exponential[c]), -1.0  # symbolic gains: no constant
+                value = kappa[mask, c]
+                return int(exponential[c]), float("inf") if value is None else value
 
             best = max(holding, key=strength)
+        value = None if best is None else kappa.get((mask, best))
         results.append(
             SubsetResult(
-                sensors=members,
-                verdict=names[int(verdict_code[k])],
+                sensors=_members(mask),
+                verdict=names[verdict_code[mask]],
                 best=None if best is None else cands[best].name,
-                kappa=None if best is None or np.isnan(kappa[best, k]) else float(kappa[best, k]),
-                unbounded=bool(best is not None and unbounded[best, k]),
+                kappa=value,
+                unbounded=best is not None and (mask, best) in kappa and value is None,
                 holding=tuple(dict.fromkeys(cands[c].name for c in holding)),
                 partition=None
                 if best is None or cands[best].partition is None
                 else (cands[best].partition.x1, cands[best].partition.x2),  # type: ignore[union-attr]
             )
         )
-    minimal = _minimal_sets(masks, verdict_code, names, nn)
+    minimal = _minimal_sets(verdict_code, names, nn)
     return SensorSearch(
         model=model.name,
         order=order,
@@ -343,34 +323,120 @@ def search_sensors(
     )
 
 
+#: Up to this many (subset, variant) pairs κ* is computed in pure Python (Jacobi
+#: eigenvalues): importing numpy would cost more than the whole computation.
+PURE_PYTHON_JOBS = 600
+
+
+def _kappas(
+    model: BCPHS,
+    gains: tuple[sympy.Expr, ...],
+    cands: tuple[Candidate, ...],
+    jobs: list[tuple[int, int]],
+    progress: Callable[[int, int], None] | None,
+    total: int,
+) -> dict[tuple[int, int], float | None]:
+    r"""κ* per (subset mask, candidate): :math:`1/\lambda_{\max}(B)`, ``None`` when RHS ≡ 0.
+
+    Column ``j`` of :math:`S K_m L^{-1/2}` for a measured output ``j`` is
+    :math:`(-g_j T^{-1}_{:, j} + T^{-1}_{:, Nn + j}) / \sqrt{g_j}` on the selected rows;
+    its exact zero pattern decides "unbounded" (RHS vanishes on K) without a tolerance.
+    """
+    nn = model.order * model.size
+    U, Y = port_matrices(model)
+    T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
+    exact_columns = [
+        [-gains[j] * T_inv[i, j] + T_inv[i, nn + j] for j in range(nn)] for i in range(2 * nn)
+    ]
+    nonzero = [[not vanishes(x) for x in row] for row in exact_columns]
+    root = [math.sqrt(float(g)) for g in gains]
+    columns = [[float(x) / root[j] for j, x in enumerate(row)] for row in exact_columns]
+    out: dict[tuple[int, int], float | None] = {}
+    todo: list[tuple[int, int, list[int], list[int]]] = []
+    for mask, c in jobs:
+        rows = list(cands[c].selected)
+        pick = [j for j in range(nn) if mask >> j & 1]
+        if not any(nonzero[i][j] for i in rows for j in pick):
+            out[mask, c] = None
+        else:
+            todo.append((mask, c, rows, pick))
+    if len(todo) <= PURE_PYTHON_JOBS:
+        for mask, c, rows, pick in todo:
+            M = [[columns[i][j] for j in pick] for i in rows]
+            B = [[sum(r[a] * r[b] for r in M) for b in range(len(pick))] for a in range(len(pick))]
+            out[mask, c] = 1.0 / max(_jacobi_eigenvalues(B))
+        if progress is not None and total > PROGRESS_THRESHOLD:
+            progress(total, total)
+        return out
+    import numpy as np
+
+    cols = np.array(columns)
+    by_shape: dict[tuple[int, int], list[tuple[int, int, list[int], list[int]]]] = {}
+    for job in todo:
+        by_shape.setdefault((job[1], len(job[3])), []).append(job)
+    done = 0
+    for (c, _q), group in sorted(by_shape.items(), key=lambda item: item[0][1]):
+        rows = np.array(cands[c].selected)
+        picks = np.array([job[3] for job in group])
+        M = cols[rows][:, picks].transpose(1, 0, 2)  # (subsets, |S|, q)
+        top = np.linalg.eigvalsh(np.einsum("kia,kib->kab", M, M))[:, -1]
+        for job, mu in zip(group, top, strict=True):
+            out[job[0], job[1]] = float(1.0 / mu)
+        done += len(group)
+        if progress is not None and total > PROGRESS_THRESHOLD:
+            progress(min(total, round(total * done / len(todo))), total)
+    return out
+
+
+def _jacobi_eigenvalues(B: list[list[float]]) -> list[float]:
+    """Eigenvalues of a small symmetric matrix by cyclic Jacobi rotations (pure Python)."""
+    A = [row[:] for row in B]
+    n = len(A)
+    for _sweep in range(50):
+        off = sum(A[i][j] ** 2 for i in range(n) for j in range(n) if i != j)
+        scale = sum(A[i][i] ** 2 for i in range(n))
+        if off <= 1e-32 * scale or off == 0.0:
+            break
+        for p in range(n - 1):
+            for q in range(p + 1, n):
+                if A[p][q] == 0.0:
+                    continue
+                theta = (A[q][q] - A[p][p]) / (2.0 * A[p][q])
+                t = math.copysign(1.0, theta) / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                cos = 1.0 / math.sqrt(t * t + 1.0)
+                sin = t * cos
+                for k in range(n):
+                    akp, akq = A[k][p], A[k][q]
+                    A[k][p], A[k][q] = cos * akp - sin * akq, sin * akp + cos * akq
+                for k in range(n):
+                    apk, aqk = A[p][k], A[q][k]
+                    A[p][k], A[q][k] = cos * apk - sin * aqk, sin * apk + cos * aqk
+    return [A[i][i] for i in range(n)]
+
+
 def _members(mask: int) -> tuple[int, ...]:
     return tuple(j + 1 for j in range(mask.bit_length()) if mask >> j & 1)
 
 
 def _minimal_sets(
-    masks: Any, verdict_code: Any, names: tuple[str, ...], nn: int
+    verdict_code: list[int], names: tuple[str, ...], nn: int
 ) -> dict[str, tuple[tuple[int, ...], ...]]:
     """Return the sets with a verdict no proper subset has (DP over bit masks)."""
     total = 1 << nn
-    verdict = [-1] * total  # -1 for the empty set
-    for k, mask in enumerate(masks):
-        verdict[int(mask)] = int(verdict_code[k])
+    verdict = list(verdict_code)
+    verdict[0] = -1  # the empty set has no verdict
     # below[v][m]: some proper non-empty subset of m has verdict v
     minimal: dict[str, list[tuple[int, ...]]] = {name: [] for name in names}
     below = [[False] * total for _ in names]
     for m in range(1, total):
         for v in range(len(names)):
             flag = False
-            sub = m
-            j = 0
-            while sub:
-                if sub & 1:
+            for j in range(nn):
+                if m >> j & 1:
                     smaller = m & ~(1 << j)
                     if smaller and (verdict[smaller] == v or below[v][smaller]):
                         flag = True
                         break
-                sub >>= 1
-                j += 1
             below[v][m] = flag
         if not below[verdict[m]][m]:
             minimal[names[verdict[m]]].append(_members(m))
