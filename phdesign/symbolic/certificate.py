@@ -169,12 +169,12 @@ def certify(
     if method in ("auto", "exact"):
         exact = _exact_kappa(A_r, B_r)
         if exact is not None:
-            value = float(exact.evalf(30))
-            return Certificate(True, exact, value, False, None, (), "exact", None, pencil)
+            return Certificate(
+                True, exact, float(exact.evalf(30)), False, None, (), "exact", None, pencil
+            )
         if method == "exact":
             raise ValueError("no exact root available for this pencil; use method='float'")
-    value = float_kappa(A_r, B_r)
-    return Certificate(True, None, value, False, None, (), "float", None, pencil)
+    return Certificate(True, None, float_kappa(A_r, B_r), False, None, (), "float", None, pencil)
 
 
 def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | None:
@@ -204,7 +204,8 @@ def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | N
     mu_max = max(roots, key=lambda r: float(r.evalf(30)))
     if mu_max == 0:
         return None
-    return sympy.nsimplify(1 / mu_max) if mu_max.is_rational else 1 / mu_max
+    # radsimp rationalizes denominators like 1/(4 sqrt(2)/7 + 16/7) = (4 - sqrt(2))/4
+    return 1 / mu_max if mu_max.is_rational else sympy.radsimp(1 / mu_max)
 
 
 def _symbolic_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> tuple[sympy.Expr | None, str]:

@@ -257,9 +257,7 @@ def _exactify_entries(M: sympy.MatrixBase, what: str) -> sympy.ImmutableMatrix:
         for j in range(M.cols):
             x = M[i, j]
             if isinstance(x, sympy.Basic) and x.has(sympy.nan, sympy.zoo, sympy.oo, -sympy.oo):
-                raise ObserverError(
-                    f"{what}[{i + 1}][{j + 1}] must be a finite number; found {x}"
-                )
+                raise ObserverError(f"{what}[{i + 1}][{j + 1}] must be a finite number; found {x}")
             if isinstance(x, sympy.Basic) and x.free_symbols:
                 row.append(x)
                 continue

@@ -376,9 +376,9 @@ def _kappas(
         by_shape.setdefault((job[1], len(job[3])), []).append(job)
     done = 0
     for (c, _q), group in sorted(by_shape.items(), key=lambda item: item[0][1]):
-        rows = np.array(cands[c].selected)
+        selected = np.array(cands[c].selected)
         picks = np.array([job[3] for job in group])
-        M = cols[rows][:, picks].transpose(1, 0, 2)  # (subsets, |S|, q)
+        M = cols[selected][:, picks].transpose(1, 0, 2)  # (subsets, |S|, q)
         top = np.linalg.eigvalsh(np.einsum("kia,kib->kab", M, M))[:, -1]
         for job, mu in zip(group, top, strict=True):
             out[job[0], job[1]] = float(1.0 / mu)
