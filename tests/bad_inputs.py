@@ -136,6 +136,11 @@ BAD_MODELS = [
     ),
     ({"ports__inputs": "e1(0)"}, ModelError, "inputs must be a list"),
     (
+        {"ports__inputs": [["e1(0)"], "e1'(0)", "e2(1)", "e2'(1)"]},
+        ExpressionError,
+        r"inputs\[1\] must be a trace expression such as \"e1\(0\)\"; found list",
+    ),
+    (
         {"ports__extra": ["e1(0)"]},
         ModelFileError,
         r"\[ports\] must hold exactly inputs and outputs",

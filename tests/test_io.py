@@ -64,7 +64,7 @@ def random_models(draw) -> BCPHS:
         *[
             draw(
                 st.sampled_from(
-                    ["1", "2", "1 + z", "3/2", "k"]
+                    ["1", "2", "2 + z", "3/2", "k"]
                     if use_parameter
                     else ["1", "2", "1 + z**2", "1/2"]
                 )

@@ -194,9 +194,7 @@ class BCPHS:
             if isinstance(texts, str) or not isinstance(texts, Sequence):
                 raise ModelError(f"{kind} must be a list of trace expressions; found {texts!r}")
             ports[kind] = tuple(
-                parse_trace_expression(t, endpoints, order, size, names, what=f"{kind}[{i + 1}]")
-                if isinstance(t, str)
-                else exactify(sympy.sympify(t))
+                _port(t, endpoints, order, size, names, what=f"{kind}[{i + 1}]")
                 for i, t in enumerate(texts)
             )
         return cls(
@@ -249,6 +247,24 @@ class BCPHS:
 
 
 # ---------------------------------------------------------------------- helpers
+
+
+def _port(
+    value: object,
+    interval: tuple[sympy.Expr, sympy.Expr],
+    order: int,
+    size: int,
+    parameters: Sequence[str],
+    what: str,
+) -> sympy.Expr:
+    if isinstance(value, str):
+        return parse_trace_expression(value, interval, order, size, parameters, what=what)
+    if isinstance(value, sympy.Expr):
+        return exactify(value)
+    raise ExpressionError(
+        f'{what} must be a trace expression such as "e1(0)"; found {type(value).__name__} '
+        f"{value!r}"
+    )
 
 
 def _interval(interval: Sequence[object]) -> tuple[sympy.Expr, sympy.Expr]:
