@@ -69,7 +69,14 @@ BAD_MODELS = [
     (
         {"matrices__H": [["z - 0.5", 0], [0, 1]]},
         ModelError,
-        r"positive definite on \[0.0, 1.0\]; found smallest eigenvalue -0.5 at z = 0",
+        # exact: the minor z - 1/2 has minimum -1/2 on [0, 1] (at z = 0)
+        r"found leading principal minor 1 = z - 1/2 with minimum -1/2",
+    ),
+    (
+        {"matrices__H": [["cos(3*z)", 0], [0, 1]]},
+        ModelError,
+        # grid: cos(3 z) decreases on [0, 1] (its first zero is pi/6), cos(3) = -0.989992
+        r"smallest eigenvalue -0.989992 at z = 1 \(parameter defaults\)",
     ),
     ({"matrices__H": [["1/z", 0], [0, 1]]}, ModelError, "bounded on"),
     (

@@ -42,18 +42,23 @@ def test_define_from_code_equals_the_builtin():
     assert dict(beam.parameters)[sympy.Symbol("d", real=True)] == sympy.Rational(1, 5)
 
 
-def test_z_dependent_H_is_checked_on_a_grid_and_says_so():
-    model = BCPHS.define(
-        name="tapered string",
-        interval=(0, 2),
-        order=1,
-        P={1: [[0, 1], [1, 0]]},
-        H=[["1/(1 + z)", 0], [0, "1 + z**2"]],
-        inputs=["e1(0)", "e2(2)"],
-        outputs=["-e2(0)", "e1(2)"],
-    )
-    assert model.H[0, 0] == 1 / (1 + Z)
-    assert any("grid" in check for check in model.checks)
+def test_z_dependent_H_is_checked_exactly_when_rational_else_on_a_grid():
+    def string(H):
+        return BCPHS.define(
+            name="tapered string",
+            interval=(0, 2),
+            order=1,
+            P={1: [[0, 1], [1, 0]]},
+            H=H,
+            inputs=["e1(0)", "e2(2)"],
+            outputs=["-e2(0)", "e1(2)"],
+        )
+
+    rational = string([["1/(1 + z)", 0], [0, "1 + z**2"]])
+    assert rational.H[0, 0] == 1 / (1 + Z)
+    assert any("exact on [a, b]" in check for check in rational.checks)
+    transcendental = string([["2 + sin(z)", 0], [0, "exp(z)"]])
+    assert any("grid of 2001 points" in check for check in transcendental.checks)
 
 
 def test_with_parameters_revalidates_and_refuses_unknown_names():

@@ -476,7 +476,42 @@ def _check_positive_definite(
             "H must be positive definite; at the parameter defaults found eigenvalues "
             f"{sorted(sympy.ImmutableMatrix(H_defaults).eigenvals())}"
         )
-    return _check_positive_definite_on_grid(H_defaults, interval)
+    exact = _check_positive_definite_exactly(H_defaults, interval)
+    return exact if exact is not None else _check_positive_definite_on_grid(H_defaults, interval)
+
+
+def _check_positive_definite_exactly(
+    H: sympy.MatrixBase, interval: tuple[sympy.Expr, sympy.Expr]
+) -> str | None:
+    """Prove min over [a, b] of every leading principal minor > 0, for rational H(z).
+
+    Returns ``None`` when sympy cannot decide (then the grid check runs).
+    """
+    from sympy.calculus.util import minimum
+
+    minors = [sympy.cancel(H[:k, :k].det()) for k in range(1, H.shape[0] + 1)]
+    if not all(m.is_rational_function(Z) for m in minors):
+        return None
+    domain = sympy.Interval(*interval)
+    for k, minor in enumerate(minors, start=1):
+        _, denominator = sympy.fraction(minor)
+        if sympy.solveset(denominator, Z, domain) != sympy.EmptySet:
+            raise ModelError(
+                f"H must be bounded on [{interval[0]}, {interval[1]}]; its minor {k} = {minor} "
+                "has a pole there (parameter defaults)"
+            )
+        try:
+            smallest = minimum(minor, Z, domain)
+        except (NotImplementedError, ValueError):
+            return None
+        if not smallest.is_number:
+            return None
+        if not smallest > 0:
+            raise ModelError(
+                f"H must be positive definite on [{interval[0]}, {interval[1]}]; found leading "
+                f"principal minor {k} = {minor} with minimum {smallest} (parameter defaults)"
+            )
+    return "H > 0: exact on [a, b] at the parameter defaults (leading principal minors)"
 
 
 def _check_positive_definite_on_grid(
