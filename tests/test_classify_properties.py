@@ -16,6 +16,7 @@ from functools import cache
 from pathlib import Path
 
 import numpy as np
+import pytest
 import sympy
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -129,3 +130,34 @@ def test_search_matches_classify_on_random_models(shape, seed):
     for entry in found.subsets:
         single = classify(m, sensor_matrix(entry.sensors, nn), sympy.eye(len(entry.sensors)))
         assert entry.verdict == single.verdict
+
+
+@pytest.mark.slow
+@settings(max_examples=10, deadline=None)
+@given(
+    st.sampled_from([0, 1, 3]),  # shapes with N n <= 4: symbolic pencils stay small
+    st.integers(0, 3),
+    st.data(),
+)
+def test_symbolic_gains_agree_with_numeric_gains(shape, seed, data):
+    from phdesign.symbolic.observer import gain_symbols, parse_gain
+
+    m = model(shape, seed)
+    nn = m.order * m.size
+    sensors = data.draw(
+        st.lists(st.integers(1, nn), min_size=1, max_size=min(nn, 3), unique=True).map(sorted)
+    )
+    q = len(sensors)
+    C_m = sensor_matrix(sensors, nn)
+    symbolic = classify(m, C_m, parse_gain("symbolic", q))
+    values = data.draw(st.lists(st.integers(1, 12), min_size=q, max_size=q))
+    gains = [sympy.Rational(v, 4) for v in values]
+    numeric = classify(m, C_m, sympy.diag(*gains))
+    substitution = dict(zip(gain_symbols(q), gains, strict=True))
+    for s, n in zip(symbolic.results, numeric.results, strict=True):
+        # a symbolic yes/no holds for every positive gain, so it must match any sample
+        assert s.holds == n.holds
+        assert s.unbounded == n.unbounded
+        if s.holds and not s.unbounded and s.kappa is not None:
+            value = float(s.kappa.subs(substitution).evalf(30))
+            assert value == pytest.approx(n.kappa_float, rel=1e-12)
