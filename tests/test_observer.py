@@ -167,3 +167,10 @@ def test_port_matrices_substitute_parameters(beam):
     assert not U.free_symbols
     assert not Y.free_symbols
     assert error_system(2, 2, U, Y, sensor_matrix([4], 4), sympy.eye(1)).K.shape == (8, 4)
+
+
+def test_singular_port_stack_is_an_observer_error():
+    # U = Y: each alone has full rank, but (U; Y) is singular (not power conjugates)
+    U = sympy.Matrix([[1, 0, 0, 0], [0, 1, 0, 0]])
+    with pytest.raises(ObserverError, match=r"\(U; Y\) is singular.*dimension Nn = 2"):
+        error_system(1, 2, U, U, sensor_matrix([1], 2), sympy.eye(1))

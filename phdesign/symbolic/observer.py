@@ -54,6 +54,7 @@ from functools import lru_cache
 
 import sympy
 from sympy.polys.matrices import DomainMatrix
+from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.errors import ExpressionError, ObserverError, check_shape
 from phdesign.symbolic.expressions import exact_number
@@ -327,7 +328,14 @@ def port_matrices(model: BCPHS) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableM
 @lru_cache(maxsize=64)
 def _inverse(T: sympy.ImmutableMatrix) -> sympy.ImmutableMatrix:
     dm = DomainMatrix.from_Matrix(T).to_field()
-    return sympy.ImmutableMatrix(dm.inv().to_Matrix())
+    try:
+        return sympy.ImmutableMatrix(dm.inv().to_Matrix())
+    except DMNonInvertibleMatrixError:
+        raise ObserverError(
+            "the stacked port matrix (U; Y) is singular, so the admissible traces "
+            f"K = ker(U + C_mᵀ L C_m Y) cannot have dimension Nn = {T.rows // 2}; "
+            "the outputs must be the power conjugates of the inputs"
+        ) from None
 
 
 @dataclass(frozen=True)
