@@ -79,7 +79,6 @@ def _text(x: Any) -> str:
 
 def _table(result: Any) -> str:
     model = result.model
-    interval = model.interval
     sensors = "; ".join(
         " + ".join(f"{c}·y{j + 1}" if c != 1 else f"y{j + 1}" for j, c in enumerate(row) if c != 0)
         for row in result.C_m.tolist()
@@ -110,24 +109,24 @@ def _table(result: Any) -> str:
         if len(kappa) > 28:
             kappa = f"{r.kappa_float:.6g}" if r.kappa_float is not None else kappa[:27] + "…"
         lines.append(f"{r.proposition:<5} {r.variant:<3} {holds:<6} {kappa:<28} {r.rhs}")
-        note = r.reason
+        notes = []
+        if not r.applicable or not r.holds:
+            notes.append(r.reason)
+        else:
+            if r.kappa is not None and len(str(r.kappa)) > 28:
+                notes.append(f"κ* = {r.kappa}")
+            if r.conditions:
+                notes.append(r.conditions)
         if r.partition is not None and r.applicable:
-            note += f" [partition {r.partition.label(model.state_names)}]"
-        if r.applicable and (
-            not r.holds or r.conditions or (r.kappa is not None and len(str(r.kappa)) > 28)
-        ):
-            if r.holds and r.kappa is not None and len(str(r.kappa)) > 28:
-                note = f"κ* = {r.kappa}" + (f"; {r.conditions}" if r.conditions else "")
-            lines.append(f"{'':<16}{'':<28} ↳ {note}")
-        elif not r.applicable:
-            lines.append(f"{'':<16}{'':<28} ↳ {note}")
+            notes.append(f"partition {r.partition.label(model.state_names)}")
+        if notes:
+            lines.append(f"{'':<45}↳ {'; '.join(notes)}")
     lines.append("")
     best = result.best
     tail = ""
     if best is not None:
         tail = f" (best: Proposition {best.proposition} variant {best.variant})"
     lines.append(f"verdict: {result.verdict}{tail}")
-    del interval
     return "\n".join(lines)
 
 
