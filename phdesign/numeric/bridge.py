@@ -181,6 +181,9 @@ def _parameter_values(model: Any, parameters: Mapping[str, Any] | None) -> dict[
     """Defaults of ``model`` overridden by ``parameters`` (keys by name)."""
     import sympy
 
+    if parameters and hasattr(model, "with_parameters"):
+        model = model.with_parameters({str(k): v for k, v in parameters.items()})
+        parameters = None
     values: dict[Any, Any] = dict(model.parameter_defaults)
     by_name = {str(s): s for s in values}
     for key, val in (parameters or {}).items():
@@ -345,6 +348,7 @@ def initial_state_function(
     import sympy
 
     names = {s: i for i, s in enumerate(nm.state_names)}
+    names.update({f"x{i + 1}": i for i in range(n)})
     efforts = {f"e{i + 1}": i for i in range(n)}
     exprs: dict[int, Any] = {}
     kind: str | None = None
@@ -412,19 +416,20 @@ def _parse_z_expression(text: str, model: Any, parameters: Mapping[str, Any] | N
     from phdesign.symbolic import expressions as ex
     from phdesign.symbolic.model import Z
 
-    parser = getattr(ex, "parse_expression", None) or getattr(ex, "parse_scalar", None)
-    if parser is None:
-        raise NumericError("the symbolic layer offers no safe expression parser")
-    allowed = {"z": Z}
     values: dict[Any, Any] = {}
     if model is not None:
         values = _parameter_values(model, parameters)
-        allowed.update({str(s): s for s in values})
-    try:
-        expr = parser(text, allowed)
-    except TypeError:
-        expr = parser(text)
-    expr = sympy.sympify(expr).subs(values)
+    expr = ex.parse_scalar(
+        text, parameters=[str(s) for s in values], allow_z=True, what="initial state expression"
+    )
+    # parse_scalar builds its own z and parameter symbols; map them by name.
+    by_name = {str(s): v for s, v in values.items()}
+    subs = {
+        s: (Z if str(s) == "z" else by_name[str(s)])
+        for s in expr.free_symbols
+        if str(s) == "z" or str(s) in by_name
+    }
+    expr = expr.xreplace(subs)
     free = set(expr.free_symbols) - {Z}
     if free:
         raise ParameterError(_free_symbols_message(f"initial state expression {text!r}", free))

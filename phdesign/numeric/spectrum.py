@@ -1,0 +1,365 @@
+"""Converged spectra: spectral abscissa and rightmost eigenvalues under refinement.
+
+The eigenvalues of the generalized problem :math:`(J - R - B K_{cl} B^\\top) v = \\lambda E v`
+(closed plant, u = 0, or the observer error system, ũ = −C_mᵀ L C_m ỹ) are computed at
+resolutions p and ⌈1.5 p⌉ and only those that agree are kept (the drift-ratio rule of
+Dedalus' eigentools): the discrete spectrum of any semi-discretization contains
+unresolved high-frequency eigenvalues whose real parts are artefacts.  On a damped wave
+they tend to 0 (like h² for finite differences, like p⁻² ... p⁻⁴ for Galerkin), so the
+largest real part over *all* discrete eigenvalues converges to 0, not to the true
+abscissa: the unresolved modes lose the boundary damping.
+
+An eigenvalue λ at the finer resolution is *resolved* when its nearest neighbour μ at
+the coarser one satisfies :math:`|\\lambda - \\mu| \\le r_{tol} \\max(1, |\\lambda|)` and the
+pairing is mutual.  The resolution pair is refined (p → 1.5 p) until the rightmost
+resolved eigenvalue's real part agrees to ``tol``.  Digits are
+:math:`-\\log_{10}(|\\Delta \\operatorname{Re}| / \\max(1, |\\alpha|))`.
+
+Ill-conditioning (near a coalescence, e.g. a critically damped gain) is measured by the
+energy-norm eigenvalue condition number
+:math:`\\kappa = \\|x\\|_E \\|y\\|_{E^{-1}} / |y^* E x|` (1 for a normal operator in the
+energy inner product) and by the relative gap to the nearest other eigenvalue.  When no
+eigenvalue is resolved at any resolution the spectrum is reported as unbounded below
+(finite-time extinction, e.g. the wave with the matched damper k = 1), never as a number.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sl
+
+from phdesign.errors import NumericError
+from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
+
+__all__ = [
+    "SpectrumReport",
+    "default_resolutions",
+    "eigen",
+    "in_band_unresolved",
+    "match_resolved",
+    "resolved_abscissa",
+    "spectrum",
+]
+
+
+@dataclass(frozen=True)
+class SpectrumReport:
+    """Result of :func:`spectrum`.
+
+    Attributes
+    ----------
+    spectral_abscissa : float or None
+        max Re over the resolved eigenvalues (None when unbounded below or none resolved).
+    rightmost : list of complex
+        Resolved eigenvalues with the largest real parts (finest resolution), conjugate
+        pairs kept, sorted by decreasing real part then increasing |Im|.
+    converged : bool
+        The abscissa agrees to ``tol`` between the last two resolutions.
+    digits : float or None
+        Agreeing digits of the abscissa between the last two resolutions.
+    n_resolved, n_total : int
+        Resolved eigenvalues and all eigenvalues at the finest resolution.
+    resolutions : tuple of int
+        The last resolution pair.
+    unbounded_below : bool
+        No eigenvalue converges: empty spectrum / finite-time extinction.
+    ill_conditioned : bool
+        The rightmost eigenvalue is ill-conditioned (near a coalescence).
+    condition_numbers : list of float
+        Energy-norm condition numbers of ``rightmost``.
+    all_eigenvalues_max_real : float
+        max Re over ALL discrete eigenvalues at the finest resolution (the trap value; not
+        an approximation of the abscissa).
+    warnings : list of str
+    """
+
+    spectral_abscissa: float | None
+    rightmost: list[complex]
+    converged: bool
+    digits: float | None
+    n_resolved: int
+    n_total: int
+    resolutions: tuple[int, int]
+    method: str
+    system: str
+    unbounded_below: bool = False
+    ill_conditioned: bool = False
+    condition_numbers: list[float] = field(default_factory=list)
+    all_eigenvalues_max_real: float | None = None
+    history: list[dict[str, Any]] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary (complex numbers as ``[re, im]``)."""
+        d = asdict(self)
+        d["rightmost"] = [[float(z.real), float(z.imag)] for z in self.rightmost]
+        d["resolutions"] = list(self.resolutions)
+        return d
+
+
+def eigen(
+    d: DiscretePHS, K: np.ndarray | None = None, condition: bool = False
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Eigenvalues of ``E v' = closed_matrix(K) v`` and, optionally, condition numbers."""
+    A = d.closed_matrix(K)
+    if not condition:
+        return sl.eigvals(A, d.E), None
+    lam, Vl, Vr = sl.eig(A, d.E, left=True, right=True)
+    EVr = d.E @ Vr
+    num = np.sqrt(np.abs(np.einsum("ij,ij->j", Vr.conj(), EVr)))
+    num *= np.sqrt(np.abs(np.einsum("ij,ij->j", Vl.conj(), np.linalg.solve(d.E, Vl))))
+    den = np.abs(np.einsum("ij,ij->j", Vl.conj(), EVr))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        kappa = np.where(den > 0, num / den, np.inf)
+    return lam, kappa
+
+
+def match_resolved(
+    fine: np.ndarray, coarse: np.ndarray, rtol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Indices of ``fine`` eigenvalues resolved against ``coarse`` and their drifts.
+
+    An eigenvalue is kept when its nearest coarse eigenvalue is within
+    ``rtol * max(1, |λ|)`` and the nearest-neighbour pairing is mutual.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> idx, drift = match_resolved(np.array([-1 + 1j, 50j]), np.array([-1 + 1j, 20j]), 1e-8)
+    >>> idx.tolist()
+    [0]
+    """
+    fine = np.asarray(fine)
+    coarse = np.asarray(coarse)
+    finite_f = np.isfinite(fine)
+    finite_c = np.isfinite(coarse)
+    if not finite_f.any() or not finite_c.any():
+        return np.array([], dtype=int), np.array([])
+    f_idx = np.flatnonzero(finite_f)
+    c = coarse[finite_c]
+    dist = np.abs(fine[f_idx][:, None] - c[None, :])
+    nearest_c = np.argmin(dist, axis=1)
+    nearest_f = np.argmin(dist, axis=0)
+    drift = dist[np.arange(f_idx.size), nearest_c]
+    mutual = nearest_f[nearest_c] == np.arange(f_idx.size)
+    scale = np.maximum(1.0, np.abs(fine[f_idx]))
+    keep = mutual & (drift <= rtol * scale)
+    return f_idx[keep], drift[keep] / scale[keep]
+
+
+def in_band_unresolved(fine: np.ndarray, tight: np.ndarray) -> np.ndarray:
+    """Indices of unresolved ``fine`` eigenvalues inside the resolved frequency band.
+
+    The band is |λ| ≤ max |λ| over the resolved ones.  Unresolved eigenvalues above it
+    are the high-frequency artefacts of the semi-discretization (discarded); inside it
+    they are genuine but ill-conditioned eigenvalues (a cluster near a coalescence
+    moves by O((eps κ)^(1/m)) between resolutions), and they are never dropped.
+    """
+    fine = np.asarray(fine)
+    if tight.size == 0:
+        return np.array([], dtype=int)
+    band = np.max(np.abs(fine[tight]))
+    rest = np.setdiff1d(np.flatnonzero(np.isfinite(fine)), tight)
+    return rest[np.abs(fine[rest]) <= band]
+
+
+def resolved_abscissa(fine: np.ndarray, coarse: np.ndarray, rtol: float = 1e-6) -> float | None:
+    """Max real part over the resolved and the in-band unresolved eigenvalues, or None."""
+    idx, _ = match_resolved(fine, coarse, rtol)
+    if idx.size == 0:
+        return None
+    both = np.concatenate([idx, in_band_unresolved(fine, idx)]).astype(int)
+    return float(np.max(fine[both].real))
+
+
+def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
+    """Starting and maximal resolution for ``method`` (degree or nodes per group)."""
+    if method == "fd":
+        return 70, 240
+    # p^(2N) eps must stay small: cap the degree harder for high orders.
+    cap = {1: 160, 2: 110}.get(nm.order, 60)
+    return 20, cap
+
+
+def _rightmost(lam: np.ndarray, count: int) -> np.ndarray:
+    order = np.lexsort((np.abs(lam.imag), -np.round(lam.real, 12)))
+    return lam[order][:count]
+
+
+def spectrum(
+    nm: NumericModel,
+    C_m: np.ndarray | None = None,
+    L: np.ndarray | None = None,
+    *,
+    method: str = "galerkin",
+    resolution: int | None = None,
+    max_resolution: int | None = None,
+    tol: float | None = None,
+    rtol_resolved: float | None = None,
+    count: int = 6,
+) -> SpectrumReport:
+    """Converged spectral abscissa and rightmost eigenvalues.
+
+    Parameters
+    ----------
+    nm : NumericModel
+    C_m, L : ndarray, optional
+        Sensors and gain; when given the error system (ũ = −C_mᵀ L C_m ỹ) is analysed,
+        otherwise the closed plant with u = 0.
+    method : {"galerkin", "fd"}
+    resolution, max_resolution : int, optional
+        First and largest resolution (degree or nodes per group).
+    tol : float, optional
+        Required agreement of the abscissa (absolute, times max(1, |α|)); default 1e-10
+        for Galerkin, 1e-3 for the second-order finite differences.
+    rtol_resolved : float, optional
+        Relative drift under which an eigenvalue counts as resolved; default 1e-6 for
+        Galerkin, 1e-2 for finite differences.
+    count : int
+        How many rightmost eigenvalues to report.
+
+    Returns
+    -------
+    SpectrumReport
+    """
+    if (C_m is None) != (L is None):
+        raise NumericError("give both the sensors C_m and the gain L, or neither")
+    K = None if C_m is None else feedback_matrix(C_m, L, nm.n_ports)
+    if tol is None:
+        tol = 1e-10 if method == "galerkin" else 1e-3
+    if rtol_resolved is None:
+        rtol_resolved = 1e-6 if method == "galerkin" else 1e-2
+    p0, pmax = default_resolutions(nm, method)
+    p = int(resolution) if resolution is not None else p0
+    pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
+    system = "plant (u = 0)" if K is None else "observer error system"
+
+    def solve(res: int) -> np.ndarray:
+        return eigen(discretize(nm, method, res), K)[0]
+
+    history: list[dict[str, Any]] = []
+    coarse = solve(p)
+    prev_alpha: float | None = None
+    result: dict[str, Any] = {}
+    while True:
+        fine_res = math.ceil(1.5 * p)
+        d_fine = discretize(nm, method, fine_res)
+        fine, kappa = eigen(d_fine, K, condition=True)
+        idx, _drift = match_resolved(fine, coarse, rtol_resolved)
+        loose = in_band_unresolved(fine, idx)
+        n_tight = int(idx.size)
+        idx = np.concatenate([idx, loose]).astype(int)
+        entry: dict[str, Any] = {
+            "resolutions": [p, fine_res],
+            "n_resolved": n_tight,
+            "n_loose": int(loose.size),
+            "all_max_real": float(np.max(fine.real[np.isfinite(fine)])),
+        }
+        if idx.size:
+            res_lam = fine[idx]
+            j = int(np.argmax(res_lam.real))
+            alpha = float(res_lam.real[j])
+            # drift of the abscissa itself between the two resolutions
+            nearest = coarse[np.argmin(np.abs(coarse - res_lam[j]))]
+            d_alpha = abs(alpha - float(nearest.real))
+            entry.update({"spectral_abscissa": alpha, "abscissa_drift": d_alpha})
+            result = {
+                "lam": fine,
+                "kappa": kappa,
+                "idx": idx,
+                "n_tight": n_tight,
+                "loose": loose,
+                "alpha": alpha,
+                "d_alpha": d_alpha,
+                "res": (p, fine_res),
+                "prev_alpha": prev_alpha,
+            }
+            prev_alpha = alpha
+            if d_alpha <= tol * max(1.0, abs(alpha)):
+                history.append(entry)
+                break
+        history.append(entry)
+        if fine_res >= pmax:
+            break
+        p, coarse = fine_res, fine
+    if not result:
+        return SpectrumReport(
+            spectral_abscissa=None,
+            rightmost=[],
+            converged=False,
+            digits=None,
+            n_resolved=0,
+            n_total=int(fine.size),
+            resolutions=(p, fine_res),
+            method=method,
+            system=system,
+            unbounded_below=True,
+            all_eigenvalues_max_real=float(np.max(fine.real)),
+            history=history,
+            warnings=[
+                "no eigenvalue converges under refinement up to resolution "
+                f"{fine_res}: the spectrum is empty or runs off to -infinity "
+                "(finite-time extinction); the spectral abscissa is unbounded below"
+            ],
+        )
+    lam, kap, idx = result["lam"], result["kappa"], result["idx"]
+    loose_set = set(int(i) for i in result["loose"])
+    alpha, d_alpha = result["alpha"], result["d_alpha"]
+    res_lam, res_kap = lam[idx], kap[idx]
+    order = np.lexsort((np.abs(res_lam.imag), -np.round(res_lam.real, 12)))
+    top = order[:count]
+    rightmost = [complex(z) for z in res_lam[top]]
+    conds = [float(c) for c in res_kap[top]]
+    converged = bool(d_alpha <= tol * max(1.0, abs(alpha)))
+    digits = float(-np.log10(max(d_alpha, 1e-17) / max(1.0, abs(alpha))))
+    warnings: list[str] = []
+    # Rightmost eigenvalue conditioning and neighbour gap (coalescence detector).
+    lead = res_lam[top[0]]
+    others = lam[np.abs(lam - lead) > 0]
+    gap = float(np.min(np.abs(others - lead))) / max(1.0, abs(lead)) if others.size else np.inf
+    lead_loose = int(idx[top[0]]) in loose_set
+    ill = bool(conds[0] > 1e4 or gap < 1e-3 or lead_loose)
+    if ill:
+        warnings.append(
+            f"the rightmost eigenvalue {lead:.6g} is ill-conditioned (condition number "
+            f"{conds[0]:.3g}, relative gap to its nearest neighbour {gap:.2g}): near a "
+            "coalescence of eigenvalues (e.g. a critically damped gain); few digits are reliable"
+        )
+    # Never drop the rightmost silently: unresolved eigenvalues to the right.
+    unresolved = np.setdiff1d(np.arange(lam.size), idx)
+    right_unres = unresolved[lam.real[unresolved] > alpha + 1e-9 * max(1.0, abs(alpha))]
+    if right_unres.size:
+        low = right_unres[np.abs(lam[right_unres]) <= np.max(np.abs(res_lam))]
+        warnings.append(
+            f"{right_unres.size} unresolved eigenvalues lie to the right of the abscissa (max Re "
+            f"{float(np.max(lam.real[right_unres])):.3g}); {low.size} of them within the "
+            "resolved frequency band"
+            + (": check them" if low.size else " (unresolved high frequencies, discarded)")
+        )
+    if not converged:
+        warnings.append(
+            f"the spectral abscissa did not converge to {tol:g}: it drifts by {d_alpha:.2g} "
+            f"between resolutions {result['res'][0]} and {result['res'][1]}"
+        )
+    return SpectrumReport(
+        spectral_abscissa=alpha,
+        rightmost=rightmost,
+        converged=converged,
+        digits=digits,
+        n_resolved=int(result["n_tight"]),
+        n_total=int(lam.size),
+        resolutions=tuple(result["res"]),
+        method=method,
+        system=system,
+        unbounded_below=False,
+        ill_conditioned=ill,
+        condition_numbers=conds,
+        all_eigenvalues_max_real=float(np.max(lam.real)),
+        history=history,
+        warnings=warnings,
+    )
