@@ -374,7 +374,8 @@ def plot_spectrum(
     eigenvalues : array of complex
         The eigenvalues at the finer resolution.
     resolved : array of bool or of int, optional
-        Mask (or indices) of the resolved eigenvalues; default: all resolved.
+        Mask (or indices) of the resolved eigenvalues; default: no distinction is
+        made and every eigenvalue is drawn as a blue dot labelled "eigenvalues".
     ax : Axes, optional
     abscissa : float, optional
         Drawn as a vertical dashed line.
@@ -409,7 +410,7 @@ def plot_spectrum(
         ls="none",
         marker="o",
         color="tab:blue",
-        label="resolved (agree at two resolutions)",
+        label="eigenvalues" if resolved is None else "resolved (agree at two resolutions)",
     )
     if not mask.all():
         ax.plot(
