@@ -19,8 +19,8 @@ from phdesign.symbolic.observer import (
     sensor_matrix,
     vanishes,
 )
+from phdesign.symbolic.ports import trace_index
 from phdesign.symbolic.ports import trace_index as ports_trace_index
-from phdesign.symbolic.propositions import trace_index
 
 
 @pytest.fixture(scope="module")

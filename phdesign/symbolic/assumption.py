@@ -40,6 +40,8 @@ from itertools import combinations
 
 import sympy
 
+from phdesign.symbolic.expressions import vanishes
+
 __all__ = ["AssumptionCheck", "Partition", "check_assumption"]
 
 #: Beyond this size the subset search (C(n, n/2) subsets) is not attempted.
@@ -109,10 +111,7 @@ class AssumptionCheck:
 
 
 def _is_zero(expr: sympy.Expr) -> bool:
-    # Structural zero first (fast); otherwise simplify: an entry must vanish
-    # identically (in z and in the parameters), not only at the default values.
-    from phdesign.symbolic.observer import vanishes
-
+    # An entry must vanish identically (in z and in the parameters), not only at the defaults.
     return vanishes(expr)
 
 

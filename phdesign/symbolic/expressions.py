@@ -53,6 +53,7 @@ __all__ = [
     "parse_trace_expression",
     "trace_of",
     "trace_symbol",
+    "vanishes",
 ]
 
 Side = Literal["a", "b"]
@@ -195,13 +196,35 @@ def exact_number(value: object, what: str) -> sympy.Expr:
 
 
 def canonical(expr: sympy.Expr) -> sympy.Expr:
-    """Simplify an exact expression, cheaply when it is a number or expands to zero."""
+    """Return ``cancel(expand(expr))``, far cheaper than :func:`sympy.simplify`.
+
+    It is canonical for rational functions of the parameters with algebraic coefficients.
+    """
     if expr.is_Number:
         return expr
-    expanded = sympy.expand(expr)
-    if expanded.is_Number:
-        return expanded
-    return sympy.simplify(expanded)
+    return sympy.cancel(sympy.expand(expr))
+
+
+def vanishes(expr: object) -> bool:
+    """Decide exactly whether ``expr`` is identically zero, cheaply when possible.
+
+    Rational functions (of gains or parameters) and algebraic numbers are settled by
+    :func:`canonical`; :func:`sympy.simplify` is the last resort, for transcendental
+    entries (it is slow, and imports ``sympy.physics`` on first use).
+    """
+    e = sympy.sympify(expr)
+    if e == 0:
+        return True
+    if e.is_Number:
+        return False
+    e = canonical(e)
+    if e == 0:
+        return True
+    if e.is_number and e.is_zero is not None:
+        return bool(e.is_zero)
+    if e.is_rational_function():
+        return False
+    return bool(sympy.simplify(e) == 0)
 
 
 def exactify(expr: sympy.Expr) -> sympy.Expr:

@@ -44,6 +44,7 @@ from phdesign.symbolic.expressions import (
     parse_scalar,
     parse_trace_expression,
     trace_of,
+    vanishes,
 )
 
 __all__ = ["BCPHS", "Displacement", "Z"]
@@ -350,7 +351,7 @@ def _validate(model: BCPHS) -> list[str]:
     for k in range(1, N + 1):
         sign = (-1) ** (k - 1)
         residual = (model.P[k].T - sign * model.P[k]).applyfunc(canonical)
-        if not residual.is_zero_matrix:
+        if not all(vanishes(x) for x in residual):
             relation = f"P{k}^T = P{k}" if sign == 1 else f"P{k}^T = -P{k}"
             raise ModelError(
                 f"P{k} must satisfy {relation} (k = {k}); found P{k}^T - ({sign})*P{k} = "
@@ -360,7 +361,7 @@ def _validate(model: BCPHS) -> list[str]:
     checks.append(_check_semidefinite(model.P[0] + model.P[0].T, defaults))
     checks.append(_check_invertible(model.P[N], f"P{N}", defaults))
     residual = (model.H - model.H.T).applyfunc(canonical)
-    if not residual.is_zero_matrix:
+    if not all(vanishes(x) for x in residual):
         raise ModelError(f"H must be symmetric; found H - H^T = {residual.tolist()}")
     checks.append(_check_positive_definite(model.H, model.interval, defaults))
     if model.displacement is not None:
@@ -443,11 +444,11 @@ def _check_semidefinite(S: sympy.MatrixBase, defaults: Mapping[sympy.Symbol, sym
 def _check_invertible(
     P: sympy.MatrixBase, name: str, defaults: Mapping[sympy.Symbol, sympy.Expr]
 ) -> str:
-    det = sympy.simplify(P.det())
+    det = canonical(P.det())
     if det == 0:
         raise ModelError(f"{name} must be invertible; found det({name}) = 0")
     if det.free_symbols:
-        value = sympy.simplify(det.xreplace(dict(defaults)))
+        value = canonical(det.xreplace(dict(defaults)))
         if value == 0:
             raise ModelError(
                 f"{name} must be invertible; found det({name}) = 0 at the parameter defaults"

@@ -57,7 +57,7 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.errors import ExpressionError, ObserverError, check_shape
-from phdesign.symbolic.expressions import exact_number
+from phdesign.symbolic.expressions import exact_number, vanishes
 from phdesign.symbolic.model import BCPHS
 
 __all__ = [
@@ -72,28 +72,6 @@ __all__ = [
     "sensor_matrix",
     "vanishes",
 ]
-
-
-def vanishes(expr: object) -> bool:
-    """Decide exactly whether ``expr`` is identically zero, cheaply when possible.
-
-    Rational functions (in the gains or parameters) and algebraic numbers are
-    settled by ``cancel(expand(.))``; :func:`sympy.simplify` is the last resort
-    (it is slow, and drags in ``sympy.physics`` on first use).
-    """
-    e = sympy.sympify(expr)
-    if e == 0:
-        return True
-    if e.is_Number:
-        return False
-    e = sympy.cancel(sympy.expand(e))
-    if e == 0:
-        return True
-    if e.is_number and e.is_zero is not None:
-        return bool(e.is_zero)
-    if e.is_rational_function():
-        return False
-    return bool(sympy.simplify(e) == 0)
 
 
 # --------------------------------------------------------------------------- sensors

@@ -52,7 +52,13 @@ from typing import TYPE_CHECKING
 import sympy
 
 from phdesign.errors import PortError
-from phdesign.symbolic.expressions import Trace, canonical, linear_coefficients, trace_symbol
+from phdesign.symbolic.expressions import (
+    Trace,
+    canonical,
+    linear_coefficients,
+    trace_symbol,
+    vanishes,
+)
 
 if TYPE_CHECKING:
     from phdesign.symbolic.model import BCPHS
@@ -206,7 +212,7 @@ def derive_ports(model: BCPHS) -> Ports:
     Y = coefficient_matrix(model.outputs, N, n, "outputs")
     defaults = model.parameter_defaults
     for name, M in (("inputs", U), ("outputs", Y)):
-        rank = M.xreplace(defaults).rank(simplify=True)
+        rank = M.xreplace(defaults).rank(iszerofunc=vanishes)
         if rank != N * n:
             raise PortError(
                 f"the {name} are linearly dependent: rank of "
@@ -231,7 +237,7 @@ def derive_ports(model: BCPHS) -> Ports:
         residual = residuals[key].applyfunc(canonical)
         largest = _max_abs(residual, defaults)
         identities[key] = largest
-        if not residual.is_zero_matrix:
+        if not all(vanishes(x) for x in residual):
             at = " at the parameter defaults" if residual.free_symbols else ""
             raise PortError(
                 f"port identity {statements[key]} fails: largest residual |entry| = "

@@ -48,6 +48,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from phdesign.symbolic.expressions import Trace
+from phdesign.symbolic.ports import trace_index
 
 __all__ = [
     "PROPOSITIONS",
@@ -55,7 +56,6 @@ __all__ = [
     "TraceGroup",
     "Variant",
     "applicable_variants",
-    "trace_index",
 ]
 
 Side = Literal["a", "b"]
@@ -68,21 +68,6 @@ PROPOSITIONS: dict[str, str] = {
     "3.3": "exponential",
     "3.4": "exponential",
 }
-
-
-def trace_index(component: int, derivative: int, side: str, order: int, size: int) -> int:
-    r"""Return the 0-based index of :math:`e_i^{(k)}(\text{side})` in the trace vector.
-
-    The ordering is fixed by the API contract: :math:`v = (\phi(b); \phi(a))` with
-    :math:`\phi = (e, e', \dots, e^{(N-1)})`, so the index is
-    ``(0 if side == "b" else N n) + k n + (i - 1)``.
-
-    Examples
-    --------
-    >>> trace_index(2, 0, "a", order=2, size=2)
-    5
-    """
-    return (0 if side == "b" else order * size) + derivative * size + (component - 1)
 
 
 @dataclass(frozen=True)
