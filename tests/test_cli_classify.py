@@ -107,7 +107,10 @@ def test_all_sensors(capsys):
         (["wave", "--cm", "[[1, 0, 0]]"], "expected (q, 2) but found (1, 3)"),
         (["wave"], "classify needs --sensors, --cm or --all-sensors"),
         (["wave", "--all-sensors", "--sensors", "1"], "drop --sensors/--cm"),
-        (["wave", "--all-sensors", "--gain", "1,2,3"], "expected 1 or 2 diagonal values"),
+        (
+            ["wave", "--all-sensors", "--gain", "1,2,3"],
+            "expected 2 diagonal values (one per output) or a single one",
+        ),
         (["no-such-model", "--sensors", "1"], "unknown model"),
         (["wave", "--sensors", "1", "--cm", "[[1,0]]"], "not allowed with argument"),
     ],

@@ -163,7 +163,10 @@ def test_minimal_sets_definition_on_synthetic_model():
 
 
 def test_gain_checks(beam):
-    with pytest.raises(ObserverError, match=r"expected 1 or 4 diagonal values .* found 2"):
+    with pytest.raises(
+        ObserverError,
+        match=r"expected 4 diagonal values \(one per output\) or a single one; found 2",
+    ):
         search_sensors(beam, gain="1,2")
     with pytest.raises(ObserverError, match=r"output 2 must be > 0"):
         search_sensors(beam, gain="1,-2,1,1")

@@ -63,6 +63,7 @@ from phdesign.symbolic.model import BCPHS
 __all__ = [
     "ErrorSystem",
     "ObserverDesign",
+    "diagonal_values",
     "error_system",
     "gain_symbols",
     "parse_cm",
@@ -159,6 +160,33 @@ def parse_cm(text: str, n_outputs: int) -> sympy.ImmutableMatrix:
     return C_m
 
 
+def diagonal_values(entries: Sequence[object], count: int, meaning: str) -> list[sympy.Expr]:
+    """Read diagonal gain entries exactly; a single entry is used ``count`` times.
+
+    Raises
+    ------
+    ObserverError
+        If an entry is not a finite number, or there are neither 1 nor ``count`` entries.
+    """
+    for i, part in enumerate(entries):
+        if str(part).lower().lstrip("+-") in ("nan", "inf", "infinity"):
+            raise ObserverError(
+                f"--gain: entry {i + 1} must be a finite positive number; found {part!r}"
+            )
+    try:
+        values = [exact_number(p, f"--gain entry {p!r}") for p in entries]
+    except ExpressionError as error:
+        raise ObserverError(f"--gain: {error}") from None
+    if len(values) == 1:
+        values = values * count
+    if len(values) != count:
+        raise ObserverError(
+            f"--gain: expected {count} diagonal values ({meaning}) or a single one; "
+            f"found {len(values)}"
+        )
+    return values
+
+
 @lru_cache(maxsize=64)
 def gain_symbols(q: int) -> tuple[sympy.Symbol, ...]:
     """Return the positive symbols ``l1 .. lq`` used for symbolic gains."""
@@ -183,23 +211,7 @@ def parse_gain(text: str, q: int) -> sympy.ImmutableMatrix:
                 f"(one row and column per sensor) but found {L.shape}"
             )
         return L
-    parts = [p.strip() for p in text.split(",")]
-    for i, part in enumerate(parts):
-        if part.lower().lstrip("+-") in ("nan", "inf", "infinity"):
-            raise ObserverError(
-                f"--gain: entry {i + 1} must be a finite positive number; found {part!r}"
-            )
-    try:
-        values = [exact_number(p, f"--gain entry {p!r}") for p in parts]
-    except ExpressionError as error:
-        raise ObserverError(f"--gain: {error}") from None
-    if len(values) == 1:
-        values = values * q
-    if len(values) != q:
-        raise ObserverError(
-            f"--gain: expected {q} diagonal values (one per sensor) or a single one; "
-            f"found {len(values)} in {text!r}"
-        )
+    values = diagonal_values([p.strip() for p in text.split(",")], q, "one per sensor")
     return sympy.ImmutableMatrix(sympy.diag(*values))
 
 

@@ -41,9 +41,8 @@ import sympy
 
 from phdesign.errors import ObserverError
 from phdesign.symbolic.assumption import Partition, check_assumption
-from phdesign.symbolic.expressions import exact_number
 from phdesign.symbolic.model import BCPHS
-from phdesign.symbolic.observer import _inverse, port_matrices, vanishes
+from phdesign.symbolic.observer import _inverse, diagonal_values, port_matrices, vanishes
 from phdesign.symbolic.propositions import VARIANTS, Variant
 
 __all__ = ["Candidate", "SensorSearch", "SubsetResult", "candidates", "search_sensors"]
@@ -220,17 +219,7 @@ def _gain_vector(gain: Any, nn: int) -> tuple[sympy.Expr, ...] | None:
             )
         gain = [p.strip() for p in text.split(",")]
     values = list(gain) if isinstance(gain, Sequence) else [gain]
-    try:
-        exact = [exact_number(v, "gain") for v in values]
-    except ValueError as error:
-        raise ObserverError(f"--gain: {error}") from None
-    if len(exact) == 1:
-        exact = exact * nn
-    if len(exact) != nn:
-        raise ObserverError(
-            f"--gain with --all-sensors: expected 1 or {nn} diagonal values (one per output); "
-            f"found {len(exact)}"
-        )
+    exact = diagonal_values(values, nn, "one per output")
     for i, value in enumerate(exact):
         if not value.is_positive:
             raise ObserverError(
