@@ -527,8 +527,10 @@ def plot_gain_map(
             f"found {a.shape}"
         )
     fig, ax = _axes(ax, figsize=(6.2, 4.8))
-    mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(a), shading="nearest", cmap="viridis")
-    mesh.cmap.set_bad("0.8")
+    from matplotlib import colormaps
+
+    cmap = colormaps["viridis"].with_extremes(bad="0.8")  # unresolved cells in grey
+    mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(a), shading="nearest", cmap=cmap)
     fig.colorbar(mesh, ax=ax, label=ABSCISSA_LABEL)
     if designs:
         for label, (g1, g2) in designs.items():
