@@ -364,7 +364,7 @@ def initial_state_function(
         elif key in efforts:
             this, idx = "e", efforts[key]
         else:
-            known = ", ".join([*nm.state_names, *efforts])
+            known = ", ".join([*nm.state_names, *(f"x{i + 1}" for i in range(n)), *efforts])
             raise ParameterError(
                 f"initial state: unknown component {key!r}; expected one of {known}"
             )
