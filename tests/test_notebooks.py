@@ -1,0 +1,81 @@
+"""Execute every design notebook headless, as CI does on a clean machine.
+
+Each ``notebooks/*.py`` (jupytext percent format) is read with jupytext and executed with
+nbclient in a Jupyter kernel that runs *this* interpreter (a kernel spec written to a
+temporary folder, so the test never depends on which ``python3`` kernel happens to be
+installed). Any error in any cell fails the test, and so does an ``assert`` of a number
+the notebook discusses. Budget: all notebooks together within 5 minutes (issue 6).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+jupytext = pytest.importorskip("jupytext", reason="install the notebooks extra")
+nbclient = pytest.importorskip("nbclient", reason="install the notebooks extra")
+pytest.importorskip("ipykernel", reason="install the notebooks extra")
+
+NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
+PATHS = sorted(NOTEBOOKS.glob("[0-9][0-9]_*.py"))
+KERNEL = "phdesign-notebook-test"
+TOTAL_BUDGET = 300.0  # seconds, all notebooks together (issue 6)
+PER_CELL_TIMEOUT = 240  # seconds; a single cell over this is a hang, not slowness
+DURATIONS: dict[str, float] = {}
+
+
+@pytest.fixture(scope="module")
+def kernel_name(tmp_path_factory: pytest.TempPathFactory) -> str:
+    """A kernel spec for the running interpreter, found through JUPYTER_PATH."""
+    root = tmp_path_factory.mktemp("jupyter")
+    spec = root / "kernels" / KERNEL
+    spec.mkdir(parents=True)
+    argv = [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"]
+    spec.joinpath("kernel.json").write_text(
+        json.dumps({"argv": argv, "display_name": "phdesign tests", "language": "python"})
+    )
+    mp = pytest.MonkeyPatch()
+    mp.setenv("JUPYTER_PATH", str(root))
+    yield KERNEL
+    mp.undo()
+
+
+def test_there_are_four_notebooks():
+    assert [p.stem for p in PATHS] == [
+        "01_quickstart",
+        "02_euler_bernoulli_paper",
+        "03_wave_and_timoshenko",
+        "04_higher_order",
+    ]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", PATHS, ids=[p.stem for p in PATHS])
+def test_notebook_runs_without_error(path: Path, kernel_name: str):
+    notebook = jupytext.read(path)
+    assert any(c.cell_type == "markdown" for c in notebook.cells), "a notebook tells a story"
+    client = nbclient.NotebookClient(
+        notebook,
+        kernel_name=kernel_name,
+        timeout=PER_CELL_TIMEOUT,
+        resources={"metadata": {"path": str(NOTEBOOKS)}},
+    )
+    start = time.perf_counter()
+    client.execute()  # raises CellExecutionError, naming the cell, on any error
+    DURATIONS[path.stem] = time.perf_counter() - start
+    outputs = [o for c in notebook.cells if c.cell_type == "code" for o in c.get("outputs", [])]
+    assert not [o for o in outputs if o.get("output_type") == "error"]
+    print(f"{path.stem}: {DURATIONS[path.stem]:.1f} s")
+
+
+@pytest.mark.slow
+def test_all_notebooks_within_the_time_budget():
+    if set(DURATIONS) != {p.stem for p in PATHS}:
+        pytest.skip("runs after every notebook has been executed in this session")
+    total = sum(DURATIONS.values())
+    detail = ", ".join(f"{k} {v:.1f} s" for k, v in DURATIONS.items())
+    assert total <= TOTAL_BUDGET, f"notebooks took {total:.0f} s > {TOTAL_BUDGET:.0f} s: {detail}"
