@@ -52,6 +52,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.figure import Figure
 
 __all__ = [
+    "new_figure",
     "plot_abscissa_sweep",
     "plot_deflection",
     "plot_deflection_panels",
@@ -88,8 +89,19 @@ def _in_jupyter_kernel() -> bool:
     return "ipykernel" in sys.modules
 
 
-def _new_figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
-    """Return ``(fig, axes)`` as ``subplots`` does, on an Agg canvas outside Jupyter."""
+def new_figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
+    """Return ``(fig, axes)`` as ``pyplot.subplots`` does, to compose panels.
+
+    Outside Jupyter the figure lives on an Agg canvas (no display, no pyplot state);
+    inside a Jupyter kernel it is made by pyplot so that the inline backend shows it.
+    Keyword arguments go to the figure (``figsize``, ``dpi``); the layout is constrained.
+
+    Examples
+    --------
+    >>> fig, axes = new_figure(1, 2, figsize=(8, 3))
+    >>> plot_spectrum(np.array([-1.0 + 1j]), ax=axes[0]) is fig
+    True
+    """
     if _in_jupyter_kernel():
         import matplotlib.pyplot as plt
 
@@ -107,7 +119,7 @@ def _new_figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, 
 def _axes(ax: Axes | None, **kwargs: Any) -> tuple[Figure, Axes]:
     if ax is not None:
         return ax.get_figure(), ax
-    fig, new = _new_figure(**kwargs)
+    fig, new = new_figure(**kwargs)
     return fig, new
 
 
@@ -153,7 +165,7 @@ def plot_hamiltonians(result: Any, axes: Sequence[Axes] | None = None) -> Figure
     t = _require(result, "t", "no time grid")
     H = _require(result, "H", "no plant energy")
     if axes is None:
-        fig, (ax_lin, ax_log) = _new_figure(1, 2, figsize=(10, 3.8))
+        fig, (ax_lin, ax_log) = new_figure(1, 2, figsize=(10, 3.8))
     else:
         ax_lin, ax_log = axes
         fig = ax_lin.get_figure()
@@ -309,7 +321,7 @@ def plot_deflection_panels(result: Any) -> Figure:
     """
     w = _field(result, "w")
     w_hat = _field(result, "w_hat")
-    fig, axes = _new_figure(2, 2, figsize=(11, 7))
+    fig, axes = new_figure(2, 2, figsize=(11, 7))
     shared = float(max(np.max(np.abs(w)), np.max(np.abs(w_hat)))) or 1.0
     plot_deflection(result, "w", axes[0, 0], vmax=shared)
     plot_deflection(result, "w_hat", axes[0, 1], vmax=shared)
@@ -591,7 +603,7 @@ def plot_simulation(
                 f"output file {str(path)!r} exists; pass --force to overwrite it"
             )
     has_w = getattr(result, "w", None) is not None
-    fig, axes = _new_figure(2 if has_w else 1, 2, figsize=(11, 7.5 if has_w else 3.8))
+    fig, axes = new_figure(2 if has_w else 1, 2, figsize=(11, 7.5 if has_w else 3.8))
     top = axes[0] if has_w else axes
     plot_hamiltonians(result, top)
     if has_w:

@@ -75,7 +75,7 @@ def test_hamiltonians_without_observer_draw_only_the_plant():
 
 
 def test_hamiltonians_draw_on_given_axes():
-    fig0, axes = plots._new_figure(1, 2)
+    fig0, axes = plots.new_figure(1, 2)
     fig = plots.plot_hamiltonians(make_result(), axes)
     assert fig is fig0
     assert len(axes[0].get_lines()) == 3
