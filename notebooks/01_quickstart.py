@@ -33,7 +33,8 @@ import numpy as np
 from phdesign import plots
 from phdesign.io import model_from_toml, model_to_toml
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretize import discretize, feedback_matrix
+from phdesign.numeric.discretize import discretize
+from phdesign.numeric.export import error_statespace, observer_statespace, plant_statespace
 from phdesign.numeric.spectrum import spectrum
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.model import BCPHS
@@ -163,16 +164,20 @@ assert report.spectral_abscissa < wkb
 # %% [markdown]
 # ## Export to python-control
 #
-# The discretized error system $E \dot{\tilde e} = (J - R - B K B^\top) \tilde e$,
-# $K = C_m^\top L C_m$, as a `control.StateSpace` (inputs and outputs: the boundary ports).
+# Plant, observer and error system of the discretization, as `control.StateSpace`
+# objects. The observer takes $(u, y_m)$ and returns $(\hat y, \hat e)$; the error system
+# $E \dot{\tilde e} = (J - R - B K B^\top) \tilde e$, $K = C_m^\top L C_m$, has no input.
 # Its poles contain the resolved eigenvalues above.
 
 # %%
 d = discretize(nm, "galerkin", report.resolutions[1])
-K = feedback_matrix(C, L, nm.n_ports)
-error_ss = control.ss(d.standard_form(K), np.linalg.solve(d.E, d.B), d.B.T, d.D)
+plant_ss = plant_statespace(d)
+observer_ss = observer_statespace(d, C, L)
+error_ss = error_statespace(d, C, L)
+for sys_ in (plant_ss, observer_ss, error_ss):
+    print(f"{sys_.name:9}: {sys_.nstates} states, {sys_.ninputs} inputs, {sys_.noutputs} outputs")
+assert isinstance(error_ss, control.StateSpace)
 poles = control.poles(error_ss)
-print(error_ss.nstates, "states;", error_ss.ninputs, "inputs;", error_ss.noutputs, "outputs")
 nearest = min(abs(poles - report.rightmost[0]))
 print(f"distance from the rightmost resolved eigenvalue to the nearest pole: {nearest:.1e}")
 assert nearest < 1e-8
