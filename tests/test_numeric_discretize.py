@@ -75,7 +75,9 @@ def test_fd_refuses_unsupported_models():
 def _cantilever_betas(count):
     # Clamped-free Euler-Bernoulli beam: cos(b) cosh(b) = -1 (classical, e.g. Meirovitch).
     f = lambda b: np.cos(b) * np.cosh(b) + 1.0  # noqa: E731
-    return np.array([brentq(f, (k + 0.5) * np.pi - 1.0, (k + 0.5) * np.pi + 1.0) for k in range(count)])
+    return np.array(
+        [brentq(f, (k + 0.5) * np.pi - 1.0, (k + 0.5) * np.pi + 1.0) for k in range(count)]
+    )
 
 
 def test_cantilever_roots_match_the_tabulated_values():

@@ -32,8 +32,16 @@ def test_initial_energy_and_tip_deflection_of_the_paper_initial_state():
     # Galerkin holds the polynomial exactly; FD uses nodal values (second order).
     nm, x0 = _paper_x0()
     for method, res, tol in (("galerkin", 20, 1e-13), ("fd", 70, 1e-3)):
-        r = simulate(nm, PAPER_SENSORS, np.diag([0.1, 1]), x0=x0, t_end=0.1, samples=2,
-                     method=method, resolution=res)
+        r = simulate(
+            nm,
+            PAPER_SENSORS,
+            np.diag([0.1, 1]),
+            x0=x0,
+            t_end=0.1,
+            samples=2,
+            method=method,
+            resolution=res,
+        )
         assert abs(r.H[0] - 0.73 / 6) < tol
         assert abs(r.H_err[0] - r.H[0]) < 1e-15  # observer starts from zero
         assert abs(r.w[0, -1] + 0.85 / 3) < tol
@@ -50,8 +58,9 @@ def test_table_I_decay_times_agree_between_fd140_and_galerkin(l1, l2):
     L = np.diag([l1, l2])
     times = {}
     for method, res in (("fd", 70), ("galerkin", 45)):
-        r = simulate(nm, PAPER_SENSORS, L, x0=x0, t_end=8.0, samples=1601, method=method,
-                     resolution=res)
+        r = simulate(
+            nm, PAPER_SENSORS, L, x0=x0, t_end=8.0, samples=1601, method=method, resolution=res
+        )
         assert r.info["states"] == (140 if method == "fd" else 92)
         # H_err decays: every 1 s window ends lower than it starts
         idx = np.searchsorted(r.t, np.arange(0.0, 8.0, 1.0))
@@ -120,12 +129,14 @@ def test_exported_statespace_reproduces_the_simulation(method, res):
     assert P.input_labels == ["u1", "u2", "u3", "u4"]
     assert O.input_labels == ["u1", "u2", "u3", "u4", "y_m1", "y_m2"]
     assert O.output_labels[:4] == ["y_hat1", "y_hat2", "y_hat3", "y_hat4"]
-    S = control.ss([], [], [], PAPER_SENSORS, inputs=P.output_labels,
-                   outputs=["y_m1", "y_m2"], name="sensors")
+    S = control.ss(
+        [], [], [], PAPER_SENSORS, inputs=P.output_labels, outputs=["y_m1", "y_m2"], name="sensors"
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # unused observer state outputs
-        loop = control.interconnect([P, S, O], inplist=P.input_labels,
-                                    outlist=O.output_labels[:4] + P.output_labels)
+        loop = control.interconnect(
+            [P, S, O], inplist=P.input_labels, outlist=O.output_labels[:4] + P.output_labels
+        )
     X0 = np.concatenate([d.project(x0), np.zeros(d.dim)])
     fr = control.forced_response(loop, T=r.t, U=np.zeros((4, r.t.size)), X0=X0)
     scale = np.abs(r.y).max()
@@ -138,8 +149,7 @@ def test_exported_statespace_reproduces_the_simulation(method, res):
 
 def test_csv_and_json_formats():
     nm, x0 = _paper_x0()
-    r = simulate(nm, PAPER_SENSORS, np.diag([0.1, 1]), x0=x0, t_end=0.5, samples=6,
-                 resolution=12)
+    r = simulate(nm, PAPER_SENSORS, np.diag([0.1, 1]), x0=x0, t_end=0.5, samples=6, resolution=12)
     rows = list(csv.reader(io.StringIO(r.to_csv())))
     assert rows[0][:4] == ["t", "H", "H_hat", "H_err"]
     assert rows[0][-2:] == ["w_tip", "w_hat_tip"]

@@ -182,7 +182,7 @@ def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
     if method == "fd":
         return 70, 240
     # p^(2N) eps must stay small: cap the degree harder for high orders.
-    cap = {1: 160, 2: 110}.get(nm.order, 60)
+    cap = {1: 100, 2: 110}.get(nm.order, 60)
     return 20, cap
 
 
