@@ -86,7 +86,10 @@ _FIELDS = {
 
 # ----------------------------------------------------------------------------- figures
 def _in_jupyter_kernel() -> bool:
-    return "ipykernel" in sys.modules
+    """Tell whether this runs inside a Jupyter kernel (not merely with ipykernel imported)."""
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    return type(shell).__name__ == "ZMQInteractiveShell"
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:

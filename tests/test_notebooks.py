@@ -69,6 +69,8 @@ def test_notebook_runs_without_error(path: Path, kernel_name: str):
     DURATIONS[path.stem] = time.perf_counter() - start
     outputs = [o for c in notebook.cells if c.cell_type == "code" for o in c.get("outputs", [])]
     assert not [o for o in outputs if o.get("output_type") == "error"]
+    # the figures are shown inline (plots made inside a kernel go through pyplot)
+    assert any("image/png" in o.get("data", {}) for o in outputs), "no figure was displayed"
     print(f"{path.stem}: {DURATIONS[path.stem]:.1f} s")
 
 
