@@ -52,6 +52,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.figure import Figure
 
 __all__ = [
+    "check_plot_path",
     "new_figure",
     "plot_abscissa_sweep",
     "plot_deflection",
@@ -565,6 +566,37 @@ def plot_gain_map(
 
 
 # ----------------------------------------------------------------------------- CLI entry
+def check_plot_path(path: str | os.PathLike[str], force: bool = False) -> str:
+    """Check an output image path before any work is done; return its format.
+
+    The format is the file suffix (``png``, ``pdf``, ``svg``, ...).
+
+    Raises
+    ------
+    OutputFileError
+        The file exists and ``force`` is false, or the suffix is not an image format
+        matplotlib can write.
+
+    Examples
+    --------
+    >>> check_plot_path("beam.PNG")
+    'png'
+    """
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    target = Path(path)
+    fmt = target.suffix.lstrip(".").lower()
+    supported = FigureCanvasBase.get_supported_filetypes()
+    if fmt not in supported:
+        raise OutputFileError(
+            f"plot file {str(target)!r}: unknown image format {fmt!r}; expected a suffix "
+            f"among {', '.join('.' + s for s in sorted(supported))}"
+        )
+    if target.exists() and not force:
+        raise OutputFileError(f"output file {str(target)!r} exists; pass --force to overwrite it")
+    return fmt
+
+
 def plot_simulation(
     result: Any,
     path: str | os.PathLike[str] | None = None,
@@ -598,13 +630,7 @@ def plot_simulation(
     OutputFileError
         The file exists (without ``force``), its format is unknown, or it cannot be written.
     """
-    fmt = None
-    if path is not None:
-        fmt = Path(path).suffix.lstrip(".").lower()
-        if Path(path).exists() and not force:
-            raise OutputFileError(
-                f"output file {str(path)!r} exists; pass --force to overwrite it"
-            )
+    fmt = None if path is None else check_plot_path(path, force=force)
     has_w = getattr(result, "w", None) is not None
     fig, axes = new_figure(2 if has_w else 1, 2, figsize=(11, 7.5 if has_w else 3.8))
     top = axes[0] if has_w else axes
@@ -616,12 +642,6 @@ def plot_simulation(
     if title:
         fig.suptitle(title)
     if path is not None:
-        supported = fig.canvas.get_supported_filetypes()
-        if fmt not in supported:
-            raise OutputFileError(
-                f"plot file {str(path)!r}: unknown image format {fmt!r}; expected a suffix "
-                f"among {', '.join('.' + s for s in sorted(supported))}"
-            )
         from phdesign.io import atomic_write
 
         buffer = io.BytesIO()

@@ -278,3 +278,23 @@ def test_importing_plots_does_not_import_matplotlib():
     code = "import sys, phdesign.plots; print('matplotlib' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize(
+    ("name", "exists", "force", "match"),
+    [
+        ("a.png", True, False, "exists; pass --force"),
+        ("a.txt", False, False, "unknown image format 'txt'"),
+        ("a", False, False, "unknown image format ''"),
+    ],
+)
+def test_check_plot_path_refuses_before_any_work(tmp_path, name, exists, force, match):
+    path = tmp_path / name
+    if exists:
+        path.write_bytes(b"old")
+    with pytest.raises(OutputFileError, match=match):
+        plots.check_plot_path(path, force=force)
+
+
+def test_check_plot_path_returns_the_format():
+    assert plots.check_plot_path("figure.SVG") == "svg"
