@@ -120,9 +120,21 @@ def new_figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, A
     return fig, axes
 
 
+def _figure_of(ax: Axes) -> Figure:
+    """Return the top-level figure an Axes belongs to (through any subfigures)."""
+    from matplotlib.figure import Figure
+
+    fig: Any = ax.get_figure()
+    while fig is not None and not isinstance(fig, Figure):
+        fig = fig.get_figure()
+    if fig is None:
+        raise NumericError("the given Axes belongs to no figure")
+    return fig
+
+
 def _axes(ax: Axes | None, **kwargs: Any) -> tuple[Figure, Axes]:
     if ax is not None:
-        return ax.get_figure(), ax
+        return _figure_of(ax), ax
     fig, new = new_figure(**kwargs)
     return fig, new
 
@@ -172,7 +184,7 @@ def plot_hamiltonians(result: Any, axes: Sequence[Axes] | None = None) -> Figure
         fig, (ax_lin, ax_log) = new_figure(1, 2, figsize=(10, 3.8))
     else:
         ax_lin, ax_log = axes
-        fig = ax_lin.get_figure()
+        fig = _figure_of(ax_lin)
     ax_lin.plot(t, H, color=PLANT_COLOR, ls="-", label="H (plant)")
     has_observer = getattr(result, "H_err", None) is not None
     if has_observer:
