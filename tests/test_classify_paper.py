@@ -260,3 +260,23 @@ def test_json_keys(beam):
     not_applicable = data["results"][2]
     assert not_applicable["applicable"] is False
     assert not_applicable["kappa"] is None
+
+
+def test_airy_symbolic_gains_with_irrational_ports():
+    """Airy, sensors y1 and y3, L = diag(l1, l2): Proposition 3.1 variant 1 (traces at a).
+
+    Hand derivation. Ports: u = (e(0), e(1), (e'(0)+e'(1))/√2), y = (-e''(0), e''(1),
+    (e'(0)-e'(1))/√2). On K: e(0) = l1 e''(0), e(1) = 0, and with p = e'(0), q = e'(1),
+    p + q = -l2 (p - q). For l2 ≠ 1 this gives p = -(l2 - 1) d / 2 with d = p - q, so
+    LHS = l1 e''(0)² + l2 d²/2 and RHS = e(0)² + e'(0)² + e''(0)² = (1 + l1²) e''(0)²
+    + (l2 - 1)² d²/4: κ* = min(l1/(1 + l1²), 2 l2/(l2 - 1)²). The √2 in the ports once
+    made the exact check of Y K = I fail structurally (regression).
+    """
+    l1, l2 = gain_symbols(2)
+    result = classify(load_builtin("airy"), sensor_matrix([1, 3], 3), parse_gain("symbolic", 2))
+    assert result.verdict == "asymptotic"
+    variant = result.result("3.1", 1)
+    assert variant.holds
+    expected = sympy.Min(l1 / (1 + l1**2), 2 * l2 / (l2 - 1) ** 2)
+    for values in ({l1: 2, l2: 3}, {l1: sympy.Rational(1, 3), l2: sympy.Rational(1, 2)}):
+        assert sympy.simplify(variant.kappa.subs(values) - expected.subs(values)) == 0

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import stat
+
 import pytest
 import sympy
 from hypothesis import given, settings
@@ -118,6 +121,16 @@ def test_read_and_write_files(tmp_path):
     write_model(beam.with_parameters({"d": 0.5}), out, force=True)
     assert read_model(out) != beam
     assert [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")] == []
+
+
+def test_atomic_write_gives_the_usual_file_mode(tmp_path):
+    """The temporary file of mkstemp is 0600; the written file must honour the umask instead."""
+    umask = os.umask(0o022)
+    try:
+        atomic_write(tmp_path / "x.txt", "x")
+    finally:
+        os.umask(umask)
+    assert stat.S_IMODE((tmp_path / "x.txt").stat().st_mode) == 0o644
 
 
 def test_atomic_write_refuses_unwritable_places(tmp_path):

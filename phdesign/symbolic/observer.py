@@ -391,8 +391,8 @@ def error_system(
     K = sympy.ImmutableMatrix(T_inv * sympy.Matrix.vstack(-G, sympy.eye(nn)))
     # dim K = Nn: K has Nn columns and its lower part through Y is the identity
     # (Y K = I), so the columns are independent; K solves the boundary condition.
-    residual = boundary * K
-    if not all(vanishes(x) for x in residual) or sympy.eye(nn) != (Y * K):
+    residuals = [*(boundary * K), *(Y * K - sympy.eye(nn))]
+    if not all(vanishes(x) for x in residuals):
         raise ObserverError(
             f"the admissible traces K = ker(U + C_mᵀ L C_m Y) must have dimension Nn = {nn}; "
             "the port matrices are inconsistent"
