@@ -35,7 +35,8 @@ def test_spectrum_extinction_prints_no_number(capsys):
     assert "unbounded below" in out
     status, out, _ = run(capsys, "spectrum", "wave", "--sensors", "2", "--gain", "1", "--json")
     data = json.loads(out)
-    assert data["spectral_abscissa"] is None and data["unbounded_below"] is True
+    assert data["spectral_abscissa"] is None
+    assert data["unbounded_below"] is True
 
 
 def test_spectrum_plant_with_param_override(capsys):
@@ -64,14 +65,17 @@ def test_simulate_csv_and_json(capsys, tmp_path):
     status, out, _ = run(capsys, *argv)
     assert status == 0
     rows = list(csv.reader(io.StringIO(out)))
-    assert rows[0][:4] == ["t", "H", "H_hat", "H_err"] and len(rows) == 7
+    assert rows[0][:4] == ["t", "H", "H_hat", "H_err"]
+    assert len(rows) == 7
     target = tmp_path / "sim.json"
     status, out, _ = run(capsys, *argv, "--json", "--output", str(target))
-    assert status == 0 and out == ""
+    assert status == 0
+    assert out == ""
     data = json.loads(target.read_text())
     assert abs(data["H"][0] - 0.73 / 6) < 1e-12  # H(0) = 1/2 int (z - 0.9)^2
     status, _, err = run(capsys, *argv, "--json", "--output", str(target))
-    assert status == 2 and "exists" in err
+    assert status == 2
+    assert "exists" in err
 
 
 @pytest.mark.slow
@@ -96,7 +100,8 @@ def test_simulate_plot(capsys, tmp_path):
         "--plot",
         str(target),
     )
-    assert status == 0 and target.stat().st_size > 1000
+    assert status == 0
+    assert target.stat().st_size > 1000
 
 
 def test_tune_json_contract(capsys):
@@ -128,8 +133,9 @@ BAD = [
 
 @pytest.mark.parametrize(("argv", "needle"), BAD)
 def test_bad_input_exits_2_with_one_line(capsys, argv, needle):
-    status, out, err = run(capsys, *argv)
+    status, _, err = run(capsys, *argv)
     assert status == 2
     # argparse usage errors are prefixed "phdesign <command>:" by the lead's parser
-    assert err.startswith("phdesign") and err.count("\n") == 1
+    assert err.startswith("phdesign")
+    assert err.count("\n") == 1
     assert needle in err

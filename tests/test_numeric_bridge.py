@@ -24,7 +24,8 @@ def test_builtins_cross_the_bridge_with_the_contract_ordering(name):
     model = load_builtin(name)
     nm = to_numeric(model)
     N, n = model.order, model.size
-    assert nm.U.shape == (N * n, 2 * N * n) and nm.Y.shape == nm.U.shape
+    assert nm.U.shape == (N * n, 2 * N * n)
+    assert nm.Y.shape == nm.U.shape
     ports = derive_ports(model)
     np.testing.assert_allclose(nm.U, np.array(ports.U.subs(model.parameter_defaults), float))
     assert len(nm.P) == N + 1

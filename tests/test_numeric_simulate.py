@@ -98,7 +98,8 @@ def test_expm_and_midpoint_agree_and_plant_only_mode(rng):
     x0 = initial_state_function("x1: sin(pi*z), x2: 0", nm, model=load_builtin("wave"))
     a = simulate(nm, x0=x0, t_end=1.0, samples=1001, resolution=16)
     b = simulate(nm, x0=x0, t_end=1.0, samples=1001, resolution=16, scheme="midpoint")
-    assert a.H_hat is None and a.H_err is None
+    assert a.H_hat is None
+    assert a.H_err is None
     np.testing.assert_allclose(a.H, b.H, rtol=1e-5)
     # the undamped closed wave (u = 0) conserves energy exactly under both schemes
     assert np.max(np.abs(a.H / a.H[0] - 1)) < 1e-11
@@ -124,18 +125,18 @@ def test_exported_statespace_reproduces_the_simulation(method, res):
     d = discretize(nm, method, res)
     r = simulate(nm, PAPER_SENSORS, L, x0=x0, t_end=2.0, samples=201, discrete=d)
     P = plant_statespace(d)
-    O = observer_statespace(d, PAPER_SENSORS, L)
+    obs = observer_statespace(d, PAPER_SENSORS, L)
     E = error_statespace(d, PAPER_SENSORS, L)
     assert P.input_labels == ["u1", "u2", "u3", "u4"]
-    assert O.input_labels == ["u1", "u2", "u3", "u4", "y_m1", "y_m2"]
-    assert O.output_labels[:4] == ["y_hat1", "y_hat2", "y_hat3", "y_hat4"]
+    assert obs.input_labels == ["u1", "u2", "u3", "u4", "y_m1", "y_m2"]
+    assert obs.output_labels[:4] == ["y_hat1", "y_hat2", "y_hat3", "y_hat4"]
     S = control.ss(
         [], [], [], PAPER_SENSORS, inputs=P.output_labels, outputs=["y_m1", "y_m2"], name="sensors"
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # unused observer state outputs
         loop = control.interconnect(
-            [P, S, O], inplist=P.input_labels, outlist=O.output_labels[:4] + P.output_labels
+            [P, S, obs], inplist=P.input_labels, outlist=obs.output_labels[:4] + P.output_labels
         )
     X0 = np.concatenate([d.project(x0), np.zeros(d.dim)])
     fr = control.forced_response(loop, T=r.t, U=np.zeros((4, r.t.size)), X0=X0)
@@ -157,7 +158,8 @@ def test_csv_and_json_formats():
     d = json.loads(r.to_json())
     for key in ("t", "H", "H_hat", "H_err", "y", "y_hat", "w", "w_hat", "z_w"):
         assert key in d
-    assert len(d["w"]) == 6 and len(d["w"][0]) == len(d["z_w"])
+    assert len(d["w"]) == 6
+    assert len(d["w"][0]) == len(d["z_w"])
 
 
 def test_initial_state_syntax_errors():

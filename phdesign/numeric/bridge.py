@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import ModelError, NumericError, ParameterError, check_shape
+from phdesign.errors import ModelError, ParameterError, check_shape
 
 __all__ = [
     "DisplacementSpec",
@@ -411,8 +411,6 @@ def _split_top_level(text: str) -> list[str]:
 
 def _parse_z_expression(text: str, model: Any, parameters: Mapping[str, Any] | None) -> Any:
     """Parse an expression in z (and parameters) safely and substitute parameter values."""
-    import sympy
-
     from phdesign.symbolic import expressions as ex
     from phdesign.symbolic.model import Z
 

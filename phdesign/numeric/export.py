@@ -1,15 +1,15 @@
-"""Export of plant, observer and error system as ``control.StateSpace`` objects.
+r"""Export of plant, observer and error system as ``control.StateSpace`` objects.
 
 All three are written in standard form with the discrete efforts ê as states
-(:mod:`phdesign.numeric.discretize`): from :math:`E \\dot{\\hat e} = (J - R)\\hat e + B u`,
+(:mod:`phdesign.numeric.discretize`): from :math:`E \dot{\hat e} = (J - R)\hat e + B u`,
 
-* plant: :math:`A = E^{-1}(J - R)`, :math:`B_s = E^{-1} B`, :math:`C = B^\\top`, :math:`D`;
+* plant: :math:`A = E^{-1}(J - R)`, :math:`B_s = E^{-1} B`, :math:`C = B^\top`, :math:`D`;
   inputs ``u1..``, outputs ``y1..``.
-* observer: inputs (u, y_m), outputs (ŷ, ê_obs).  With :math:`K = C_m^\\top L C_m`,
-  :math:`M = (I + K D)^{-1}`: :math:`\\hat u = M (u + C_m^\\top L y_m - K B^\\top \\hat e_{obs})`,
-  so :math:`A_o = E^{-1}(J - R - B M K B^\\top)`, :math:`B_o = E^{-1} B M [I, C_m^\\top L]`,
-  :math:`C_o = [B^\\top - D M K B^\\top; I]`, :math:`D_o = [D M [I, C_m^\\top L]; 0]`.
-* error system: :math:`A_e = E^{-1}(J - R - B M K B^\\top)`, no input, output ỹ.
+* observer: inputs (u, y_m), outputs (ŷ, ê_obs).  With :math:`K = C_m^\top L C_m`,
+  :math:`M = (I + K D)^{-1}`: :math:`\hat u = M (u + C_m^\top L y_m - K B^\top \hat e_{obs})`,
+  so :math:`A_o = E^{-1}(J - R - B M K B^\top)`, :math:`B_o = E^{-1} B M [I, C_m^\top L]`,
+  :math:`C_o = [B^\top - D M K B^\top; I]`, :math:`D_o = [D M [I, C_m^\top L]; 0]`.
+* error system: :math:`A_e = E^{-1}(J - R - B M K B^\top)`, no input, output ỹ.
 
 ``control`` is imported lazily, inside the functions, so importing phdesign never pays
 for it.
@@ -46,7 +46,7 @@ def _ss(A: Any, B: Any, C: Any, D: Any, **names: Any) -> Any:
 
 
 def plant_statespace(d: DiscretePHS, name: str = "plant") -> Any:
-    """The discretized plant as ``control.StateSpace`` (inputs u, outputs y)."""
+    """Return the discretized plant as ``control.StateSpace`` (inputs u, outputs y)."""
     m = d.n_ports
     A = np.linalg.solve(d.E, d.J - d.R)
     B = np.linalg.solve(d.E, d.B)
@@ -73,7 +73,7 @@ def _observer_parts(d: DiscretePHS, C_m: np.ndarray, L: np.ndarray):  # type: ig
 def observer_statespace(
     d: DiscretePHS, C_m: np.ndarray, L: np.ndarray, name: str = "observer"
 ) -> Any:
-    """The observer as ``control.StateSpace``: inputs (u, y_m), outputs (ŷ, ê_obs)."""
+    """Return the observer as ``control.StateSpace``: inputs (u, y_m), outputs (ŷ, ê_obs)."""
     C, Lm, K, M = _observer_parts(d, C_m, L)
     m, q, n = d.n_ports, C.shape[0], d.dim
     In = np.hstack([np.eye(m), C.T @ Lm])  # û = M (In [u; y_m] - K Bᵀ ê)
@@ -96,7 +96,7 @@ def observer_statespace(
 
 
 def error_statespace(d: DiscretePHS, C_m: np.ndarray, L: np.ndarray, name: str = "error") -> Any:
-    """The observer error system as ``control.StateSpace`` (no input, output ỹ)."""
+    """Return the observer error system as ``control.StateSpace`` (no input, output ỹ)."""
     _C, _Lm, K, M = _observer_parts(d, C_m, L)
     m, n = d.n_ports, d.dim
     A = np.linalg.solve(d.E, d.J - d.R - d.B @ M @ K @ d.B.T)

@@ -1,33 +1,33 @@
-"""Legendre-Galerkin discretization with power-conjugate weak boundary inputs.
+r"""Legendre-Galerkin discretization with power-conjugate weak boundary inputs.
 
-Take the efforts in a polynomial basis, :math:`e(z) \\approx \\Psi(z) \\hat e` with
-:math:`\\Psi = I_n \\otimes (\\psi_0, \\dots, \\psi_p)` and :math:`\\psi_j` the Legendre
-polynomials orthonormal on [a, b].  Testing the PDE :math:`\\partial_t x = \\sum_k P_k
-\\partial_z^k e`, :math:`x = H^{-1} e`, with the same basis gives
+Take the efforts in a polynomial basis, :math:`e(z) \approx \Psi(z) \hat e` with
+:math:`\Psi = I_n \otimes (\psi_0, \dots, \psi_p)` and :math:`\psi_j` the Legendre
+polynomials orthonormal on [a, b].  Testing the PDE :math:`\partial_t x = \sum_k P_k
+\partial_z^k e`, :math:`x = H^{-1} e`, with the same basis gives
 
 .. math::
 
-    M \\dot{\\hat e} = A \\hat e, \\quad
-    M = \\int_a^b \\Psi^\\top H^{-1} \\Psi \\, dz, \\quad
-    A = \\sum_{k=0}^N \\int_a^b \\Psi^\\top P_k \\partial_z^k \\Psi \\, dz .
+    M \dot{\hat e} = A \hat e, \quad
+    M = \int_a^b \Psi^\top H^{-1} \Psi \, dz, \quad
+    A = \sum_{k=0}^N \int_a^b \Psi^\top P_k \partial_z^k \Psi \, dz .
 
 Integration by parts (the energy identity of the BC-PHS, applied to the polynomial
 e = Ψê, for which it is exact) gives, with T the matrix mapping ê to the trace vector v,
 
 .. math::
 
-    A + A^\\top = T^\\top (U^\\top Y + Y^\\top U) T + 2 \\int \\Psi^\\top \\operatorname{sym}(P_0) \\Psi,
+    A + A^\top = T^\top (U^\top Y + Y^\top U) T + 2 \int \Psi^\top \operatorname{sym}(P_0) \Psi,
 
-so :math:`A - T^\\top Y^\\top U T = J - R` with :math:`J = -J^\\top` and
-:math:`R = -\\int \\Psi^\\top \\operatorname{sym}(P_0) \\Psi \\succeq 0`.  Replacing the
-state's own input :math:`U T \\hat e` by the imposed input u,
+so :math:`A - T^\top Y^\top U T = J - R` with :math:`J = -J^\top` and
+:math:`R = -\int \Psi^\top \operatorname{sym}(P_0) \Psi \succeq 0`.  Replacing the
+state's own input :math:`U T \hat e` by the imposed input u,
 
 .. math::
 
-    M \\dot{\\hat e} = (J - R) \\hat e + B u, \\quad y = B^\\top \\hat e, \\quad B = (Y T)^\\top,
+    M \dot{\hat e} = (J - R) \hat e + B u, \quad y = B^\top \hat e, \quad B = (Y T)^\top,
 
 a port-Hamiltonian system whose energy balance
-:math:`\\tfrac{d}{dt} \\tfrac12 \\hat e^\\top M \\hat e = -\\hat e^\\top R \\hat e + u^\\top y` is
+:math:`\tfrac{d}{dt} \tfrac12 \hat e^\top M \hat e = -\hat e^\top R \hat e + u^\top y` is
 exact.  The scheme is consistent: the exact solution satisfies it with u = UTe.  The
 boundary conditions are imposed weakly, through the power pairing, so that no basis
 function has to satisfy them and every admissible (U, Y) is covered by the same code.
@@ -67,10 +67,10 @@ def _derivative_coefficients(p: int, k: int) -> np.ndarray:
 
 
 def legendre_basis(z: np.ndarray, p: int, k: int, interval: tuple[float, float]) -> np.ndarray:
-    """Values of the k-th z-derivative of the orthonormal Legendre basis on ``interval``.
+    r"""Values of the k-th z-derivative of the orthonormal Legendre basis on ``interval``.
 
     Returns an array of shape ``(len(z), p + 1)``; column j is
-    :math:`\\psi_j^{(k)}(z)`, :math:`\\psi_j(z) = \\sqrt{(2j+1)/(b-a)}\\, P_j(t)`,
+    :math:`\psi_j^{(k)}(z)`, :math:`\psi_j(z) = \sqrt{(2j+1)/(b-a)}\, P_j(t)`,
     :math:`t = (2z - a - b)/(b - a)`.
 
     Examples
@@ -196,7 +196,7 @@ def _displacement_basis(nm: NumericModel, effort_basis, iv):  # type: ignore[no-
     polynomials) discrete transform, and integrated exactly in that expansion.
     """
     spec = nm.displacement
-    assert spec is not None  # noqa: S101 - internal invariant, not user input
+    assert spec is not None
     c = spec.component - 1
     nq = 160
     zq, wq = _gauss(nq, iv)

@@ -1,29 +1,29 @@
-"""Simulation of plant and observer together, exact in time for these LTI systems.
+r"""Simulation of plant and observer together, exact in time for these LTI systems.
 
-With the discretization :math:`E \\dot{\\hat e} = (J - R)\\hat e + B u`,
-:math:`y = B^\\top \\hat e + D u` (:mod:`phdesign.numeric.discretize`), the observer is the
+With the discretization :math:`E \dot{\hat e} = (J - R)\hat e + B u`,
+:math:`y = B^\top \hat e + D u` (:mod:`phdesign.numeric.discretize`), the observer is the
 same system driven by
 
 .. math::
 
-    \\hat u = u + C_m^\\top L (y_m - \\hat y_m), \\qquad K = C_m^\\top L C_m,
+    \hat u = u + C_m^\top L (y_m - \hat y_m), \qquad K = C_m^\top L C_m,
 
 which, with the feedthrough loop solved, is
-:math:`\\hat u = u + (I + K D)^{-1} K B^\\top (\\hat e - \\hat e_{obs})`.  Plant and observer
-form one LTI system :math:`\\dot X = F X + G u`.  Time stepping (never an explicit generic
+:math:`\hat u = u + (I + K D)^{-1} K B^\top (\hat e - \hat e_{obs})`.  Plant and observer
+form one LTI system :math:`\dot X = F X + G u`.  Time stepping (never an explicit generic
 ODE solver):
 
 ``"expm"`` (default)
-    exact: :math:`X_{k+1} = e^{F\\Delta t} X_k + \\Gamma_1 u_k + \\Gamma_2 (u_{k+1}-u_k)/\\Delta t`
+    exact: :math:`X_{k+1} = e^{F\Delta t} X_k + \Gamma_1 u_k + \Gamma_2 (u_{k+1}-u_k)/\Delta t`
     from one matrix exponential of the augmented matrix (exact for u = 0 and for u
     piecewise linear between output samples).
 ``"midpoint"``
     implicit midpoint (Gauss-Legendre order 2): the discrete energy
-    :math:`\\tfrac12 X^\\top E X` is conserved exactly when R = 0 and u = 0, because the
+    :math:`\tfrac12 X^\top E X` is conserved exactly when R = 0 and u = 0, because the
     step is the Cayley transform of an E-skew operator.
 
-Energies: :math:`H = \\tfrac12 \\hat e^\\top E \\hat e`, :math:`\\hat H` likewise for the
-observer and :math:`\\tilde H = \\tfrac12 (\\hat e - \\hat e_{obs})^\\top E (\\hat e - \\hat e_{obs})`.
+Energies: :math:`H = \tfrac12 \hat e^\top E \hat e`, :math:`\hat H` likewise for the
+observer and :math:`\tilde H = \tfrac12 (\hat e - \hat e_{obs})^\top E (\hat e - \hat e_{obs})`.
 """
 
 from __future__ import annotations
@@ -102,7 +102,7 @@ class SimulationResult:
         return out
 
     def to_json(self) -> str:
-        """The :meth:`to_dict` payload as JSON text."""
+        """Return the :meth:`to_dict` payload as JSON text."""
         return json.dumps(self.to_dict())
 
     def to_csv(self) -> str:

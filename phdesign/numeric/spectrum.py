@@ -1,6 +1,6 @@
-"""Converged spectra: spectral abscissa and rightmost eigenvalues under refinement.
+r"""Converged spectra: spectral abscissa and rightmost eigenvalues under refinement.
 
-The eigenvalues of the generalized problem :math:`(J - R - B K_{cl} B^\\top) v = \\lambda E v`
+The eigenvalues of the generalized problem :math:`(J - R - B K_{cl} B^\top) v = \lambda E v`
 (closed plant, u = 0, or the observer error system, ũ = −C_mᵀ L C_m ỹ) are computed at
 resolutions p and ⌈1.5 p⌉ and only those that agree are kept (the drift-ratio rule of
 Dedalus' eigentools): the discrete spectrum of any semi-discretization contains
@@ -10,14 +10,14 @@ largest real part over *all* discrete eigenvalues converges to 0, not to the tru
 abscissa: the unresolved modes lose the boundary damping.
 
 An eigenvalue λ at the finer resolution is *resolved* when its nearest neighbour μ at
-the coarser one satisfies :math:`|\\lambda - \\mu| \\le r_{tol} \\max(1, |\\lambda|)` and the
+the coarser one satisfies :math:`|\lambda - \mu| \le r_{tol} \max(1, |\lambda|)` and the
 pairing is mutual.  The resolution pair is refined (p → 1.5 p) until the rightmost
 resolved eigenvalue's real part agrees to ``tol``.  Digits are
-:math:`-\\log_{10}(|\\Delta \\operatorname{Re}| / \\max(1, |\\alpha|))`.
+:math:`-\log_{10}(|\Delta \operatorname{Re}| / \max(1, |\alpha|))`.
 
 Ill-conditioning (near a coalescence, e.g. a critically damped gain) is measured by the
 energy-norm eigenvalue condition number
-:math:`\\kappa = \\|x\\|_E \\|y\\|_{E^{-1}} / |y^* E x|` (1 for a normal operator in the
+:math:`\kappa = \|x\|_E \|y\|_{E^{-1}} / |y^* E x|` (1 for a normal operator in the
 energy inner product) and by the relative gap to the nearest other eigenvalue.  When no
 eigenvalue is resolved at any resolution the spectrum is reported as unbounded below
 (finite-time extinction, e.g. the wave with the matched damper k = 1), never as a number.
@@ -122,7 +122,7 @@ def eigen(
 def match_resolved(
     fine: np.ndarray, coarse: np.ndarray, rtol: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Indices of ``fine`` eigenvalues resolved against ``coarse`` and their drifts.
+    """Return the indices of ``fine`` eigenvalues resolved against ``coarse`` and their drifts.
 
     An eigenvalue is kept when its nearest coarse eigenvalue is within
     ``rtol * max(1, |λ|)`` and the nearest-neighbour pairing is mutual.
@@ -153,7 +153,7 @@ def match_resolved(
 
 
 def in_band_unresolved(fine: np.ndarray, tight: np.ndarray) -> np.ndarray:
-    """Indices of unresolved ``fine`` eigenvalues inside the resolved frequency band.
+    """Return the indices of unresolved ``fine`` eigenvalues inside the resolved frequency band.
 
     The band is |λ| ≤ max |λ| over the resolved ones.  Unresolved eigenvalues above it
     are the high-frequency artefacts of the semi-discretization (discarded); inside it
@@ -178,7 +178,7 @@ def resolved_abscissa(fine: np.ndarray, coarse: np.ndarray, rtol: float = 1e-6) 
 
 
 def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
-    """Starting and maximal resolution for ``method`` (degree or nodes per group)."""
+    """Return the starting and maximal resolution for ``method`` (degree or nodes per group)."""
     if method == "fd":
         return 70, 240
     # p^(2N) eps must stay small: cap the degree harder for high orders.
@@ -308,7 +308,7 @@ def spectrum(
             ],
         )
     lam, kap, idx = result["lam"], result["kappa"], result["idx"]
-    loose_set = set(int(i) for i in result["loose"])
+    loose_set = {int(i) for i in result["loose"]}
     alpha, d_alpha = result["alpha"], result["d_alpha"]
     res_lam, res_kap = lam[idx], kap[idx]
     order = np.lexsort((np.abs(res_lam.imag), -np.round(res_lam.real, 12)))

@@ -1,4 +1,4 @@
-"""Staggered-grid finite differences (Trenchant, Ramirez, Kotyczka, Le Gorrec, JCP 2018).
+r"""Staggered-grid finite differences (Trenchant, Ramirez, Kotyczka, Le Gorrec, JCP 2018).
 
 The paper's own setting (140 states for the beam).  Supported models: order N = 1 or 2,
 the state splits into a group p whose traces at a are the inputs there and a group q
@@ -7,8 +7,8 @@ P_N couples only p and q, and 0 < k < N gives P_k = 0:
 
 .. math::
 
-    N = 1:\\; \\dot x_p = G^\\top \\partial_z e_q,\\; \\dot x_q = G \\partial_z e_p; \\qquad
-    N = 2:\\; \\dot x_p = -G^\\top \\partial_z^2 e_q,\\; \\dot x_q = G \\partial_z^2 e_p,
+    N = 1:\; \dot x_p = G^\top \partial_z e_q,\; \dot x_q = G \partial_z e_p; \qquad
+    N = 2:\; \dot x_p = -G^\top \partial_z^2 e_q,\; \dot x_q = G \partial_z^2 e_p,
 
 plus P_0 (coupling between the grids through an averaging operator and its adjoint).
 This covers wave, Timoshenko and Euler-Bernoulli.  Other models raise NumericError (use

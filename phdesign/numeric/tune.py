@@ -1,15 +1,16 @@
-"""Observer gain tuning: minimize the converged spectral abscissa of the error system.
+r"""Observer gain tuning: minimize the converged spectral abscissa of the error system.
 
-The error system is :math:`E \\dot{\\tilde e} = (J - R - B C_m^\\top L C_m B^\\top)\\tilde e`
+The error system is :math:`E \dot{\tilde e} = (J - R - B C_m^\top L C_m B^\top)\tilde e`
 (Galerkin: D = 0).  The objective is the largest real part over the eigenvalues that
 are *resolved* (agree between the resolutions p and 1.5 p, see
 :mod:`phdesign.numeric.spectrum`), never over all discrete eigenvalues: the unresolved
 high frequencies of any semi-discretization have real parts that tend to the undamped
 value and would flatten the landscape (the h² trap of DESIGN.md).
 
-The search runs Nelder-Mead from several starts in log-space, :math:`L = \\operatorname{diag}(e^{s})`
-(or, with ``full=True``, :math:`L = e^{S} + W` with S symmetric and W skew, which keeps
-:math:`L + L^\\top \\succ 0`), then re-checks the optimum with the adaptive
+The search runs Nelder-Mead from several starts in log-space,
+:math:`L = \operatorname{diag}(e^{s})` (or, with ``full=True``, :math:`L = e^{S} + W` with
+S symmetric and W skew, which keeps
+:math:`L + L^\top \succ 0`), then re-checks the optimum with the adaptive
 :func:`~phdesign.numeric.spectrum.spectrum`.  The spectral abscissa is non-smooth where
 two eigenvalue branches meet; the minimum of a boundary damper typically sits at such a
 meeting (a coalescence, "critical damping"), so the result says whether it does.
@@ -180,7 +181,7 @@ def tune(
         records.append(rec)
         if best is None or res.fun < best.fun:
             best = res
-    assert best is not None  # noqa: S101 - at least one start always runs
+    assert best is not None
     L = _gain_from(best.x, q, full)
     report = spectrum(nm, C, L)
     if report.spectral_abscissa is None and not report.unbounded_below:
