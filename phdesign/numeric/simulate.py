@@ -271,7 +271,7 @@ def simulate(
     if (C_m is None) != (L is None):
         raise NumericError("give both the sensors C_m and the gain L, or neither")
     d = discrete if discrete is not None else discretize(nm, method, resolution)
-    K = None if C_m is None else feedback_matrix(C_m, L, nm.n_ports)
+    K = None if C_m is None or L is None else feedback_matrix(C_m, L, nm.n_ports)
     t = np.linspace(0.0, float(t_end), int(samples))
     zero = lambda z: np.zeros((np.atleast_1d(z).size, nm.size))  # noqa: E731
     e0 = d.project(x0 or zero)

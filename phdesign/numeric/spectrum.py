@@ -229,7 +229,7 @@ def spectrum(
     """
     if (C_m is None) != (L is None):
         raise NumericError("give both the sensors C_m and the gain L, or neither")
-    K = None if C_m is None else feedback_matrix(C_m, L, nm.n_ports)
+    K = None if C_m is None or L is None else feedback_matrix(C_m, L, nm.n_ports)
     if tol is None:
         tol = 1e-10 if method == "galerkin" else 1e-3
     if rtol_resolved is None:

@@ -155,13 +155,13 @@ def tune(
 
     rng = np.random.default_rng(seed)
     npar = q if not full else q * (q + 1) // 2 + q * (q - 1) // 2
-    x_starts = [np.zeros(npar)]
+    x_starts: list[np.ndarray] = [np.zeros(npar)]
     for _ in range(max(0, starts - 1)):
         if not full:
-            x_starts.append(rng.uniform(*log_range, size=q))
+            x_starts.append(np.asarray(rng.uniform(log_range[0], log_range[1], size=q)))
         else:
             x = np.zeros(npar)
-            S = np.diag(rng.uniform(*log_range, size=q))
+            S = np.diag(rng.uniform(log_range[0], log_range[1], size=q))
             x[: q * (q + 1) // 2] = S[np.triu_indices(q)]
             x_starts.append(x)
     records = []
