@@ -78,6 +78,17 @@ class TuneResult:
         }
 
 
+def _eig_kappa(A: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues of (A, E) and their energy-norm condition numbers."""
+    lam, Vl, Vr = sl.eig(A, E, left=True, right=True)
+    EVr = E @ Vr
+    num = np.sqrt(np.abs(np.einsum("ij,ij->j", Vr.conj(), EVr)))
+    num *= np.sqrt(np.abs(np.einsum("ij,ij->j", Vl.conj(), np.linalg.solve(E, Vl))))
+    den = np.abs(np.einsum("ij,ij->j", Vl.conj(), EVr))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return lam, np.where(den > 0, num / den, np.inf)
+
+
 def _gain_from(params: np.ndarray, q: int, full: bool) -> np.ndarray:
     if not full:
         return np.diag(np.exp(np.clip(params, -30, 30)))
@@ -146,11 +157,10 @@ def tune(
 
     def objective(params: np.ndarray) -> float:
         L = _gain_from(params, q, full)
-        lams = []
-        for E, A0, Bc in pair:
-            lam = sl.eigvals(A0 - Bc @ L @ Bc.T, E)
-            lams.append(lam)
-        alpha = resolved_abscissa(lams[1], lams[0])
+        (E0, A00, B0), (E1, A01, B1) = pair
+        coarse = sl.eigvals(A00 - B0 @ L @ B0.T, E0)
+        fine, kappa = _eig_kappa(A01 - B1 @ L @ B1.T, E1)
+        alpha = resolved_abscissa(fine, coarse, kappa=kappa)
         return 1e6 if alpha is None else alpha  # nothing resolved: leave this region
 
     rng = np.random.default_rng(seed)
