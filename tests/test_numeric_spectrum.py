@@ -138,3 +138,31 @@ def test_bad_requests():
         spectrum(numeric("wave"), SENSOR2, None)
     with pytest.raises(ObserverError, match="positive definite"):
         spectrum(numeric("wave"), SENSOR2, np.array([[-1.0]]))
+
+
+def _airy_exact_rightmost():
+    # Airy error system, all three sensors, L = I: e_t = e_zzz on [0, 1] with u + y = 0:
+    #   e(0) - e''(0) = 0,  e(1) + e''(1) = 0,  sqrt(2) e'(0) = 0.
+    # An eigenfunction is sum_i c_i exp(mu_i z) with mu_i^3 = lambda; for real lambda < 0,
+    # mu = -r, r e^{+-i pi/3}, r = |lambda|^(1/3).  The 3x3 determinant of the boundary
+    # conditions is purely imaginary for real lambda; its root is the eigenvalue.
+    from scipy.optimize import brentq
+
+    def det(lam):
+        r = abs(lam) ** (1 / 3)
+        mus = np.array([-r, r * np.exp(1j * np.pi / 3), r * np.exp(-1j * np.pi / 3)])
+        M = np.array([mus, 1 - mus**2, np.exp(mus) * (1 + mus**2)])
+        return np.linalg.det(M).imag
+
+    return brentq(det, -2.1, -1.9, xtol=1e-15)  # -1.99392753717954...
+
+
+def test_third_order_airy_error_abscissa_against_the_characteristic_equation():
+    # N = 3 is the conditioning stress test (the feedback on e'' traces scales like p^8):
+    # the report must reach the exact root to ~1e-9 and say how many digits it trusts
+    # instead of claiming 1e-10 convergence.
+    exact = _airy_exact_rightmost()
+    rep = spectrum(numeric("airy"), np.eye(3), np.eye(3))
+    assert abs(rep.spectral_abscissa - exact) < 1e-8
+    assert rep.digits > 8
+    assert rep.rightmost[0].imag == 0.0
