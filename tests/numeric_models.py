@@ -43,3 +43,15 @@ def numeric(name: str, **params: object) -> NumericModel:
 
 PAPER_SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])  # y3, y4 (Section IV.C)
 TABLE_I = ((0.03, 0.3), (0.1, 1.0), (0.2, 2.0))  # paper, Table I
+
+# Wave with outputs that mix in the inputs (y = y_nat + K u, K skew): the staggered
+# grid then has a skew feedthrough D != 0 and scaled inputs (S != I).
+FEEDTHROUGH = BCPHS.define(
+    name="wave with feedthrough",
+    interval=[0, 1],
+    order=1,
+    P={1: [[0, 1], [1, 0]]},
+    H=[[1, 0], [0, 1]],
+    inputs=["2*e1(0)", "e2(1)"],
+    outputs=["-e2(0)/2 + e2(1)", "e1(1) - 2*e1(0)"],
+)
