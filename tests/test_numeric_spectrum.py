@@ -166,3 +166,28 @@ def test_third_order_airy_error_abscissa_against_the_characteristic_equation():
     assert abs(rep.spectral_abscissa - exact) < 1e-8
     assert rep.digits > 8
     assert rep.rightmost[0].imag == 0.0
+
+
+def test_fd_rates_on_the_beam_plant_and_error_system():
+    # Cantilever plant (u = 0): lowest frequency beta_1^2 (cos b cosh b = -1), second order.
+    # Error system with the paper's sensors: the measured e1'(1) enters through
+    # (p_m - p_{m-1})/h, a first-order boundary closure (it is e1' at b - h/2), so the
+    # observed rate falls toward 1 (measured 1.44, 1.29, 1.17 on successive doublings).
+    from scipy.optimize import brentq
+
+    beta = brentq(lambda b: np.cos(b) * np.cosh(b) + 1, 1.5, 2.5)
+    ms = np.array([20, 40, 80, 160])
+    beam0, beam = numeric("euler-bernoulli", d=0), numeric("euler-bernoulli")
+    K = feedback_matrix(PAPER_SENSORS, np.diag([0.1, 1.0]), 4)
+    ref = -2.9106562986317006 + 2.51438586374747j  # Galerkin, 13 digits (test above)
+    e_plant, e_err = [], []
+    for m in ms:
+        d = discretize(beam0, "fd", int(m))
+        lam = sl.eigvals(d.closed_matrix(), d.E)
+        e_plant.append(np.min(np.abs(lam - 1j * beta**2)))
+        d = discretize(beam, "fd", int(m))
+        e_err.append(np.min(np.abs(sl.eigvals(d.closed_matrix(K), d.E) - ref)))
+    r_plant = np.polyfit(np.log(1.0 / ms), np.log(e_plant), 1)[0]
+    r_err = np.polyfit(np.log(1.0 / ms), np.log(e_err), 1)[0]
+    assert abs(r_plant - 2.0) < 0.1, f"observed plant rate {r_plant:.3f}, theory 2"
+    assert 0.9 < r_err < 1.6, f"observed error-system rate {r_err:.3f}, theory -> 1"
