@@ -47,7 +47,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import sympy
 
@@ -60,8 +60,27 @@ from phdesign.symbolic.expressions import (
     vanishes,
 )
 
-if TYPE_CHECKING:
-    from phdesign.symbolic.model import BCPHS
+
+class PortedSystem(Protocol):
+    """What the port derivation reads of a model (a :class:`~phdesign.symbolic.model.BCPHS`).
+
+    A protocol rather than an import keeps this module below the model module, which
+    calls :func:`derive_ports` to validate itself.
+    """
+
+    @property
+    def order(self) -> int: ...
+    @property
+    def size(self) -> int: ...
+    @property
+    def P(self) -> tuple[sympy.ImmutableMatrix, ...]: ...
+    @property
+    def inputs(self) -> tuple[sympy.Expr, ...]: ...
+    @property
+    def outputs(self) -> tuple[sympy.Expr, ...]: ...
+    @property
+    def parameter_defaults(self) -> dict[sympy.Symbol, sympy.Expr]: ...
+
 
 __all__ = [
     "IDENTITY_NAMES",
@@ -189,7 +208,7 @@ def sigma_matrix(dimension: int) -> sympy.ImmutableMatrix:
 
 
 @lru_cache(maxsize=256)
-def derive_ports(model: BCPHS) -> Ports:
+def derive_ports(model: PortedSystem) -> Ports:
     """Derive and check the port structure of ``model``.
 
     Raises
