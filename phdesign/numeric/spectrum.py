@@ -17,8 +17,9 @@ resolved eigenvalue's real part agrees to ``tol``.  Digits are
 
 Ill-conditioning (near a coalescence, e.g. a critically damped gain) is measured by the
 energy-norm eigenvalue condition number
-:math:`\kappa = \|x\|_E \|y\|_{E^{-1}} / |y^* E x|` (1 for a normal operator in the
-energy inner product) and by the relative gap to the nearest other eigenvalue.  When no
+:math:`\kappa = \|x\|_E \|y\|_E / |y^* E x|` (x right, y left eigenvector of the pencil,
+:math:`y^* A = \lambda y^* E`; 1 for an operator :math:`E^{-1}A` normal in the energy
+inner product) and by the relative gap to the nearest other eigenvalue.  When no
 eigenvalue is resolved at any resolution the spectrum is reported as unbounded below
 (finite-time extinction, e.g. the wave with the matched damper k = 1), never as a number.
 """
@@ -112,7 +113,7 @@ def eigen(
     lam, Vl, Vr = sl.eig(A, d.E, left=True, right=True)
     EVr = d.E @ Vr
     num = np.sqrt(np.abs(np.einsum("ij,ij->j", Vr.conj(), EVr)))
-    num *= np.sqrt(np.abs(np.einsum("ij,ij->j", Vl.conj(), np.linalg.solve(d.E, Vl))))
+    num *= np.sqrt(np.abs(np.einsum("ij,ij->j", Vl.conj(), d.E @ Vl)))
     den = np.abs(np.einsum("ij,ij->j", Vl.conj(), EVr))
     with np.errstate(divide="ignore", invalid="ignore"):
         kappa = np.where(den > 0, num / den, np.inf)
@@ -125,7 +126,8 @@ def match_resolved(
     """Return the indices of ``fine`` eigenvalues resolved against ``coarse`` and their drifts.
 
     An eigenvalue is kept when its nearest coarse eigenvalue is within
-    ``rtol * max(1, |λ|)`` and the nearest-neighbour pairing is mutual.
+    ``rtol * max(1, |λ|)``, the real parts agree within ``rtol * max(1, |Re λ|)``, and
+    the nearest-neighbour pairing is mutual.
 
     Examples
     --------
@@ -148,7 +150,14 @@ def match_resolved(
     drift = dist[np.arange(f_idx.size), nearest_c]
     mutual = nearest_f[nearest_c] == np.arange(f_idx.size)
     scale = np.maximum(1.0, np.abs(fine[f_idx]))
-    keep = mutual & (drift <= rtol * scale)
+    # The real part decides the abscissa: it must agree on its own scale too, or a
+    # high-frequency pair with a loose |λ| match could carry a meaningless real part.
+    d_re = np.abs(fine[f_idx].real - c[nearest_c].real)
+    keep = (
+        mutual
+        & (drift <= rtol * scale)
+        & (d_re <= rtol * np.maximum(1.0, np.abs(fine[f_idx].real)))
+    )
     return f_idx[keep], drift[keep] / scale[keep]
 
 

@@ -83,7 +83,7 @@ def _eig_kappa(A: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     lam, Vl, Vr = sl.eig(A, E, left=True, right=True)
     EVr = E @ Vr
     num = np.sqrt(np.abs(np.einsum("ij,ij->j", Vr.conj(), EVr)))
-    num *= np.sqrt(np.abs(np.einsum("ij,ij->j", Vl.conj(), np.linalg.solve(E, Vl))))
+    num *= np.sqrt(np.abs(np.einsum("ij,ij->j", Vl.conj(), E @ Vl)))
     den = np.abs(np.einsum("ij,ij->j", Vl.conj(), EVr))
     with np.errstate(divide="ignore", invalid="ignore"):
         return lam, np.where(den > 0, num / den, np.inf)
