@@ -51,6 +51,7 @@ from phdesign.symbolic.model import BCPHS, Displacement
 
 __all__ = [
     "atomic_write",
+    "check_output_path",
     "json_value",
     "model_from_dict",
     "model_from_toml",
@@ -224,6 +225,26 @@ def write_model(model: BCPHS, path: str | os.PathLike[str], force: bool = False)
     atomic_write(path, model_to_toml(model), force=force)
 
 
+def check_output_path(path: str | os.PathLike[str], force: bool = False) -> Path:
+    """Check, before any work is done, that ``path`` can be written.
+
+    Raises
+    ------
+    OutputFileError
+        If ``path`` is a folder, exists while ``force`` is false, or its folder is missing.
+    """
+    target = Path(path)
+    if target.is_dir():
+        raise OutputFileError(f"output path {str(target)!r} is a folder; expected a file name")
+    if target.exists() and not force:
+        raise OutputFileError(f"output file {str(target)!r} exists; pass --force to overwrite it")
+    if not target.parent.is_dir():
+        raise OutputFileError(
+            f"cannot write {str(target)!r}: folder {str(target.parent)!r} does not exist"
+        )
+    return target
+
+
 def atomic_write(path: str | os.PathLike[str], text: str | bytes, force: bool = False) -> None:
     """Write a file through a temporary file in the same folder and a rename.
 
@@ -232,12 +253,8 @@ def atomic_write(path: str | os.PathLike[str], text: str | bytes, force: bool = 
     OutputFileError
         If the file exists and ``force`` is false, or the folder is not writable.
     """
-    target = Path(path)
-    if target.is_dir():
-        raise OutputFileError(f"output path {str(target)!r} is a folder; expected a file name")
-    if target.exists() and not force:
-        raise OutputFileError(f"output file {str(target)!r} exists; pass --force to overwrite it")
-    folder = target.parent if str(target.parent) else Path(".")
+    target = check_output_path(path, force)
+    folder = target.parent
     data = text.encode("utf-8") if isinstance(text, str) else text
     try:
         handle, temporary = tempfile.mkstemp(dir=folder, prefix=f".{target.name}.", suffix=".tmp")

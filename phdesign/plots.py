@@ -46,6 +46,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from phdesign.errors import NumericError, OutputFileError
+from phdesign.io import check_output_path
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
@@ -604,8 +605,7 @@ def check_plot_path(path: str | os.PathLike[str], force: bool = False) -> str:
             f"plot file {str(target)!r}: unknown image format {fmt!r}; expected a suffix "
             f"among {', '.join('.' + s for s in sorted(supported))}"
         )
-    if target.exists() and not force:
-        raise OutputFileError(f"output file {str(target)!r} exists; pass --force to overwrite it")
+    check_output_path(target, force)
     return fmt
 
 

@@ -14,6 +14,7 @@ parser: user text is never evaluated.
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
 
 from phdesign.cli.common import (
@@ -156,6 +157,15 @@ def _simulate(args: argparse.Namespace) -> int:
         raise NumericError("--xhat0 needs an observer: give --sensors or --cm")
     x0 = initial_state_function(args.x0, nm, model=model)
     xh0 = initial_state_function(args.xhat0, nm, model=model)
+    # refuse unwritable or existing outputs before the (possibly long) simulation
+    if args.output:
+        from phdesign.io import check_output_path
+
+        check_output_path(args.output, args.force)
+    if args.plot:
+        from phdesign.plots import check_plot_path
+
+        check_plot_path(args.plot, args.force)
     res = simulate(
         nm,
         C_m,
@@ -182,6 +192,8 @@ def _simulate(args: argparse.Namespace) -> int:
         from phdesign.plots import plot_simulation
 
         plot_simulation(res, args.plot, force=args.force, title=model.name)
+    for warning in res.warnings:
+        print(f"phdesign: warning: {warning}", file=sys.stderr)
     return 0
 
 
