@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.errors import ModelError, ParameterError, check_shape
+from phdesign.symbolic.ports import trace_index
 
 __all__ = [
     "DisplacementSpec",
@@ -37,17 +38,6 @@ __all__ = [
     "to_numeric",
     "trace_index",
 ]
-
-
-def trace_index(i: int, k: int, side: str, order: int, size: int) -> int:
-    r"""Return the 0-based index of :math:`e_i^{(k)}(\text{side})` in the trace vector.
-
-    Examples
-    --------
-    >>> trace_index(2, 1, "a", order=2, size=2)   # e2'(a) for the beam
-    7
-    """
-    return (0 if side == "b" else order * size) + k * size + (i - 1)
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.numeric.discretize import DiscretePHS, feedback_matrix
+from phdesign.numeric.phs import DiscretePHS, feedback_matrix
 
 __all__ = ["error_statespace", "observer_statespace", "plant_statespace", "state_labels"]
 

@@ -49,7 +49,7 @@ from numpy.polynomial import legendre as leg
 
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel, trace_index
-from phdesign.numeric.discretize import DiscretePHS
+from phdesign.numeric.phs import DiscretePHS
 
 __all__ = ["galerkin", "legendre_basis"]
 

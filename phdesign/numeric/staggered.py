@@ -35,7 +35,7 @@ import numpy as np
 
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel, trace_index
-from phdesign.numeric.discretize import DiscretePHS
+from phdesign.numeric.phs import DiscretePHS
 
 __all__ = ["staggered_fd"]
 
