@@ -17,8 +17,10 @@ from bad_inputs import BAD_MODELS, beam_with
 
 from phdesign.cli import main
 from phdesign.errors import (
+    ExpressionError,
     ModelError,
     ModelFileError,
+    NumericError,
     ObserverError,
     OutputFileError,
     ParameterError,
@@ -44,9 +46,11 @@ def row(argv: str, message: str, error: type[Exception] | None, **files: str) ->
 
 
 BEAM_SENSORS = "classify euler-bernoulli --sensors"
+BEAM_GAIN = "classify euler-bernoulli --sensors 3,4 --gain"
+SIM = "simulate wave --sensors 2"
 COMMAND_ROWS = [
     # model selection and parameters
-    row("ports nosuch", "unknown model 'nosuch'", ModelFileError),
+    row("ports nosuch", "unknown model 'nosuch'; expected a built-in model", ModelFileError),
     row("ports {tmp}/missing.toml", "cannot read model file", ModelFileError),
     row("ports {tmp}/bad.toml", "not valid TOML", ModelFileError, **{"bad.toml": "name = = 1"}),
     row(
@@ -56,62 +60,176 @@ COMMAND_ROWS = [
         **{"empty.toml": ""},
     ),
     row(
-        "ports {tmp}/bin.toml", "cannot read model file", ModelFileError, **{"bin.toml": "\udcff"}
+        "ports {tmp}/bin.toml", "can't decode byte 0xff", ModelFileError, **{"bin.toml": "\udcff"}
     ),
     row("ports wave --param rho", "--param expects NAME=VALUE; found 'rho'", ParameterError),
-    row("ports wave --param =1", "--param expects NAME=VALUE", ParameterError),
-    row("ports wave --param mass=1", "unknown parameter 'mass'", ParameterError),
+    row("ports wave --param =1", "--param expects NAME=VALUE; found '=1'", ParameterError),
+    row(
+        "ports wave --param mass=1",
+        "unknown parameter 'mass'; the model's parameters are rho, T",
+        ParameterError,
+    ),
     row("ports wave --param rho=-1", "H must be positive definite", ModelError),
     row("ports wave --param rho=0", r"H\[1,1\] = 1/rho is not finite .*rho = 0", ModelError),
-    row("ports wave --param rho=abc", "unknown symbol 'abc'", ParameterError),
-    row("ports wave --param rho=nan", "unknown symbol 'nan'", ParameterError),
-    row("ports wave --param rho=1 --param rho=2", "given twice", ParameterError),
+    row("ports wave --param rho=abc", "parameter rho: unknown symbol 'abc'", ParameterError),
+    row("ports wave --param rho=nan", "parameter rho: unknown symbol 'nan'", ParameterError),
+    row(
+        "ports wave --param rho=1e999",
+        "parameter rho: number '1e999' is out of range",
+        ParameterError,
+    ),
+    row("ports wave --param rho=1 --param rho=2", "--param rho is given twice", ParameterError),
     row("ports wave --param rho=__import__('os')", "unexpected character", ParameterError),
-    row("ports euler-bernoulli --param d=-1", "negative semidefinite", ModelError),
-    row("ports", "required", None),
-    row("frobnicate", "invalid choice", None),
-    row("ports wave --nope", "unrecognized arguments", None),
-    # output files
+    row(
+        "ports euler-bernoulli --param d=-1", "P0 + P0^T must be negative semidefinite", ModelError
+    ),
+    row("ports", "ports: the following arguments are required: MODEL", None),
+    row("frobnicate", "invalid choice: 'frobnicate'", None),
+    row("ports wave --nope", "unrecognized arguments: --nope", None),
+    # output files: never overwritten without --force, never half-written
     row(
         "show wave --toml -o {tmp}/exists.toml",
         "exists; pass --force",
         OutputFileError,
         **{"exists.toml": "mine"},
     ),
-    row("show wave --toml -o {tmp}/no/such/dir/x.toml", "cannot write", OutputFileError),
-    row("show wave --toml -o {tmp}", "is a folder", OutputFileError),
-    # sensors
-    row(f"{BEAM_SENSORS} 5", "5", ObserverError),
-    row(f"{BEAM_SENSORS} 0", "0", ObserverError),
-    row(f"{BEAM_SENSORS} -1", "-1", ObserverError),
-    row(f"{BEAM_SENSORS} 3,3", "3", ObserverError),
-    row(f"{BEAM_SENSORS} 3,x", "x", ObserverError),
-    row(f"{BEAM_SENSORS} 1.5", "1.5", ObserverError),
-    row(f"{BEAM_SENSORS} ,", "sensors", ObserverError),
-    row("classify euler-bernoulli", "needs --sensors", ObserverError),
-    row("classify euler-bernoulli --gain 1", "--gain needs --sensors", ObserverError),
-    row("classify euler-bernoulli --sensors 3 --cm [[0,0,1,0]]", "not allowed with", None),
-    row("classify euler-bernoulli --all-sensors --sensors 3", "drop --sensors", ObserverError),
-    # C_m in full
-    row("classify euler-bernoulli --cm [[0,0,1]]", "C_m", ObserverError),
-    row("classify euler-bernoulli --cm [[0,0,1,0]", "--cm", ObserverError),
-    row("classify euler-bernoulli --cm [[0,0,0,0]]", "C_m", ObserverError),
-    row("classify euler-bernoulli --cm [[0,0,1,0],[0,0,2,0]]", "C_m", ObserverError),
     row(
-        "classify euler-bernoulli --cm [[0,0,nan,0]]", "--cm: expected a JSON list", ObserverError
+        "show wave --toml -o {tmp}/no/such/dir/x.toml",
+        "no/such/dir' does not exist",
+        OutputFileError,
+    ),
+    row("show wave --toml -o {tmp}", "is a folder; expected a file name", OutputFileError),
+    # sensors
+    row(f"{BEAM_SENSORS} 5", "output index 5 is out of range; expected 1..4", ObserverError),
+    row(f"{BEAM_SENSORS} 0", "output index 0 is out of range; expected 1..4", ObserverError),
+    row(f"{BEAM_SENSORS} -1", "output index -1 is out of range; expected 1..4", ObserverError),
+    row(f"{BEAM_SENSORS} 3,3", "output index 3 is repeated; expected distinct", ObserverError),
+    row(f"{BEAM_SENSORS} 3,x", "found 'x' in '3,x'", ObserverError),
+    row(f"{BEAM_SENSORS} 1.5", "found '1.5' in '1.5'", ObserverError),
+    row(f"{BEAM_SENSORS} ,", "--sensors: expected comma-separated output indices", ObserverError),
+    row(
+        "classify euler-bernoulli",
+        "classify needs --sensors, --cm or --all-sensors",
+        ObserverError,
+    ),
+    row("classify euler-bernoulli --gain 1", "--gain needs --sensors or --cm", ObserverError),
+    row(
+        "classify euler-bernoulli --sensors 3 --cm [[0,0,1,0]]",
+        "argument --cm: not allowed with argument --sensors",
+        None,
+    ),
+    row(
+        "classify euler-bernoulli --all-sensors --sensors 3", "drop --sensors/--cm", ObserverError
+    ),
+    row(
+        "classify wave --all-sensors --gain 1,2,3",
+        "expected 2 diagonal values (one per output) or a single one; found 3",
+        ObserverError,
+    ),
+    # C_m in full
+    row(
+        "classify euler-bernoulli --cm [[0,0,1]]",
+        r"C_m matrix; expected \(q, 4\) but found \(1, 3\)",
+        ObserverError,
+    ),
+    row(
+        "classify euler-bernoulli --cm [[0,0,1,0]",
+        "--cm: expected a JSON list of rows",
+        ObserverError,
+    ),
+    row(
+        "classify euler-bernoulli --cm [[0,0,0,0]]",
+        "C_m must have full row rank (independent measurements); expected rank 1 but found 0",
+        ObserverError,
+    ),
+    row(
+        "classify euler-bernoulli --cm [[0,0,1,0],[0,0,2,0]]",
+        "expected rank 2 but found 1",
+        ObserverError,
+    ),
+    row(
+        "classify euler-bernoulli --cm [[0,0,nan,0]]",
+        "--cm: expected a JSON list of rows",
+        ObserverError,
     ),
     row("classify euler-bernoulli --cm []", "--cm: expected a non-empty list", ObserverError),
     # gains
-    row(f"{BEAM_SENSORS} 3,4 --gain 1,2,3", "gain", ObserverError),
-    row(f"{BEAM_SENSORS} 3,4 --gain 1,-1", "L + Lᵀ must be positive definite", ObserverError),
-    row(f"{BEAM_SENSORS} 3,4 --gain 1,0", "L + Lᵀ must be positive definite", ObserverError),
-    row(f"{BEAM_SENSORS} 3,4 --gain 1,nan", "gain", ObserverError),
-    row(f"{BEAM_SENSORS} 3,4 --gain 1,inf", "gain", ObserverError),
-    row(f"{BEAM_SENSORS} 3,4 --gain [[1,3],[-3,-1]]", "L + L", ObserverError),
-    row(f"{BEAM_SENSORS} 3,4 --gain [[1,0,0],[0,1,0]]", "gain", ObserverError),
-    row(f"{BEAM_SENSORS} 3,4 --gain [[1,0],[0,1]", "gain", ObserverError),
-    row(f"{BEAM_SENSORS} 3,4 --gain 1,__import__('os')", "gain", ObserverError),
-    row(f"{BEAM_SENSORS} 3,4 --gain symbolically", "gain", ObserverError),
+    row(
+        f"{BEAM_GAIN} 1,2,3",
+        "expected 2 diagonal values (one per sensor) or a single one; found 3",
+        ObserverError,
+    ),
+    row(
+        f"{BEAM_GAIN} 1,-1",
+        "L + Lᵀ must be positive definite; expected every leading "
+        "principal minor > 0 but found minor 2 = -4",
+        ObserverError,
+    ),
+    row(f"{BEAM_GAIN} 1,0", "but found minor 2 = 0", ObserverError),
+    row(
+        f"{BEAM_GAIN} 1,nan",
+        "--gain: entry 2 must be a finite positive number; found 'nan'",
+        ObserverError,
+    ),
+    row(
+        f"{BEAM_GAIN} 1,inf",
+        "--gain: entry 2 must be a finite positive number; found 'inf'",
+        ObserverError,
+    ),
+    row(f"{BEAM_GAIN} [[1,3],[-3,-1]]", "L + Lᵀ must be positive definite", ObserverError),
+    row(
+        f"{BEAM_GAIN} [[1,0,0],[0,1,0]]",
+        r"L matrix; expected \(2, 2\) \(one row and column per sensor\) but found \(2, 3\)",
+        ObserverError,
+    ),
+    row(f"{BEAM_GAIN} [[1,0],[0,1]", "--gain: expected a JSON list of rows", ObserverError),
+    row(f"{BEAM_GAIN} 1,__import__('os')", "unexpected character", ObserverError),
+    row(f"{BEAM_GAIN} symbolically", "unknown symbol 'symbolically'", ObserverError),
+    # spectrum
+    row("spectrum wave --sensors 2 --gain -1", "L + Lᵀ must be positive definite", ObserverError),
+    row(
+        "spectrum wave --sensors 3", "output index 3 is out of range; expected 1..2", ObserverError
+    ),
+    row("spectrum euler-bernoulli --sensors 3,4 --gain symbolic", "l1", ParameterError),
+    row("spectrum wave --resolution 0", "--resolution", NumericError),
+    row("spectrum wave --method spectral", "argument --method: invalid choice: 'spectral'", None),
+    row("spectrum airy --method fd", "N = 1 and 2", NumericError),
+    row("spectrum wave --count x", "argument --count: invalid int value: 'x'", None),
+    # simulate: initial states, times, outputs
+    row(
+        f"{SIM} --x0 x9:z",
+        "initial state: unknown component 'x9'; expected one of",
+        ParameterError,
+    ),
+    row(f"{SIM} --x0 x1:import_os", "import_os", ExpressionError),
+    row(f"{SIM} --x0 x1:q*z", "unknown symbol 'q'", ExpressionError),
+    row(f"{SIM} --x0 x1:(z", "expected ')'", ExpressionError),
+    row(f"{SIM} --x0 x1:e1(0)", "trace 'e1(0)' is not allowed here", ExpressionError),
+    row(f"{SIM} --t-end -1", "--t-end", NumericError),
+    row(f"{SIM} --t-end 0", "--t-end", NumericError),
+    row(f"{SIM} --t-end nan", "--t-end", NumericError),
+    row(f"{SIM} --t-end abc", "argument --t-end: invalid float value: 'abc'", None),
+    row(f"{SIM} --samples 1", "--samples must be at least 2; found 1", NumericError),
+    row("simulate wave --xhat0 x1:z", "--xhat0 needs an observer", NumericError),
+    row("simulate wave --gain 1", "--gain needs --sensors or --cm", ObserverError),
+    row(
+        f"{SIM} -o {{tmp}}/run.csv",
+        "exists; pass --force",
+        OutputFileError,
+        **{"run.csv": "earlier results"},
+    ),
+    row(f"{SIM} -o {{tmp}}/none/run.csv", "does not exist", OutputFileError),
+    row(
+        f"{SIM} --plot {{tmp}}/run.png",
+        "exists; pass --force",
+        OutputFileError,
+        **{"run.png": "an earlier picture"},
+    ),
+    row(f"{SIM} --plot {{tmp}}/run.xyz", "unknown image format 'xyz'", OutputFileError),
+    # tune
+    row("tune wave", "tune: one of the arguments --sensors --cm is required", None),
+    row("tune wave --sensors 5", "output index 5 is out of range; expected 1..2", ObserverError),
+    row("tune wave --sensors 2 --starts 0", "--starts", NumericError),
 ]
 
 

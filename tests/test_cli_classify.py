@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import json
 
-import pytest
-
 from phdesign.cli import main
 
 
@@ -93,32 +91,3 @@ def test_all_sensors(capsys):
     assert data["minimal"]["exponential"] == [[2], [4]]  # derived in test_search.py
     status, out, _ = run(capsys, "classify", "wave", "--all-sensors")
     assert "minimal exponential sets: {1}, {2}" in out
-
-
-@pytest.mark.parametrize(
-    ("argv", "message"),
-    [
-        (["wave", "--sensors", "3"], "output index 3 is out of range; expected 1..2"),
-        (["wave", "--sensors", "1,1"], "output index 1 is repeated"),
-        (["wave", "--sensors", "1", "--gain", "1,2"], "expected 1 diagonal values"),
-        (["wave", "--sensors", "1", "--gain", "nan"], "must be a finite positive number"),
-        (["wave", "--sensors", "1", "--gain", "-1"], "L + Lᵀ must be positive definite"),
-        (["wave", "--cm", "[[1, 0]"], "--cm: expected a JSON list of rows"),
-        (["wave", "--cm", "[[1, 0, 0]]"], "expected (q, 2) but found (1, 3)"),
-        (["wave"], "classify needs --sensors, --cm or --all-sensors"),
-        (["wave", "--all-sensors", "--sensors", "1"], "drop --sensors/--cm"),
-        (
-            ["wave", "--all-sensors", "--gain", "1,2,3"],
-            "expected 2 diagonal values (one per output) or a single one",
-        ),
-        (["no-such-model", "--sensors", "1"], "unknown model"),
-        (["wave", "--sensors", "1", "--cm", "[[1,0]]"], "not allowed with argument"),
-    ],
-)
-def test_bad_input_exits_2_with_one_line(capsys, argv, message):
-    status, out, err = run(capsys, "classify", *argv)
-    assert status == 2
-    assert out == ""
-    assert len(err.strip().splitlines()) == 1
-    assert err.startswith("phdesign")
-    assert message in err

@@ -31,7 +31,8 @@ class _Parser(argparse.ArgumentParser):
     """An argument parser whose usage errors are one line and exit status 2."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        raise _UsageError(f"{self.prog}: {message}")
+        command = self.prog.removeprefix("phdesign").strip()
+        raise _UsageError(f"{command}: {message}" if command else message)
 
 
 class _UsageError(Exception):
@@ -91,9 +92,7 @@ def main(argv: Sequence[str] | None = None, *, reraise: bool = False) -> int:
 
 
 def _fail(message: str) -> int:
-    line = " ".join(message.split())
-    if not line.startswith("phdesign"):
-        line = f"phdesign: error: {line}"
+    line = f"phdesign: error: {' '.join(message.split())}"
     print(line, file=sys.stderr)
     return 2
 

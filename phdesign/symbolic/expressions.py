@@ -190,7 +190,7 @@ def exact_number(value: object, what: str) -> sympy.Expr:
             raise ExpressionError(f"{what} must be a finite number; found {value}")
         return expr
     if isinstance(value, str):
-        expr = parse_scalar(value, parameters=(), allow_z=False)
+        expr = parse_scalar(value, parameters=(), allow_z=False, what=what)
         return exact_number(expr, what)
     raise ExpressionError(f"{what} must be a number; found {type(value).__name__} {value!r}")
 

@@ -202,7 +202,7 @@ def parse_gain(text: str, q: int) -> sympy.ImmutableMatrix:
     """
     text = str(text).strip()
     if text == "symbolic":
-        return sympy.ImmutableMatrix(sympy.diag(*gain_symbols(q)))
+        return _check_gain(sympy.diag(*gain_symbols(q)), q)
     if text.startswith("["):
         L = _exact_matrix(_numbers_from_json(text, "--gain"), "--gain")
         if L.shape != (q, q):
@@ -210,9 +210,9 @@ def parse_gain(text: str, q: int) -> sympy.ImmutableMatrix:
                 f"--gain: Incompatible dimensions of L matrix; expected {(q, q)} "
                 f"(one row and column per sensor) but found {L.shape}"
             )
-        return L
+        return _check_gain(L, q)
     values = diagonal_values([p.strip() for p in text.split(",")], q, "one per sensor")
-    return sympy.ImmutableMatrix(sympy.diag(*values))
+    return _check_gain(sympy.diag(*values), q)
 
 
 # --------------------------------------------------------------------------- checks
