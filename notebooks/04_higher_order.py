@@ -45,16 +45,19 @@ assert all(v == 0 for v in ports.identities.values())
 # %% [markdown]
 # ## Classification
 #
-# With all three sensors and $L = I$, both variants of 3.1 hold; 3.2 to 3.4 are not
-# applicable. With only $y_1$, the witness shows which trace escapes. (The gains are
-# numbers here; the sensor search below shows that the verdicts do not depend on them.)
+# With all three sensors and positive symbolic gains $L = \mathrm{diag}(l_1, l_2, l_3)$,
+# both variants of 3.1 hold for every positive gain, with $\kappa^*$ as an expression in
+# the gains; 3.2 to 3.4 are not applicable. With only $y_1$, the witness shows which trace
+# escapes.
 
 # %%
-full = classify(airy, sensor_matrix([1, 2, 3], 3), parse_gain("1,1,1", 3))
+full = classify(airy, sensor_matrix([1, 2, 3], 3), parse_gain("symbolic", 3))
 print("sensors y1, y2, y3:", full.verdict)
 for r in full.results:
     print(f"  {r.proposition}.{r.variant}: applicable={r.applicable}, {r.reason}")
 assert full.verdict == "asymptotic"
+assert full.result("3.1", 1).holds
+assert full.result("3.1", 2).holds
 assert not any(r.applicable for r in full.results if r.proposition != "3.1")
 one = classify(airy, sensor_matrix([1], 3), parse_gain("1", 1))
 print("sensor y1 only:", one.verdict, "|", one.result("3.1", 1).reason)
