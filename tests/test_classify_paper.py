@@ -280,3 +280,6 @@ def test_airy_symbolic_gains_with_irrational_ports():
     expected = sympy.Min(l1 / (1 + l1**2), 2 * l2 / (l2 - 1) ** 2)
     for values in ({l1: 2, l2: 3}, {l1: sympy.Rational(1, 3), l2: sympy.Rational(1, 2)}):
         assert sympy.simplify(variant.kappa.subs(values) - expected.subs(values)) == 0
+    # l2 = 1: p + q = -(p - q) forces p = e'(0) = 0, so RHS = (1 + l1²) e''(0)² only and
+    # κ* = l1/(1 + l1²): the branch 2 l2/(l2 - 1)² is absent there, not infinite.
+    assert variant.kappa.subs({l1: 2, l2: 1}) == sympy.Rational(2, 5)

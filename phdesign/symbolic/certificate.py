@@ -223,8 +223,15 @@ def _symbolic_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> tuple[sympy
             continue
         for root in sympy.roots(sympy.Poly(factor, _MU)):
             root = sympy.simplify(root)
-            if root != 0:
-                branches.append(sympy.simplify(1 / root))
+            if root == 0:
+                continue
+            branch = sympy.simplify(1 / root)
+            numerator, _ = sympy.fraction(sympy.together(root))
+            if not numerator.is_positive and not numerator.is_negative:
+                # μ_i vanishes at some gains (e.g. (l - 1)²/(2 l) at l = 1): there the
+                # branch is absent from the pencil and must not enter the minimum
+                branch = sympy.Piecewise((branch, sympy.Ne(numerator, 0)), (sympy.oo, True))
+            branches.append(branch)
     gains = sorted(A_r.free_symbols | B_r.free_symbols, key=str)
     names = ", ".join(map(str, gains))
     if unresolved:
