@@ -240,6 +240,25 @@ def _rightmost(lam: np.ndarray, count: int) -> np.ndarray:
     return lam[order][:count]
 
 
+def _lost_rightmost(
+    tried: list[dict[str, Any]], chosen: dict[str, Any], rtol_resolved: float
+) -> dict[str, Any] | None:
+    """Return an earlier pair whose resolved abscissa lies clearly right of ``chosen``.
+
+    Round-off at high degree (N >= 3) can make a true eigenvalue fail the drift test at a
+    fine pair although it agreed to many digits at a coarser one; the finer pair's
+    abscissa is then the next eigenvalue to the left, a wrong answer. "Clearly" means by
+    far more than both pairs' own drifts, so that the ordinary convergence of one
+    eigenvalue under refinement never triggers this.
+    """
+    agreed = [r for r in tried if r["d_alpha"] <= rtol_resolved * max(1.0, abs(r["alpha"]))]
+    if not agreed:
+        return None
+    right = max(agreed, key=lambda r: r["alpha"])
+    margin = 100.0 * (right["d_alpha"] + chosen["d_alpha"]) + 1e-9 * max(1.0, abs(right["alpha"]))
+    return right if right["alpha"] > chosen["alpha"] + margin else None
+
+
 def spectrum(
     nm: NumericModel,
     C_m: np.ndarray | None = None,
@@ -292,6 +311,7 @@ def spectrum(
         return eigen(discretize(nm, method, res), K)[0]
 
     history: list[dict[str, Any]] = []
+    tried: list[dict[str, Any]] = []
     coarse = solve(p)
     prev_alpha: float | None = None
     result: dict[str, Any] = {}
@@ -331,6 +351,7 @@ def spectrum(
                 "prev_alpha": prev_alpha,
             }
             prev_alpha = alpha
+            tried.append(result)
             rel = d_alpha / max(1.0, abs(alpha))
             if best is None or rel < best["d_alpha"] / max(1.0, abs(best["alpha"])):
                 best = result
@@ -369,6 +390,15 @@ def spectrum(
             "(round-off at high degree); that pair is reported"
         )
         result = best
+    lost = _lost_rightmost(tried, result, rtol_resolved)
+    if lost is not None:
+        warnings.append(
+            f"the eigenvalue {lost['alpha']:.10g} agreed between resolutions {lost['res'][0]} "
+            f"and {lost['res'][1]} but not at the pair first chosen ({result['res'][0]}, "
+            f"{result['res'][1]}), whose abscissa {result['alpha']:.6g} lies to its left; "
+            "an eigenvalue that once agreed is real, so that pair is reported"
+        )
+        result = lost
     lam, kap, idx = result["lam"], result["kappa"], result["idx"]
     loose_set = {int(i) for i in result["loose"]}
     alpha, d_alpha = result["alpha"], result["d_alpha"]
