@@ -28,3 +28,21 @@ def _raise_on_floating_point_errors():
 def rng() -> np.random.Generator:
     """A seeded generator, so failures reproduce."""
     return np.random.default_rng(20230503)
+
+
+def pytest_terminal_summary(terminalreporter):
+    """Print the bad-input table's size and pass count in every run's summary (issue 7)."""
+    counts = {}
+    for outcome in ("passed", "failed"):
+        counts[outcome] = sum(
+            1
+            for report in terminalreporter.stats.get(outcome, [])
+            if "test_bad_input_table.py::test_bad_input[" in report.nodeid
+            and report.when == "call"
+        )
+    total = counts["passed"] + counts["failed"]
+    if total:
+        terminalreporter.write_line(
+            f"bad-input table: {total} rows run, {counts['passed']} passed, "
+            f"{counts['failed']} failed"
+        )

@@ -250,7 +250,6 @@ def model_file_rows() -> list[Row]:
 
 
 ROWS = COMMAND_ROWS + model_file_rows()
-_passed: list[str] = []
 
 
 def _materialize(row: Row, tmp_path) -> list[str]:
@@ -280,10 +279,8 @@ def test_bad_input(bad: Row, tmp_path, capsys):
         with pytest.raises(bad.error):
             main(argv, reraise=True)
         capsys.readouterr()
-    _passed.append(bad.id)
 
 
-def test_table_size_and_pass_count():
-    """Printed for the CI log: how many rows the table has and how many passed here."""
-    print(f"\nbad-input table: {len(ROWS)} rows, {len(_passed)} passed in this run")
+def test_table_has_at_least_60_rows():
+    """Issue 7 asks for 60 or more; the summary line of every run prints the pass count."""
     assert len(ROWS) >= 60
