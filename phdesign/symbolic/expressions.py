@@ -11,13 +11,7 @@ evaluated as Python (no :func:`eval`, no :func:`sympy.sympify` on raw text).
 Printing goes through sympy's ``str`` with each trace symbol renamed to the
 user syntax, so ``parse(format(expr)) == expr`` holds exactly.
 
-Grammar (``**`` and ``^`` are both powers)::
-
-    expr  := term (("+" | "-") term)*
-    term  := unary (("*" | "/") unary)*
-    unary := ("+" | "-") unary | power
-    power := atom (("**" | "^") unary)?
-    atom  := NUMBER | TRACE | NAME | NAME "(" expr ")" | "(" expr ")"
+The grammar and its limits live in :mod:`phdesign.symbolic.parser`.
 
 Examples
 --------
@@ -40,6 +34,7 @@ from typing import Literal
 import sympy
 
 from phdesign.errors import ExpressionError
+from phdesign.symbolic.parser import CONSTANTS, FUNCTIONS, Token, check_text, parse
 
 __all__ = [
     "Trace",
@@ -61,27 +56,8 @@ Side = Literal["a", "b"]
 #: The spatial variable of every model.
 Z = sympy.Symbol("z", real=True)
 
-MAX_LENGTH = 10_000
-MAX_DEPTH = 100
-MAX_EXPONENT = 64
-#: Largest bit length of the numerator or denominator of an exact number (about 1e300).
-MAX_NUMBER_BITS = 1000
-
-_FUNCTIONS: dict[str, Callable[[sympy.Expr], sympy.Expr]] = {
-    "sqrt": sympy.sqrt,
-    "exp": sympy.exp,
-    "log": sympy.log,
-    "sin": sympy.sin,
-    "cos": sympy.cos,
-    "tan": sympy.tan,
-    "sinh": sympy.sinh,
-    "cosh": sympy.cosh,
-    "tanh": sympy.tanh,
-    "atan": sympy.atan,
-}
-_CONSTANTS: dict[str, sympy.Expr] = {"pi": sympy.pi, "E": sympy.E}
 #: Names a parameter may not take: they mean something else in expressions.
-RESERVED_NAMES = frozenset({"z", "a", "b", *_FUNCTIONS, *_CONSTANTS})
+RESERVED_NAMES = frozenset({"z", "a", "b", *FUNCTIONS, *CONSTANTS})
 _TRACE_NAME = re.compile(r"e\d+\Z")
 _PARAMETER_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
@@ -235,223 +211,6 @@ def exactify(expr: sympy.Expr) -> sympy.Expr:
     return expr.xreplace({f: sympy.Rational(repr(float(f))) for f in floats})
 
 
-# --------------------------------------------------------------------------- tokenizer
-
-_TOKEN = re.compile(
-    r"""
-    (?P<space>\s+)
-  | (?P<trace>e(?P<comp>\d+)(?P<primes>'*)\(\s*(?P<point>[^()]*?)\s*\))
-  | (?P<number>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)
-  | (?P<name>[A-Za-z_][A-Za-z0-9_]*)
-  | (?P<op>\*\*|[-+*/^(),])
-    """,
-    re.VERBOSE,
-)
-
-
-@dataclass(frozen=True)
-class _Token:
-    kind: str
-    text: str
-    position: int
-    groups: tuple[str | None, ...] = ()
-
-
-def _tokenize(text: str) -> list[_Token]:
-    tokens: list[_Token] = []
-    position = 0
-    while position < len(text):
-        match = _TOKEN.match(text, position)
-        if match is None:
-            raise ExpressionError(
-                f"cannot read {text!r}: unexpected character {text[position]!r} "
-                f"at position {position}"
-            )
-        kind = match.lastgroup
-        if kind == "point" or kind == "primes" or kind == "comp":
-            kind = "trace"
-        if kind != "space":
-            groups = (match["comp"], match["primes"], match["point"]) if kind == "trace" else ()
-            tokens.append(_Token(str(kind), match.group(), position, groups))
-        position = match.end()
-    return tokens
-
-
-# --------------------------------------------------------------------------- parser
-
-
-@dataclass(frozen=True)
-class _Context:
-    text: str
-    parameters: frozenset[str]
-    allow_z: bool
-    trace_factory: Callable[[_Token], sympy.Expr] | None
-
-
-class _Parser:
-    """Recursive-descent parser building sympy expressions from whitelisted tokens."""
-
-    def __init__(self, context: _Context) -> None:
-        self.context = context
-        self.tokens = _tokenize(context.text)
-        self.index = 0
-        self.depth = 0
-
-    def parse(self) -> sympy.Expr:
-        if not self.tokens:
-            raise ExpressionError("empty expression; expected a number, symbol or trace")
-        expr = self.expr()
-        if self.index != len(self.tokens):
-            token = self.tokens[self.index]
-            raise ExpressionError(
-                f"cannot read {self.context.text!r}: unexpected {token.text!r} "
-                f"at position {token.position}"
-            )
-        return expr
-
-    def peek(self) -> _Token | None:
-        return self.tokens[self.index] if self.index < len(self.tokens) else None
-
-    def take(self, *texts: str) -> _Token | None:
-        token = self.peek()
-        if token is not None and token.kind == "op" and token.text in texts:
-            self.index += 1
-            return token
-        return None
-
-    def expect(self, text: str) -> None:
-        if self.take(text) is None:
-            token = self.peek()
-            found = "the end" if token is None else repr(token.text)
-            raise ExpressionError(
-                f"cannot read {self.context.text!r}: expected {text!r}, found {found}"
-            )
-
-    def enter(self) -> None:
-        self.depth += 1
-        if self.depth > MAX_DEPTH:
-            raise ExpressionError(f"expression nested deeper than {MAX_DEPTH} levels")
-
-    def expr(self) -> sympy.Expr:
-        self.enter()
-        value = self.term()
-        while (op := self.take("+", "-")) is not None:
-            rhs = self.term()
-            value = self.bounded(value + rhs if op.text == "+" else value - rhs)
-        self.depth -= 1
-        return value
-
-    def bounded(self, value: sympy.Expr) -> sympy.Expr:
-        """Refuse exact numbers too large to print or compute with (about 1e300)."""
-        for number in value.atoms(sympy.Rational):
-            if max(abs(number.p).bit_length(), number.q.bit_length()) > MAX_NUMBER_BITS:
-                raise ExpressionError(
-                    f"a number in {self.context.text!r} is out of range; "
-                    "expected magnitudes between 1e-300 and 1e300"
-                )
-        return value
-
-    def term(self) -> sympy.Expr:
-        value = self.unary()
-        while (op := self.take("*", "/")) is not None:
-            rhs = self.unary()
-            if op.text == "*":
-                value = self.bounded(value * rhs)
-            else:
-                if rhs == 0:
-                    raise ExpressionError(f"division by zero in {self.context.text!r}")
-                value = self.bounded(value / rhs)
-        return value
-
-    def unary(self) -> sympy.Expr:
-        self.enter()
-        if (op := self.take("+", "-")) is not None:
-            value = self.unary()
-            result = -value if op.text == "-" else value
-        else:
-            result = self.power()
-        self.depth -= 1
-        return result
-
-    def power(self) -> sympy.Expr:
-        base = self.atom()
-        if self.take("**", "^") is not None:
-            exponent = self.unary()
-            if exponent.is_number and abs(exponent) > MAX_EXPONENT:
-                raise ExpressionError(
-                    f"exponent {exponent} in {self.context.text!r} is too large; "
-                    f"expected at most {MAX_EXPONENT} in magnitude"
-                )
-            if base == 0 and exponent.is_number and exponent.is_nonpositive:
-                raise ExpressionError(f"division by zero in {self.context.text!r}")
-            return self.bounded(base**exponent)
-        return base
-
-    def atom(self) -> sympy.Expr:
-        token = self.peek()
-        if token is None:
-            raise ExpressionError(f"cannot read {self.context.text!r}: it ends too early")
-        self.index += 1
-        if token.kind == "number":
-            mantissa, _, exponent = token.text.lower().partition("e")
-            if len(mantissa) > 60 or (exponent and abs(int(exponent)) > 300):
-                raise ExpressionError(
-                    f"number {token.text!r} is out of range; expected magnitudes between "
-                    "1e-300 and 1e300 with at most 60 digits"
-                )
-            return sympy.Rational(token.text)
-        if token.kind == "trace":
-            if self.context.trace_factory is None:
-                raise ExpressionError(
-                    f"trace {token.text!r} is not allowed here; expected an expression "
-                    "in z and the parameters"
-                )
-            return self.context.trace_factory(token)
-        if token.kind == "name":
-            return self.name(token)
-        if token.text == "(":
-            value = self.expr()
-            self.expect(")")
-            return value
-        raise ExpressionError(
-            f"cannot read {self.context.text!r}: unexpected {token.text!r} "
-            f"at position {token.position}"
-        )
-
-    def name(self, token: _Token) -> sympy.Expr:
-        name = token.text
-        if name in _FUNCTIONS:
-            self.expect("(")
-            argument = self.expr()
-            self.expect(")")
-            return _FUNCTIONS[name](argument)
-        if name in _CONSTANTS:
-            return _CONSTANTS[name]
-        if name == "z":
-            if not self.context.allow_z:
-                raise ExpressionError(
-                    f"the spatial variable z is not allowed in {self.context.text!r}"
-                )
-            return Z
-        if name in self.context.parameters:
-            return parameter_symbol(name)
-        known = sorted(self.context.parameters)
-        raise ExpressionError(
-            f"unknown symbol {name!r} in {self.context.text!r}; "
-            f"known parameters: {', '.join(known) if known else 'none'}"
-        )
-
-
-def _check_text(text: object, what: str) -> str:
-    if not isinstance(text, str):
-        raise ExpressionError(f"{what} must be text; found {type(text).__name__} {text!r}")
-    if len(text) > MAX_LENGTH:
-        raise ExpressionError(
-            f"{what} is {len(text)} characters long; expected at most {MAX_LENGTH}"
-        )
-    return text
-
-
 def parse_scalar(
     text: str, parameters: Iterable[str] = (), allow_z: bool = True, what: str = "expression"
 ) -> sympy.Expr:
@@ -473,12 +232,30 @@ def parse_scalar(
     sympy.Expr
         The exact expression (decimals become rationals).
     """
-    _check_text(text, what)
-    context = _Context(text, frozenset(parameters), allow_z, None)
+    check_text(text, what)
     try:
-        return _Parser(context).parse()
+        return parse(text, _name_resolver(frozenset(parameters), allow_z))
     except ExpressionError as error:
         raise ExpressionError(f"{what}: {error}") from None
+
+
+def _name_resolver(parameters: frozenset[str], allow_z: bool) -> Callable[[str, str], sympy.Expr]:
+    """Resolve ``z`` and parameter names; any other name is an error that lists the known ones."""
+
+    def resolve(name: str, text: str) -> sympy.Expr:
+        if name == "z":
+            if not allow_z:
+                raise ExpressionError(f"the spatial variable z is not allowed in {text!r}")
+            return Z
+        if name in parameters:
+            return parameter_symbol(name)
+        known = sorted(parameters)
+        raise ExpressionError(
+            f"unknown symbol {name!r} in {text!r}; "
+            f"known parameters: {', '.join(known) if known else 'none'}"
+        )
+
+    return resolve
 
 
 def _point_text(interval: Sequence[object], side: Side) -> str:
@@ -515,10 +292,10 @@ def parse_trace_expression(
     sympy.Expr
         A linear form in the symbols of :func:`trace_symbol`, with no constant term.
     """
-    _check_text(text, what)
+    check_text(text, what)
     a, b = (sympy.Rational(str(sympy.sympify(p))) if _is_rational(p) else p for p in interval)
 
-    def make_trace(token: _Token) -> sympy.Expr:
+    def make_trace(token: Token) -> sympy.Expr:
         component_text, primes, point = token.groups
         component, derivative = int(str(component_text)), len(str(primes))
         if not 1 <= component <= size:
@@ -533,9 +310,8 @@ def parse_trace_expression(
             )
         return trace_symbol(component, derivative, _side_of(str(point), a, b, token.text))
 
-    context = _Context(text, frozenset(parameters), False, make_trace)
     try:
-        expr = _Parser(context).parse()
+        expr = parse(text, _name_resolver(frozenset(parameters), False), make_trace)
     except ExpressionError as error:
         raise ExpressionError(f"{what} {text!r}: {error}") from None
     linear_coefficients(expr, what=f"{what} {text!r}")
