@@ -62,8 +62,13 @@ def test_symbolic_gain_json(capsys):
     data = json.loads(out)
     r34 = data["results"][10]
     assert r34["holds"] is True
-    assert r34["kappa"] is None  # no number for symbolic gains; the expression is exact
-    assert r34["kappa_exact"] == "Min(l2, l1/(l1**2 + 1))"
+    # DESIGN.md: kappa is null only when not applicable or unbounded; for symbolic gains it
+    # is the exact expression (paper §IV-D, corrected: min(l2, l1/(1 + l1²)))
+    assert r34["kappa"] == r34["kappa_exact"] == "Min(l2, l1/(l1**2 + 1))"
+    failing = data["results"][4]  # 3.3 variant 1 fails: its witness makes the ratio 0
+    assert (failing["proposition"], failing["holds"], failing["kappa"]) == ("3.3", False, 0.0)
+    not_applicable = data["results"][2]  # 3.2 is for N = 1
+    assert not_applicable["kappa"] is None
     assert r34["conditions"] == "holds for all positive l1, l2"
 
 

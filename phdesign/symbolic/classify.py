@@ -108,13 +108,21 @@ class VariantResult:
         """``"asymptotic"`` or ``"exponential"``."""
         return "asymptotic" if self.proposition == "3.1" else "exponential"
 
-    def kappa_json(self) -> float | None:
-        r""":math:`\kappa^*` for the JSON ``kappa`` key: a float, or ``None``."""
-        if not self.holds or self.unbounded:
+    def kappa_json(self) -> float | str | None:
+        r""":math:`\kappa^*` for the JSON ``kappa`` key (DESIGN.md).
+
+        ``None`` only when the variant is not applicable or :math:`\kappa^*` is unbounded
+        (or has no closed form for symbolic gains); ``0.0`` for a failing variant (its
+        witness makes the ratio zero); a float for numeric gains; the exact expression,
+        as text, for symbolic gains.
+        """
+        if not self.applicable or self.unbounded:
             return None
+        if not self.holds:
+            return 0.0
         if self.kappa_float is not None:
             return self.kappa_float
-        return None
+        return None if self.kappa is None else str(self.kappa)
 
 
 @dataclass(frozen=True)
