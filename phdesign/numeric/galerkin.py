@@ -71,10 +71,11 @@ boundary conditions strongly creates spurious real eigenvalues drifting to 0.  P
 1.8e-7, 5.8e-12, 1.3e-12, 1e-14, 6e-15 at p = 40; :func:`trace_scaling` is α = 2N − 3/2
 with the exact constants.
 
-``DEFAULT_BASIS`` selects the basis when none is given; it is still ``"legendre"``
-because a spectrum regression test relies on that basis's round-off at degree 27 (its
-pinned copy is in ``tests/test_numeric_conditioning.py``).  Setting it to ``"scaled"``
-also raises the N >= 3 degree cap of :func:`phdesign.numeric.spectrum.default_resolutions`.
+``DEFAULT_BASIS`` selects the basis when none is given: ``"auto"`` (the default) takes
+the trace-scaled basis for N >= 3, where it turns 9 digits into 15 on the airy error
+abscissa, and the plain Legendre basis for N <= 2, where both agree to round-off and
+the Legendre basis keeps E well conditioned for any H(z). The choice also sets the
+N >= 3 degree cap of :func:`phdesign.numeric.spectrum.default_resolutions`.
 """
 
 from __future__ import annotations
@@ -88,12 +89,33 @@ from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel, trace_index
 from phdesign.numeric.phs import DiscretePHS
 
-__all__ = ["BASES", "DEFAULT_BASIS", "galerkin", "legendre_basis", "trace_scaling"]
+__all__ = [
+    "BASES",
+    "DEFAULT_BASIS",
+    "galerkin",
+    "legendre_basis",
+    "resolve_basis",
+    "trace_scaling",
+]
 
 BASES = ("scaled", "legendre")
 #: Basis used by :func:`galerkin` (and so by :func:`phdesign.numeric.discretize.discretize`
-#: and the spectrum) when none is given.
-DEFAULT_BASIS = "legendre"
+#: and the spectrum) when none is given: "auto", "scaled" or "legendre".
+DEFAULT_BASIS = "auto"
+
+
+def resolve_basis(basis: str | None, order: int) -> str:
+    """Return the basis :func:`galerkin` uses for a model of order ``order``.
+
+    Examples
+    --------
+    >>> resolve_basis(None, 3), resolve_basis(None, 2), resolve_basis("scaled", 1)
+    ('scaled', 'legendre', 'scaled')
+    """
+    chosen = DEFAULT_BASIS if basis is None else basis
+    if chosen == "auto":
+        return "scaled" if order >= 3 else "legendre"
+    return chosen
 
 
 @lru_cache(maxsize=64)
@@ -174,7 +196,7 @@ def galerkin(nm: NumericModel, degree: int, basis: str | None = None) -> Discret
     N, n, p = nm.order, nm.size, int(degree)
     if p < N + 1:
         raise NumericError(f"Galerkin degree must be at least N + 1 = {N + 1}; found {p}")
-    basis = DEFAULT_BASIS if basis is None else basis
+    basis = resolve_basis(basis, nm.order)
     if basis not in BASES:
         raise NumericError(f"unknown Galerkin basis {basis!r}; expected one of {BASES}")
     iv = nm.interval

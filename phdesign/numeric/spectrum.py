@@ -234,7 +234,7 @@ def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
         # entries of order p^(4N-3) into the closed matrix and round-off grows with p:
         # start low, cap low, and let the best-agreeing pair win.  The trace-scaled basis
         # keeps the airy abscissa to ~1e-14 up to degree 140 (galerkin module docstring).
-        return (8, 110) if galerkin.DEFAULT_BASIS == "scaled" else (8, 48)
+        return (8, 110) if galerkin.resolve_basis(None, nm.order) == "scaled" else (8, 48)
     return 20, {1: 100, 2: 110}[nm.order]
 
 
