@@ -20,8 +20,10 @@ def exact_abscissa(k):
     return 0.5 * np.log(abs((1 - k) / (1 + k)))
 
 
-@pytest.mark.parametrize("k", [0.25, 0.5, 0.75, 3.0])
+@pytest.mark.parametrize("k", [0.25, 0.5, 0.75, 3.0, 10.0, 100.0])
 def test_wave_damper_abscissa_is_exact(k):
+    # k = 10 and 100: every eigenvalue shares the abscissa; the noisy high frequencies
+    # once made the report say "not converged" although the value was exact (review)
     rep = spectrum(numeric("wave"), SENSOR2, np.array([[k]]))
     assert rep.converged
     assert not rep.unbounded_below

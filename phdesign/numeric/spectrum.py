@@ -335,11 +335,15 @@ def spectrum(
         }
         if idx.size:
             res_lam = fine[idx]
-            j = int(np.argmax(res_lam.real))
+            # drift of each resolved eigenvalue's real part between the two resolutions
+            nearest = coarse[np.argmin(np.abs(coarse[None, :] - res_lam[:, None]), axis=1)]
+            drifts = np.abs(res_lam.real - nearest.real)
+            # the abscissa is the eigenvalue with the largest real part *less its drift*:
+            # where many eigenvalues share the abscissa (a wave damper with k > 1), a
+            # noisy high frequency must not stand for an exactly resolved low one
+            j = int(np.argmax(res_lam.real - drifts))
             alpha = float(res_lam.real[j])
-            # drift of the abscissa itself between the two resolutions
-            nearest = coarse[np.argmin(np.abs(coarse - res_lam[j]))]
-            d_alpha = abs(alpha - float(nearest.real))
+            d_alpha = float(drifts[j])
             entry.update({"spectral_abscissa": alpha, "abscissa_drift": d_alpha})
             result = {
                 "lam": fine,
