@@ -19,6 +19,7 @@ __all__ = [
     "load_model",
     "observer_matrices",
     "parse_parameter_overrides",
+    "sensor_matrix_from_args",
     "write_output",
 ]
 
@@ -84,6 +85,18 @@ def add_observer_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def sensor_matrix_from_args(args: argparse.Namespace, model: BCPHS) -> Any:
+    """Return ``C_m`` from ``--sensors`` or ``--cm``, or ``None`` when neither is given."""
+    from phdesign.symbolic import observer
+
+    n_outputs = model.order * model.size
+    if args.sensors is not None:
+        return observer.parse_sensors(args.sensors, n_outputs)
+    if args.cm is not None:
+        return observer.parse_cm(args.cm, n_outputs)
+    return None
+
+
 def observer_matrices(args: argparse.Namespace, model: BCPHS) -> tuple[Any, Any] | None:
     """Return ``(C_m, L)`` from ``--sensors``/``--cm`` and ``--gain``, or ``None``.
 
@@ -91,12 +104,8 @@ def observer_matrices(args: argparse.Namespace, model: BCPHS) -> tuple[Any, Any]
     """
     from phdesign.symbolic import observer
 
-    n_outputs = model.order * model.size
-    if args.sensors is not None:
-        C_m = observer.parse_sensors(args.sensors, n_outputs)
-    elif args.cm is not None:
-        C_m = observer.parse_cm(args.cm, n_outputs)
-    else:
+    C_m = sensor_matrix_from_args(args, model)
+    if C_m is None:
         if getattr(args, "gain", None) is not None:
             raise ObserverError("--gain needs --sensors or --cm to say which outputs are measured")
         return None

@@ -25,6 +25,7 @@ from phdesign.cli.common import (
     emit_json,
     load_model,
     observer_matrices,
+    sensor_matrix_from_args,
     write_output,
 )
 from phdesign.errors import NumericError
@@ -198,20 +199,13 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _tune(args: argparse.Namespace) -> int:
-    from phdesign.numeric.bridge import gain_to_numeric
+    from phdesign.numeric.bridge import gain_to_numeric, to_numeric
     from phdesign.numeric.tune import tune
-    from phdesign.symbolic import observer
 
     _check_positive("--starts", args.starts)
     model = load_model(args)
-    from phdesign.numeric.bridge import to_numeric
-
     nm = to_numeric(model)
-    n_out = model.order * model.size
-    if args.sensors is not None:
-        C_m = observer.parse_sensors(args.sensors, n_out)
-    else:
-        C_m = observer.parse_cm(args.cm, n_out)
+    C_m = sensor_matrix_from_args(args, model)  # argparse requires --sensors or --cm here
     res = tune(nm, gain_to_numeric(C_m, "C_m"), full=args.full, starts=args.starts, seed=args.seed)
     if args.json:
         emit_json({"model": model.name, **res.to_dict()})

@@ -288,15 +288,12 @@ def gain_to_numeric(matrix: Any, name: str = "L") -> np.ndarray:
 
     Raises :class:`ParameterError` when a symbol is left (e.g. ``--gain symbolic``).
     """
-    try:
-        import sympy
+    import sympy
 
-        if isinstance(matrix, sympy.MatrixBase):
-            if matrix.free_symbols:
-                raise ParameterError(_free_symbols_message(name, set(matrix.free_symbols)))
-            return np.array(matrix.evalf(), dtype=float)
-    except ImportError:  # pragma: no cover - sympy is a hard dependency
-        pass
+    if isinstance(matrix, sympy.MatrixBase):
+        if matrix.free_symbols:
+            raise ParameterError(_free_symbols_message(name, set(matrix.free_symbols)))
+        return np.array(matrix.evalf(), dtype=float)
     try:
         return np.array(matrix, dtype=float)
     except (TypeError, ValueError) as exc:

@@ -194,11 +194,12 @@ def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | N
         roots = sympy.real_roots(poly)
     except (sympy.PolynomialError, NotImplementedError, sympy.DomainError):
         try:
-            roots = [r for r in sympy.roots(poly, _MU) if r.is_real]
+            all_roots = sympy.roots(poly, _MU)
         except Exception:
             return None
-        if sum(sympy.roots(poly, _MU).values()) != poly.degree():
+        if sum(all_roots.values()) != poly.degree():  # not every root has a closed form
             return None
+        roots = [r for r in all_roots if r.is_real]
     if not roots:
         return None
     mu_max = max(roots, key=lambda r: float(r.evalf(30)))
