@@ -84,7 +84,12 @@ def test_closed_matrix_norm_and_mass_condition_at_degree_40():
     small = lam_sc[np.abs(lam_sc) < 1e4]
     assert small.size >= 5
     gap = np.min(np.abs(small[:, None] - lam_leg[None, :]), axis=1)
-    assert gap.max() < 1e-8, gap
+    # Relative, as the congruence argument gives: QZ's error grows with |lambda|.  Against
+    # mpmath eigenvalues (40 digits) of the Legendre pencil, the scaled basis is off by
+    # 1.1e-7 at |lambda| = 9187 (1.2e-11 relative) and the Legendre one by 8e-10; an
+    # absolute 1e-8 held on one OpenBLAS build and failed on another.
+    relative_gap = gap / np.maximum(1.0, np.abs(small))
+    assert relative_gap.max() < 1e-10, relative_gap  # measured 1.3e-11
 
 
 def test_spectrum_of_airy_converges_to_11_digits_with_the_scaled_basis(monkeypatch):
