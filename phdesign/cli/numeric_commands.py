@@ -28,6 +28,12 @@ from phdesign.cli.common import (
     sensor_matrix_from_args,
     write_output,
 )
+from phdesign.cli.noise_commands import (
+    add_noise_tuning_arguments,
+    add_stochastic_arguments,
+    noise_tuning,
+    stochastic_simulation,
+)
 from phdesign.errors import NumericError
 
 __all__ = ["register"]
@@ -79,6 +85,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument("--output", "-o", metavar="FILE", help="write to FILE instead of stdout")
     sim.add_argument("--plot", metavar="FILE", help="also draw a summary figure to FILE")
     sim.add_argument("--force", action="store_true", help="overwrite existing files")
+    add_stochastic_arguments(sim)
     sim.set_defaults(handler=_simulate)
 
     tn = subparsers.add_parser("tune", help="observer gain minimizing the converged abscissa")
@@ -89,6 +96,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     tn.add_argument("--full", action="store_true", help="full L instead of positive diagonal")
     tn.add_argument("--starts", type=int, default=6, help="number of starts")
     tn.add_argument("--seed", type=int, default=0, help="seed of the random starts")
+    add_noise_tuning_arguments(tn)
     add_json_argument(tn)
     tn.set_defaults(handler=_tune)
 
@@ -167,7 +175,7 @@ def _simulate(args: argparse.Namespace) -> int:
         from phdesign.plots import check_plot_path
 
         check_plot_path(args.plot, args.force)
-    res = simulate(
+    res = (stochastic_simulation(args) or simulate)(
         nm,
         C_m,
         L,
@@ -202,6 +210,8 @@ def _tune(args: argparse.Namespace) -> int:
     from phdesign.numeric.bridge import gain_to_numeric, to_numeric
     from phdesign.numeric.tune import tune
 
+    if (noisy := noise_tuning(args)) is not None:  # --max-rms / --objective rms
+        return noisy
     _check_positive("--starts", args.starts)
     model = load_model(args)
     nm = to_numeric(model)
