@@ -238,6 +238,9 @@ def peak_gain(
         ]
     )
     grid = np.unique(grid[(grid >= 0) & (grid <= upper)])
+    # conjugate eigenvalues give frequencies equal to round-off: one grid point each, or a
+    # local maximum would be bracketed by its own twin
+    grid = grid[np.r_[True, np.diff(grid) > 1e-12 * np.maximum(1.0, grid[1:])]]
     values = response(grid)
     interior = np.r_[True, values[1:] >= values[:-1]] & np.r_[values[:-1] >= values[1:], True]
     candidates = np.flatnonzero(interior)
