@@ -89,7 +89,7 @@ def plot_tradeoff(
             zorder=4,
         )
     labelled = {"pareto": front, "all": pts, "none": []}.get(annotate, front)
-    for p in labelled:
+    for p in _spread(labelled):
         ax.annotate(
             describe_gain(p.gain),
             (p.rms, p.decay_rate),
@@ -112,6 +112,21 @@ def plot_tradeoff(
     if path is not None:
         save_figure(fig, path, force=force)
     return fig
+
+
+def _spread(points: list[Any], gap: float = 0.035) -> list[Any]:
+    """Drop labels that would overlap the previous one (log rms, linear decay, relative)."""
+    if not points:
+        return []
+    lx = np.log10([p.rms for p in points])
+    y = np.array([p.decay_rate for p in points])
+    sx, sy = max(float(np.ptp(lx)), 1e-12), max(float(np.ptp(y)), 1e-12)
+    kept = [0]
+    for i in range(1, len(points)):
+        j = kept[-1]
+        if abs(lx[i] - lx[j]) / sx > gap * 3 or abs(y[i] - y[j]) / sy > gap * 2:
+            kept.append(i)
+    return [points[i] for i in kept]
 
 
 def plot_noise_report(
@@ -139,6 +154,16 @@ def plot_noise_report(
         g = report.l2_gain
         if g.value is not None and g.frequency:
             left.plot(g.frequency, g.value, "k*", ms=12, label=f"γ = {g.value:.4g}")
+        disc = g.discrete
+        if disc is not None and disc.values and g.discrete_frequency:
+            # a sharp resonance of an unresolved mode falls between the plotted samples
+            left.plot(
+                g.discrete_frequency,
+                disc.values[-1],
+                "rx",
+                ms=9,
+                label=f"discretization's supremum {disc.values[-1]:.3g}",
+            )
         left.legend(loc="lower left", fontsize=8)
     left.set(
         xlabel="frequency ω [rad/s]",

@@ -22,6 +22,7 @@ Noise options (shared):
 from __future__ import annotations
 
 import argparse
+import math
 from typing import Any
 
 from phdesign.cli.common import (
@@ -132,7 +133,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     tr.add_argument("--output", "-o", metavar="FILE", help="write the table to FILE")
     tr.add_argument("--plot", metavar="FILE", help="draw decay rate against RMS to FILE")
     tr.add_argument("--force", action="store_true", help="overwrite existing files")
-    tr.set_defaults(handler=_tradeoff)
+    tr.set_defaults(handler=_tradeoff, gain=None)  # the family gives the gains
 
 
 # ----------------------------------------------------------------------------- parsing
@@ -326,14 +327,18 @@ def stochastic_simulation(args: argparse.Namespace) -> Any:
         raise ObserverError("--noise-intensity needs an observer: give --sensors or --cm")
     return partial(
         simulate_noisy,
-        noise_intensity=None
-        if args.noise_intensity is None
-        else _numbers(args.noise_intensity, "--noise-intensity"),
-        input_intensity=None
-        if args.input_noise is None
-        else _numbers(args.input_noise, "--input-noise"),
+        noise_intensity=_listed_intensities(args.noise_intensity, "--noise-intensity"),
+        input_intensity=_listed_intensities(args.input_noise, "--input-noise"),
         seed=args.seed,
     )
+
+
+def _listed_intensities(text: str | None, flag: str) -> Any:
+    """Intensities checked for sign and finiteness (the library checks their count)."""
+    if text is None:
+        return None
+    values = _numbers(text, flag)
+    return _intensities(text, len(values), flag)
 
 
 # ----------------------------------------------------------------------------- tune
@@ -384,6 +389,11 @@ def noise_tuning(args: argparse.Namespace) -> int | None:
         raise NumericError("--max-rms goes with the abscissa objective")
     if args.full:
         raise NumericError("noise-aware tuning searches positive diagonal gains; drop --full")
+    for flag, value in (("--max-rms", args.max_rms), ("--min-decay", args.min_decay)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise NumericError(f"{flag} must be a positive number; found {value}")
+    if args.objective == "rms" and args.min_decay is None:
+        raise NumericError("--objective rms needs --min-decay A (the decay rate to keep)")
     from phdesign.cli.common import load_model, sensor_matrix_from_args
     from phdesign.numeric.bridge import gain_to_numeric, to_numeric
     from phdesign.numeric.noise_tune import tune_noise

@@ -33,7 +33,7 @@ from itertools import product
 from typing import Any
 
 import numpy as np
-from scipy.optimize import minimize
+from scipy.optimize import minimize, minimize_scalar
 
 from phdesign.errors import NumericError, ObserverError
 from phdesign.numeric.bridge import NumericModel
@@ -220,9 +220,12 @@ def tune_noise(
     start = noise(nm, C, np.eye(q), intensity=sigma, input_intensity=w_in, performance=functionals)
     first = spectrum(nm, C, np.eye(q))
     p_lo = first.resolutions[0] if first.converged else 30
+    p_rms = max(_first_agreeing(e, _tol_of(start)) or 30 for e in start.performance)
+    # the variance is solved at the coarse member of the abscissa pair when it has converged
+    # there (one triangularization then gives both), else at its own resolution
+    p_lo = p_rms if p_rms <= p_lo else p_lo
     pair = [discretize(nm, "galerkin", p) for p in (p_lo, math.ceil(1.5 * p_lo))]
-    converged_at = [e.resolutions[-2] for e in start.performance if e.converged]
-    d_rms = discretize(nm, "galerkin", max(converged_at) if converged_at else 30)
+    d_rms = pair[0] if p_rms <= p_lo else discretize(nm, "galerkin", p_rms)
     rows = [f.row(d_rms) for f in functionals]
     count = [0]
 
@@ -230,10 +233,10 @@ def tune_noise(
         count[0] += 1
         L = np.diag(np.exp(np.clip(x, -30.0, 30.0)))
         K = feedback_matrix(C, L, nm.n_ports)
-        coarse = eigen(pair[0], K)[0]
+        stats = error_statistics(d_rms, C, L, sigma, w_in)
+        coarse = stats.eigenvalues if d_rms is pair[0] else eigen(pair[0], K)[0]
         fine, kappa = eigen(pair[1], K, condition=True)
         alpha = resolved_abscissa(fine, coarse, kappa=kappa)
-        stats = error_statistics(d_rms, C, L, sigma, w_in)
         return alpha, math.sqrt(max(stats.variance(r) for r in rows))
 
     def merit(x: np.ndarray) -> float:
@@ -245,17 +248,30 @@ def tune_noise(
         return rms + _PENALTY * max(rms, 1e-300) * max(0.0, (alpha + bound) / bound)
 
     grid = _start_grid(q, log_range)
-    scored = sorted(((merit(x), i) for i, x in enumerate(grid)), key=lambda t: t[0])
-    best_x, best_f = grid[scored[0][1]], scored[0][0]
-    for _, i in scored[:2]:
-        found = minimize(
-            merit,
-            grid[i],
-            method="Nelder-Mead",
-            options={"maxiter": maxiter * q, "xatol": 1e-5, "fatol": 1e-9},
+    scores = [merit(x) for x in grid]
+    order = np.argsort(scores)
+    best_x, best_f = grid[int(order[0])], float(scores[int(order[0])])
+    if q == 1:  # Brent between the grid neighbours of the best start
+        k = int(order[0])
+        lo, hi = grid[max(k - 1, 0)][0], grid[min(k + 1, len(grid) - 1)][0]
+        found = minimize_scalar(
+            lambda v: merit(np.array([v])),
+            bounds=(lo, hi),
+            method="bounded",
+            options={"xatol": 1e-6},
         )
         if found.fun < best_f:
-            best_x, best_f = found.x, float(found.fun)
+            best_x, best_f = np.array([found.x]), float(found.fun)
+    else:
+        for i in order[:2]:
+            found = minimize(
+                merit,
+                grid[int(i)],
+                method="Nelder-Mead",
+                options={"maxiter": maxiter * q, "xatol": 1e-5, "fatol": 1e-9},
+            )
+            if found.fun < best_f:
+                best_x, best_f = found.x, float(found.fun)
     L = np.diag(np.exp(best_x))
     spec = spectrum(nm, C, L)
     report = noise(nm, C, L, intensity=sigma, input_intensity=w_in, performance=functionals)
@@ -286,6 +302,22 @@ def tune_noise(
         evaluations=count[0],
         warnings=tuple(warnings),
     )
+
+
+def _tol_of(report: NoiseReport) -> float:
+    """Return the agreement the noise report was judged with (its method's default)."""
+    from phdesign.numeric.noise import DEFAULT_TOL
+
+    return DEFAULT_TOL.get(report.method, 1e-3)
+
+
+def _first_agreeing(est: Any, tol: float) -> int | None:
+    """Return the coarsest resolution whose value agrees with the next one to ``tol``."""
+    for k in range(len(est.values) - 1):
+        a, b = est.values[k], est.values[k + 1]
+        if math.isfinite(a + b) and abs(b - a) <= tol * abs(b):
+            return int(est.resolutions[k])
+    return None
 
 
 def _positive(value: float | None, name: str, why: str) -> float:

@@ -245,31 +245,36 @@ class Tradeoff:
         return plot_tradeoff(self, path, force=force, annotate=annotate)
 
 
-def pareto_mask(decay: Sequence[float | None], rms: Sequence[float | None]) -> list[bool]:
+def pareto_mask(
+    decay: Sequence[float | None],
+    rms: Sequence[float | None],
+    decay_tol: float = 1e-8,
+    rms_tol: float = 1e-6,
+) -> list[bool]:
     """Mark the points no other point beats in both (larger decay, smaller rms).
 
-    Points with a missing figure are never Pareto-optimal.
+    Values closer than the relative tolerances (the figures' own accuracy under
+    refinement) count as equal: a gain is not Pareto-optimal for a decay rate that beats
+    another's by round-off.  Points with a missing figure are never Pareto-optimal.
 
     Examples
     --------
-    >>> pareto_mask([1.0, 2.0, 1.5, None], [0.1, 0.3, 0.4, 0.0])
-    [True, True, False, False]
+    >>> pareto_mask([1.0, 2.0, 1.5, None, 1.0 + 1e-12], [0.1, 0.3, 0.4, 0.0, 0.2])
+    [True, True, False, False, False]
     """
-    ok = [d is not None and r is not None for d, r in zip(decay, rms, strict=True)]
-    out = []
-    for i, (di, ri) in enumerate(zip(decay, rms, strict=True)):
-        if not ok[i]:
-            out.append(False)
-            continue
-        dominated = any(
-            ok[j]
-            and decay[j] >= di  # type: ignore[operator]
-            and rms[j] <= ri  # type: ignore[operator]
-            and (decay[j] > di or rms[j] < ri)  # type: ignore[operator]
-            for j in range(len(decay))
-        )
-        out.append(not dominated)
-    return out
+    pts = [(d, r) for d, r in zip(decay, rms, strict=True)]
+
+    def beats(a: tuple[float, float], b: tuple[float, float]) -> bool:
+        td = decay_tol * max(1.0, abs(b[0]))
+        tr = rms_tol * abs(b[1])
+        no_worse = a[0] >= b[0] - td and a[1] <= b[1] + tr
+        return no_worse and (a[0] > b[0] + td or a[1] < b[1] - tr)
+
+    known = [(d, r) for d, r in pts if d is not None and r is not None]
+    return [
+        d is not None and r is not None and not any(beats(o, (d, r)) for o in known)
+        for d, r in pts
+    ]
 
 
 def gain_family(
