@@ -315,7 +315,7 @@ def test_library_errors_name_the_argument():
         noise(nm, PAPER_SENSORS, np.eye(2), intensity=[1.0, -1.0])
     with pytest.raises(NumericError, match="expected 2 values"):
         noise(nm, PAPER_SENSORS, np.eye(2), intensity=[1.0, 1.0, 1.0])
-    with pytest.raises(ObserverError, match="need sensors"):
+    with pytest.raises(ObserverError, match="noise figures: sensors needed"):
         noise(nm, np.zeros((0, 4)), np.zeros((0, 0)))
     with pytest.raises(NumericError, match="outside the interval"):
         noise(nm, PAPER_SENSORS, np.eye(2), performance=["w(1.5)"])

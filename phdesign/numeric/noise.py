@@ -78,7 +78,9 @@ __all__ = [
     "error_statistics",
     "noise",
     "noise_input",
+    "noise_intensities",
     "peak_gain",
+    "sensor_rows",
 ]
 
 #: Default relative agreement of a noise figure between two resolutions.
@@ -117,6 +119,28 @@ def check_intensity(values: Any, count: int, name: str) -> np.ndarray:
             f"time); found {bad[0]}"
         )
     return arr
+
+
+def noise_intensities(
+    nm: NumericModel, q: int, intensity: Any, input_intensity: Any, default: float = 1.0
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Return the checked sensor and input intensities (sensors: ``default`` when None).
+
+    The input intensities stay None (no input noise) unless given.
+    """
+    sigma = check_intensity(default if intensity is None else intensity, q, "intensity")
+    w_in = None
+    if input_intensity is not None:
+        w_in = check_intensity(input_intensity, nm.n_ports, "input intensity")
+    return sigma, w_in
+
+
+def sensor_rows(C_m: Any, what: str) -> np.ndarray:
+    """Return C_m as a 2-D float array, refusing an empty one (``what`` needs sensors)."""
+    C = np.atleast_2d(np.asarray(C_m, dtype=float))
+    if C.size == 0:
+        raise ObserverError(f"{what}: sensors needed; give C_m with at least one row")
+    return C
 
 
 def noise_input(
@@ -327,18 +351,10 @@ def noise(
     >>> round(rep.performance[0].value, 8), rep.error_energy.diverges  # Var = k/2
     (0.25, True)
     """
-    C = np.atleast_2d(np.asarray(C_m, dtype=float))
-    if C.size == 0 or C.shape[0] == 0:
-        raise ObserverError("noise figures need sensors: give C_m with at least one row")
+    C = sensor_rows(C_m, "the noise figures")
     Lm = np.atleast_2d(np.asarray(L, dtype=float))
     feedback_matrix(C, Lm, nm.n_ports)  # shapes and L + L^T > 0, before any work
-    q = C.shape[0]
-    sigma = check_intensity(1.0 if intensity is None else intensity, q, "intensity")
-    w_in = (
-        None
-        if input_intensity is None
-        else check_intensity(input_intensity, nm.n_ports, "input intensity")
-    )
+    sigma, w_in = noise_intensities(nm, C.shape[0], intensity, input_intensity)
     functionals = parse_functionals(performance, nm, model)
     if tol is None:
         tol = DEFAULT_TOL.get(method, 1e-3)

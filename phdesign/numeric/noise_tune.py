@@ -35,11 +35,11 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 
-from phdesign.errors import NumericError, ObserverError
+from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize, feedback_matrix
 from phdesign.numeric.functionals import Functional, parse_functionals
-from phdesign.numeric.noise import check_intensity, error_statistics, noise
+from phdesign.numeric.noise import error_statistics, noise, noise_intensities, sensor_rows
 from phdesign.numeric.noise_report import NoiseReport, describe_gain, html_table
 from phdesign.numeric.refinement import finite_or_none
 from phdesign.numeric.spectrum import SpectrumReport, eigen, resolved_abscissa, spectrum
@@ -194,9 +194,7 @@ def tune_noise(
     -------
     NoiseTuneResult
     """
-    C = np.atleast_2d(np.asarray(C_m, dtype=float))
-    if C.size == 0:
-        raise ObserverError("noise-aware tuning needs sensors: give C_m with at least one row")
+    C = sensor_rows(C_m, "noise-aware tuning")
     q = C.shape[0]
     feedback_matrix(C, np.eye(q), nm.n_ports)
     if objective == "abscissa":
@@ -205,12 +203,7 @@ def tune_noise(
         bound = _positive(min_decay, "min_decay", "the RMS objective needs a decay rate")
     else:
         raise NumericError(f"objective must be 'abscissa' or 'rms'; found {objective!r}")
-    sigma = check_intensity(1.0 if intensity is None else intensity, q, "intensity")
-    w_in = (
-        None
-        if input_intensity is None
-        else check_intensity(input_intensity, nm.n_ports, "input intensity")
-    )
+    sigma, w_in = noise_intensities(nm, q, intensity, input_intensity)
     functionals = parse_functionals(performance, nm, model)
     if not functionals:
         raise NumericError(

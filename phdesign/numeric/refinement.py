@@ -113,8 +113,8 @@ def settle(
 
     Examples
     --------
-    >>> settle("E[H]", [2.255, 3.128, 4.424], [20, 30, 45], 1e-6).status()
-    'diverges (grows like p^0.86)'
+    >>> settle("E[H]", [2.0, 3.0, 4.5], [20, 30, 45], 1e-6).status()  # linear in p
+    'diverges (grows like p^1.00)'
     >>> settle("w(1)", [0.1347085750, 0.1347085724], [20, 30], 1e-6).status()
     'converged (7.7 digits)'
     """

@@ -49,7 +49,7 @@ import scipy.linalg as sl
 from phdesign.errors import NumericError, ObserverError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
-from phdesign.numeric.noise import check_intensity
+from phdesign.numeric.noise import noise_intensities
 from phdesign.numeric.simulate import (
     SimulationResult,
     _dissipation_integral,
@@ -177,12 +177,7 @@ def simulate_noisy(
         raise ObserverError("sensor noise needs an observer: give the sensors C_m and gain L")
     d = discrete if discrete is not None else discretize(nm, method, resolution)
     q = 0 if C_m is None else np.atleast_2d(C_m).shape[0]
-    sigma = None if noise_intensity is None else check_intensity(noise_intensity, q, "intensity")
-    w_in = (
-        None
-        if input_intensity is None
-        else check_intensity(input_intensity, nm.n_ports, "input intensity")
-    )
+    sigma, w_in = noise_intensities(nm, q, noise_intensity, input_intensity, default=0.0)
     base = simulate(
         nm, C_m, L, x0=x0, xhat0=xhat0, t_end=t_end, samples=samples, u=u, z_w=z_w, discrete=d
     )
@@ -214,7 +209,7 @@ def simulate_noisy(
         if "states_hat" in changes:
             changes["w_hat"] = changes["states_hat"] @ Wd.T
     described = []
-    if sigma is not None:
+    if noise_intensity is not None:
         described.append(f"sensor intensity {', '.join(f'{s:g}' for s in sigma)}")
     if w_in is not None:
         described.append(f"input intensity {', '.join(f'{s:g}' for s in w_in)}")

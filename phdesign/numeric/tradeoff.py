@@ -25,11 +25,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.errors import NumericError, ObserverError
+from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, feedback_matrix
 from phdesign.numeric.functionals import Functional, parse_functionals
-from phdesign.numeric.noise import noise
+from phdesign.numeric.noise import noise, sensor_rows
 from phdesign.numeric.noise_report import NoiseReport, describe_gain, describe_sensors, html_table
 from phdesign.numeric.refinement import finite_or_none
 from phdesign.numeric.spectrum import spectrum
@@ -340,9 +340,7 @@ def tradeoff(
     -------
     Tradeoff
     """
-    C = np.atleast_2d(np.asarray(C_m, dtype=float))
-    if C.size == 0:
-        raise ObserverError("a trade-off needs sensors: give C_m with at least one row")
+    C = sensor_rows(C_m, "a trade-off")
     q = C.shape[0]
     functionals = parse_functionals(performance, nm, model)
     if not functionals:
