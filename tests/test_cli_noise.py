@@ -44,7 +44,7 @@ def alpha(k: float) -> float:
     return 0.5 * math.log(abs((1 - k) / (1 + k)))
 
 
-def test_noise_json_contract_and_text_is_the_report(capsys):
+def test_noise_json_contract_and_text_is_the_report(capsys, tmp_path):
     argv = ["noise", "euler-bernoulli", "--sensors", "3,4", "--gain", "0.1,1", "--at", "1"]
     status, out, _ = run(capsys, *argv, "--intensity", "0.01,0.04", "--json")
     assert status == 0
@@ -61,7 +61,9 @@ def test_noise_json_contract_and_text_is_the_report(capsys):
     assert energy["diverges"] is True
     assert energy["value"] is None
     assert len(energy["values"]) == len(data["resolutions"]) >= 3
-    status, text, _ = run(capsys, *argv, "--intensity", "0.01,0.04")
+    picture = tmp_path / "noise.png"
+    status, text, _ = run(capsys, *argv, "--intensity", "0.01,0.04", "--plot", str(picture))
+    assert picture.stat().st_size > 0
     report = noise(
         numeric("euler-bernoulli"),
         PAPER_SENSORS,

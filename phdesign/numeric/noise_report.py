@@ -244,7 +244,7 @@ class NoiseReport:
         res = ", ".join(str(r) for r in self.resolutions)
         lines = [self.header(), f"steady-state error ({self.method}, resolutions {res}):"]
         if not self.performance:
-            lines.append("  performance outputs: none (the model defines no displacement)")
+            lines.append("  performance outputs: none")
         for est in self.performance:
             if est.value is not None:
                 lines.append(
