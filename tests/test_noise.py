@@ -178,6 +178,17 @@ def test_beam_l2_gain_equals_the_continuum_peak(gain, where):
     assert max(g.estimate.values) - min(g.estimate.values) < 1e-9 * exact
 
 
+def test_gain_without_uniform_decay_is_flagged_not_reported():
+    """Timoshenko with only y1 measured: no uniform decay (the error modes' damping tends to
+    0 at high frequency; issue 10 item 7), so the resonance peaks grow with frequency and
+    the peak over the resolved band sits at its edge and grows with every refinement."""
+    rep = noise(numeric("timoshenko"), np.array([[1.0, 0.0, 0.0, 0.0]]), np.eye(1), performance=[])
+    gain = rep.l2_gain
+    assert gain.value is None
+    assert gain.diverges
+    assert any("edge of the resolved band" in w for w in rep.warnings)
+
+
 def test_frequency_sweep_equals_hamiltonian_bisection_and_the_resolvent():
     """On small discretizations (fully resolved as finite systems) the sweep + Brent peak
     over all frequencies equals the Boyd-Balakrishnan bisection, and a dense evaluation of

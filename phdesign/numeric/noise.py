@@ -55,7 +55,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, MutableMapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -452,6 +452,9 @@ class _Refinement:
             self.tol,
             pair=(last["coarse"][0], last["fine"][0]),
         )
+        if last["fine"][1] >= (1 - 1e-6) * last["band"] and estimate.converged:
+            # a peak at the band's edge is where the resolved frequencies end, not a maximum
+            estimate = replace(estimate, converged=False)
         return GainEstimate(
             estimate=estimate,
             frequency=last["fine"][1],

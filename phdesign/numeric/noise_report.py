@@ -89,7 +89,16 @@ class GainEstimate:
                 "no resolved frequency band and the L2-gain is not computed"
             ]
         out = []
-        if not est.converged and not est.diverges:
+        if (
+            self.frequency is not None
+            and self.band is not None
+            and self.frequency >= (1 - 1e-6) * self.band
+        ):
+            out.append(
+                f"the L2-gain peaks at the edge of the resolved band (ω = {self.band:.4g}): "
+                "its supremum lies at frequencies this resolution does not resolve"
+            )
+        elif not est.converged and not est.diverges:
             out.append(
                 f"the L2-gain peak over the resolved band did not converge to {tol:g} "
                 f"({est.values[-1]:.6g} at resolution {est.resolutions[-1]})"
