@@ -472,7 +472,7 @@ def aliasing_warning(
 
     Examples
     --------
-    >>> aliasing_warning(2e-2, 3e-5, 0.3, "point", 1e-3)[:59]
+    >>> aliasing_warning(2e-2, 3e-5, 0.3, "point", 1e-3)[:60]
     'the sampled observer error floor 0.02 is 667x the continuous'
     >>> aliasing_warning(4e-5, 3e-5, 0.3, "average", 1e-3) is None
     True
