@@ -156,8 +156,6 @@ def _environment() -> Any:
 def _context(observer: SampledObserver, filename: str = "observer.py") -> dict[str, Any]:
     from phdesign import __version__
 
-    if not all(np.all(np.isfinite(m)) for m in (observer.A, observer.B, observer.C, observer.D)):
-        raise NumericError("the observer's matrices are not finite: nothing to export")
     states = [f"xhat{i + 1}" for i in range(observer.order)]
     inputs, outputs = list(observer.inputs), list(observer.outputs)
     meaning = {
@@ -248,6 +246,9 @@ def write_observer(
     from phdesign.io import atomic_write
 
     target = check_export_path(path, format, force)
+    matrices = (observer.A, observer.B, observer.C, observer.D, observer.energy_matrix)
+    if not all(np.all(np.isfinite(m)) for m in matrices):
+        raise NumericError("the observer's matrices are not finite: nothing was written")
     if format == "c":
         files = render_c(observer)
         write_directory(target, files, force=force)

@@ -43,12 +43,10 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.order import REDUCTIONS, OrderSelection, check_order, select_order
 from phdesign.numeric.sampling import (
     ContinuousObserver,
-    aliasing_warning,
     check_sampling,
     default_initial_state,
-    error_floor,
     hold_discretization,
-    run_loop,
+    run_against_continuous,
 )
 
 __all__ = [
@@ -204,14 +202,11 @@ def verify_observer(
     check_order(observer.order, plant.dim, plant.resolution)
     n_steps = max(1, round(t_end / dt))
     stride = max(1, round(t_end / ((max(samples, 2) - 1) * dt)))
-    runs = [
-        run_loop(plant, observer, C_m, x0=x0, dt=dt, n_steps=n_steps, stride=stride, sampler=s)
-        for s in (sampler, None)
-    ]
-    errors = [r.performance_error(observer) for r in runs]
-    (floor, _), (cont, _) = (error_floor(runs[0].t, e, runs[0].target) for e in errors)
-    peak = float(np.max(np.abs(runs[0].target)))
-    warning = aliasing_warning(floor, cont, peak, sampler, dt)
+    sampled, continuous, (floor, cont), warning = run_against_continuous(
+        plant, observer, C_m, sampler=sampler, x0=x0, dt=dt, n_steps=n_steps, stride=stride
+    )
+    errors = [r.performance_error(observer) for r in (sampled, continuous)]
+    peak = float(np.max(np.abs(sampled.target)))
     return Verification(
         plant_degree=plant.resolution,
         plant_order=plant.dim,
@@ -219,7 +214,7 @@ def verify_observer(
         sampler=sampler,
         x0=x0_text,
         outputs=tuple(observer.outputs[i] for i in observer.performance),
-        t=runs[0].t,
+        t=sampled.t,
         error=errors[0],
         continuous_error=errors[1],
         peak=peak,

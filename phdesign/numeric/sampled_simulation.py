@@ -27,9 +27,8 @@ from phdesign.numeric.discretize import discretize
 from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.sampling import (
     ContinuousObserver,
-    aliasing_warning,
     check_sampling,
-    error_floor,
+    run_against_continuous,
     run_loop,
 )
 from phdesign.numeric.simulate import SimulationResult
@@ -139,37 +138,14 @@ def simulate_sampled(
     e0 = plant.project(x0 or zero)
     xh0 = d_obs.project(xhat0 or zero)
     kind = None if dt is None else sampler
-    run = run_loop(
-        plant,
-        observer,
-        C_m,
-        x0=e0,
-        xhat0=xh0,
-        dt=step,
-        n_steps=n_steps,
-        stride=stride,
-        sampler=kind,
-        u=U,
-    )
     warnings: tuple[str, ...] = ()
-    if kind is not None:
-        reference = run_loop(
-            plant,
-            observer,
-            C_m,
-            x0=e0,
-            xhat0=xh0,
-            dt=step,
-            n_steps=n_steps,
-            stride=stride,
-            sampler=None,
-            u=U,
-        )
-        floors = [
-            error_floor(r.t, r.performance_error(observer), r.target)[0] for r in (run, reference)
-        ]
-        peak = float(np.max(np.abs(run.target)))
-        warning = aliasing_warning(floors[0], floors[1], peak, sampler, step)
+    if kind is None:
+        run = run_loop(plant, observer, C_m, x0=e0, xhat0=xh0, dt=step, n_steps=n_steps, u=U)
+    else:
+        run, _, _, warning = run_against_continuous(
+            plant, observer, C_m, sampler=kind, x0=e0, xhat0=xh0, dt=step, n_steps=n_steps,
+            stride=stride, u=U,
+        )  # fmt: skip
         warnings = () if warning is None else (warning,)
     m = nm.n_ports
     gap = run.x - run.xhat @ P.T

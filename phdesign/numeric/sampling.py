@@ -84,6 +84,7 @@ __all__ = [
     "default_initial_state",
     "error_floor",
     "hold_discretization",
+    "run_against_continuous",
     "run_loop",
     "sample_plant",
     "sensor_names",
@@ -447,6 +448,39 @@ def run_loop(
         yhat=xhat @ observer.C.T + v @ observer.D.T,
         target=target,
     )
+
+
+def run_against_continuous(
+    plant: DiscretePHS,
+    observer: ContinuousObserver,
+    C_m: np.ndarray,
+    *,
+    sampler: str,
+    x0: np.ndarray,
+    xhat0: np.ndarray | None = None,
+    dt: float,
+    n_steps: int,
+    stride: int = 1,
+    u: np.ndarray | None = None,
+) -> tuple[LoopRun, LoopRun, tuple[float, float], str | None]:
+    """Run the sampled and the continuous observer on the same plant, data and records.
+
+    Returns both runs (sampled first), their performance error floors
+    (:func:`error_floor`, absolute) and the :func:`aliasing_warning` (or None).
+    """
+    runs = [
+        run_loop(
+            plant, observer, C_m, x0=x0, xhat0=xhat0, dt=dt, n_steps=n_steps, stride=stride,
+            sampler=s, u=u,
+        )
+        for s in (sampler, None)
+    ]  # fmt: skip
+    sampled, continuous = (
+        error_floor(r.t, r.performance_error(observer), r.target)[0] for r in runs
+    )
+    peak = float(np.max(np.abs(runs[0].target)))
+    warning = aliasing_warning(sampled, continuous, peak, sampler, dt)
+    return runs[0], runs[1], (sampled, continuous), warning
 
 
 def error_floor(t: np.ndarray, error: np.ndarray, signal: np.ndarray) -> tuple[float, float]:
