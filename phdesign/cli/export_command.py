@@ -86,7 +86,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     ex.add_argument(
         "--x0",
         metavar="EXPRS",
-        help="plant initial state of the verification (default every x_i = (z-a)/(b-a) - 0.9)",
+        help="plant initial state of the order selection and verification runs (default "
+        "every x_i = (z-a)/(b-a) - 0.9)",
     )
     ex.add_argument(
         "--t-end", type=float, default=5.0, metavar="T", help="verification time (default 5)"
