@@ -28,6 +28,7 @@ from phdesign.cli.common import (
     sensor_matrix_from_args,
     write_output,
 )
+from phdesign.cli.export_command import add_sampling_arguments, sampled_simulation
 from phdesign.errors import NumericError
 
 __all__ = ["register"]
@@ -79,6 +80,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument("--output", "-o", metavar="FILE", help="write to FILE instead of stdout")
     sim.add_argument("--plot", metavar="FILE", help="also draw a summary figure to FILE")
     sim.add_argument("--force", action="store_true", help="overwrite existing files")
+    add_sampling_arguments(sim)  # --dt, --sampler, --observer-resolution (export command)
     sim.set_defaults(handler=_simulate)
 
     tn = subparsers.add_parser("tune", help="observer gain minimizing the converged abscissa")
@@ -167,7 +169,8 @@ def _simulate(args: argparse.Namespace) -> int:
         from phdesign.plots import check_plot_path
 
         check_plot_path(args.plot, args.force)
-    res = simulate(
+    # a sampled or lower-order observer (--dt, --sampler, --observer-resolution), else None
+    res = sampled_simulation(args, nm, C_m, L, x0, xh0) or simulate(
         nm,
         C_m,
         L,
