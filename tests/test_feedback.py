@@ -284,3 +284,17 @@ def test_models_with_feedback_and_P0z_round_trip_exactly(model):
     assert model_to_toml(again) == text
     assert all(value == 0 for value in closed_ports(again).identities.values())
     assert any("exact on [a, b]" in check for check in again.checks)
+
+
+def test_closed_ports_print_short_and_refuse_what_is_not_a_model():
+    closed = closed_ports(load_builtin("wave-damper"))
+    assert repr(closed) == "ClosedPorts(closed=[2], gain=[[k]], max residual=0)"
+    assert str(closed).startswith("feedback u_c = -K y_c on inputs [2], K = [[k]]")
+    assert "e1(1)*k + e2(1) = 0" in closed._repr_html_()
+    assert closed.to_dict()["boundary_conditions"] == ["e1(1)*k + e2(1) = 0"]
+    with pytest.raises(ModelError, match="model must be a BCPHS; found str"):
+        closed_ports("wave")
+    with pytest.raises(ModelError, match="has no \\[feedback\\] section"):
+        closed_ports(load_builtin("wave"))
+    with pytest.raises(ModelError, match="model must be a BCPHS"):
+        close_inputs(None, [1], [[1]])

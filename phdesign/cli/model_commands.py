@@ -121,13 +121,6 @@ def _ports(args: argparse.Namespace) -> int:
         *(f"max |{key}| = {value:g}" for key, value in identities.items()),
     ]
     if closed is not None:
-        lines += [
-            f"feedback u_c = -K y_c on inputs {[i + 1 for i in closed.closed]}, K = "
-            f"{closed.gain.tolist()}: boundary conditions "
-            + ", ".join(closed.boundary_conditions()),
-            "closed plant W_B' (closed rows first) =",
-            sympy.pretty(closed.W_B),
-            *(f"max |{key}| = {float(value):g}" for key, value in closed.identities.items()),
-        ]
+        lines.append(str(closed))
     emit("\n".join(lines))
     return 0

@@ -226,8 +226,10 @@ def close_inputs(model: BCPHS, inputs: Sequence[int], gain: Any) -> BCPHS:
     >>> damped.feedback.inputs, damped.n_ports
     ((2,), 1)
     """
-    from phdesign.symbolic.model import parse_matrix
+    from phdesign.symbolic.model import BCPHS, parse_matrix
 
+    if not isinstance(model, BCPHS):
+        raise ModelError(f"model must be a BCPHS; found {type(model).__name__} {model!r}")
     nn = model.order * model.size
     external = external_indices(nn, model.feedback)
     picked = list(inputs)
@@ -299,6 +301,43 @@ class ClosedPorts:
             for i in range(self.boundary.rows)
         )
 
+    def __repr__(self) -> str:
+        """Short form: which inputs are closed, the gain and the identities' residuals."""
+        worst = max((abs(float(v)) for v in self.identities.values()), default=0.0)
+        return (
+            f"ClosedPorts(closed={[i + 1 for i in self.closed]}, gain={self.gain.tolist()}, "
+            f"max residual={worst:g})"
+        )[:300]
+
+    def __str__(self) -> str:
+        """Return the text ``phdesign ports`` prints for the closed plant."""
+        import sympy as sp
+
+        return "\n".join(
+            [
+                f"feedback u_c = -K y_c on inputs {[i + 1 for i in self.closed]}, K = "
+                f"{self.gain.tolist()}: boundary conditions "
+                + ", ".join(self.boundary_conditions()),
+                "closed plant W_B' (closed rows first) =",
+                sp.pretty(self.W_B),
+                *(f"max |{key}| = {float(value):g}" for key, value in self.identities.items()),
+            ]
+        )
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        rows = "".join(
+            f"<tr><td>{escape(key)}</td><td>{escape(str(value))}</td></tr>"
+            for key, value in (
+                ("closed inputs", [i + 1 for i in self.closed]),
+                ("gain K", self.gain.tolist()),
+                ("boundary conditions", "; ".join(self.boundary_conditions())),
+                *self.identities.items(),
+            )
+        )
+        return f"<table><caption>closed plant</caption>{rows}</table>"
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary (exact entries as strings)."""
         return {
@@ -328,8 +367,11 @@ def closed_ports(model: BCPHS) -> ClosedPorts:
         If a closed-plant identity fails (it cannot when the open identities hold: the
         check guards the derivation).
     """
+    from phdesign.symbolic.model import BCPHS
     from phdesign.symbolic.ports import derive_ports, sigma_matrix
 
+    if not isinstance(model, BCPHS):
+        raise ModelError(f"model must be a BCPHS; found {type(model).__name__} {model!r}")
     if model.feedback is None:
         raise ModelError(f"model {model.name!r} has no [feedback] section")
     N, n = model.order, model.size
