@@ -10,6 +10,7 @@ from scipy.integrate import simpson
 
 from phdesign import plots
 from phdesign.cli import main
+from phdesign.errors import ModelError
 from phdesign.io import model_from_toml, model_to_toml
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import input_function, to_numeric
@@ -42,6 +43,13 @@ def test_plot_labels_carry_the_units_the_model_states_and_none_it_does_not():
         ax = plots.plot_hamiltonians(run).axes[0]
         assert (ax.get_xlabel(), ax.get_ylabel()) == (time, energy)
         assert run.to_dict()["units"] == model.unit_map
+
+
+def test_units_must_be_a_mapping_of_known_quantities_to_plain_text():
+    with pytest.raises(ModelError, match="units must be a mapping"):
+        string("s")
+    with pytest.raises(ModelError, match=r"units\.rho = .* is malformed"):  # no backslash
+        string({"rho": "kg\\m"})
 
 
 def test_simulate_json_reports_the_units(capsys):

@@ -252,7 +252,7 @@ class BCPHS:
             description=description,
             displacement=displacement,
             feedback=None if feedback is None else feedback_from_mapping(feedback, names),
-            units=tuple((units or {}).items()),
+            units=_unit_pairs(units),
             derived_outputs=derived,
         )
 
@@ -329,6 +329,16 @@ def _port(
         f'{what} must be a trace expression such as "e1(0)"; found {type(value).__name__} '
         f"{value!r}"
     )
+
+
+def _unit_pairs(units: object) -> tuple[tuple[Any, Any], ...]:
+    if units is None:
+        return ()
+    if not isinstance(units, Mapping):
+        raise ModelError(
+            f"units must be a mapping {{quantity: unit}} such as {{'t': 's'}}; found {units!r}"
+        )
+    return tuple(units.items())
 
 
 def _interval(interval: Sequence[object]) -> tuple[sympy.Expr, sympy.Expr]:
