@@ -326,6 +326,40 @@ COMMAND_ROWS = [
         "is not contained in the plant's",
         NumericError,
     ),
+    # --- issue 13 (model): plant inputs --u, closed plants ([feedback])
+    row(
+        "simulate wave --u u3:sin(t)",
+        "--u: unknown input 'u3'; the model's inputs are u1, u2",
+        ParameterError,
+    ),
+    row(
+        "simulate wave-damper --u u2:t",
+        "unknown input 'u2'; the model's inputs are u1",
+        ParameterError,
+    ),
+    row("simulate wave --u u1", "--u item 'u1': expected 'u<i>: expression in t'", ParameterError),
+    row("simulate wave --u u1:1,u1:2", "--u: input 'u1' given twice", ParameterError),
+    row(
+        "simulate wave --u u1:sin(q*t)",
+        "unknown symbol 'q' in 'sin(q*t)'; expected t",
+        ExpressionError,
+    ),
+    row("simulate wave --u u1:__import__('os')", "unexpected character", ExpressionError),
+    row("simulate wave --u u1:log(t-1)", "--u: input u1 is not finite at t = 0", NumericError),
+    row(
+        "simulate wave --u u1:exp(exp(1000*t))", "input u1 is not finite at t = 0.01", NumericError
+    ),
+    row(
+        "classify wave-damper --sensors 2",
+        "output index 2 is out of range; expected 1..1",
+        ObserverError,
+    ),
+    row("spectrum wave-damper --param k=-1", "K + K^T must be positive semidefinite", ModelError),
+    row(
+        "spectrum beam-tip-damper --cm [[0,0,0,1]]",
+        r"expected \(q, 3\) but found \(1, 4\)",
+        ObserverError,
+    ),
 ]
 
 

@@ -71,6 +71,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "--x0", metavar="EXPRS", help="plant initial state, e.g. 'x1: 0, x2: z - 0.9'"
     )
     sim.add_argument("--xhat0", metavar="EXPRS", help="observer initial state (default zero)")
+    sim.add_argument(
+        "--u", metavar="EXPRS", help="plant inputs in t, e.g. 'u2: sin(2*t)' (others zero)"
+    )
     sim.add_argument("--t-end", type=float, default=5.0, metavar="T", help="final time")
     sim.add_argument("--samples", type=int, default=501, help="output samples on [0, T]")
     sim.add_argument("--scheme", choices=("expm", "midpoint"), default="expm")
@@ -148,7 +151,7 @@ def _spectrum(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from phdesign.numeric.bridge import initial_state_function
+    from phdesign.numeric.bridge import initial_state_function, input_function
     from phdesign.numeric.simulate import simulate
 
     _check_positive("--resolution", args.resolution)
@@ -160,6 +163,7 @@ def _simulate(args: argparse.Namespace) -> int:
         raise NumericError("--xhat0 needs an observer: give --sensors or --cm")
     x0 = initial_state_function(args.x0, nm, model=model)
     xh0 = initial_state_function(args.xhat0, nm, model=model)
+    u = input_function(args.u, nm, model=model)
     # refuse unwritable or existing outputs before the (possibly long) simulation
     if args.output:
         from phdesign.io import check_output_path
@@ -181,6 +185,7 @@ def _simulate(args: argparse.Namespace) -> int:
         method=args.method,
         resolution=args.resolution,
         scheme=args.scheme,
+        u=u,
     )
     if args.json:
         import json
