@@ -318,6 +318,20 @@ def stochastic_simulation(args: argparse.Namespace) -> Any:
         if args.seed is not None:
             raise NumericError("--seed needs --noise-intensity or --input-noise")
         return None
+    sampled = [
+        flag
+        for flag, name in (
+            ("--dt", "dt"),
+            ("--sampler", "sampler"),
+            ("--observer-resolution", "observer_resolution"),
+        )
+        if getattr(args, name, None) is not None
+    ]
+    if sampled:
+        raise NumericError(
+            f"the noise options run the continuous observer; {sampled[0]} asks for a sampled "
+            "one: give one or the other"
+        )
     from functools import partial
 
     from phdesign.numeric.stochastic import simulate_noisy

@@ -28,6 +28,7 @@ from phdesign.cli.common import (
     sensor_matrix_from_args,
     write_output,
 )
+from phdesign.cli.export_command import add_sampling_arguments, sampled_simulation
 from phdesign.cli.noise_commands import (
     add_noise_tuning_arguments,
     add_stochastic_arguments,
@@ -76,6 +77,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "--x0", metavar="EXPRS", help="plant initial state, e.g. 'x1: 0, x2: z - 0.9'"
     )
     sim.add_argument("--xhat0", metavar="EXPRS", help="observer initial state (default zero)")
+    sim.add_argument(
+        "--u", metavar="EXPRS", help="plant inputs in t, e.g. 'u2: sin(2*t)' (others zero)"
+    )
     sim.add_argument("--t-end", type=float, default=5.0, metavar="T", help="final time")
     sim.add_argument("--samples", type=int, default=501, help="output samples on [0, T]")
     sim.add_argument("--scheme", choices=("expm", "midpoint"), default="expm")
@@ -85,6 +89,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument("--output", "-o", metavar="FILE", help="write to FILE instead of stdout")
     sim.add_argument("--plot", metavar="FILE", help="also draw a summary figure to FILE")
     sim.add_argument("--force", action="store_true", help="overwrite existing files")
+    add_sampling_arguments(sim)  # --dt, --sampler, --observer-resolution (export command)
     add_stochastic_arguments(sim)
     sim.set_defaults(handler=_simulate)
 
@@ -154,7 +159,7 @@ def _spectrum(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from phdesign.numeric.bridge import initial_state_function
+    from phdesign.numeric.bridge import initial_state_function, input_function
     from phdesign.numeric.simulate import simulate
 
     _check_positive("--resolution", args.resolution)
@@ -166,6 +171,7 @@ def _simulate(args: argparse.Namespace) -> int:
         raise NumericError("--xhat0 needs an observer: give --sensors or --cm")
     x0 = initial_state_function(args.x0, nm, model=model)
     xh0 = initial_state_function(args.xhat0, nm, model=model)
+    u = input_function(args.u, nm, model=model)
     # refuse unwritable or existing outputs before the (possibly long) simulation
     if args.output:
         from phdesign.io import check_output_path
@@ -175,7 +181,10 @@ def _simulate(args: argparse.Namespace) -> int:
         from phdesign.plots import check_plot_path
 
         check_plot_path(args.plot, args.force)
-    res = (stochastic_simulation(args) or simulate)(
+    # a noisy run (--noise-intensity, --input-noise), else None
+    noisy = stochastic_simulation(args)
+    # a sampled or lower-order observer (--dt, --sampler, --observer-resolution), else None
+    res = sampled_simulation(args, nm, C_m, L, x0, xh0) or (noisy or simulate)(
         nm,
         C_m,
         L,
@@ -186,6 +195,7 @@ def _simulate(args: argparse.Namespace) -> int:
         method=args.method,
         resolution=args.resolution,
         scheme=args.scheme,
+        u=u,
     )
     if args.json:
         import json

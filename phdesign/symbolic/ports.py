@@ -80,6 +80,8 @@ class PortedSystem(Protocol):
     def outputs(self) -> tuple[sympy.Expr, ...]: ...
     @property
     def parameter_defaults(self) -> dict[sympy.Symbol, sympy.Expr]: ...
+    @property
+    def interval(self) -> tuple[sympy.Expr, sympy.Expr]: ...
 
 
 __all__ = [
@@ -87,6 +89,7 @@ __all__ = [
     "Ports",
     "coefficient_matrix",
     "derive_ports",
+    "extended_matrices",
     "q_matrix",
     "trace_index",
     "trace_list",
@@ -146,6 +149,22 @@ def q_matrix(P: Sequence[sympy.MatrixBase], order: int) -> sympy.ImmutableMatrix
         for i in range(1, order + 1)
     ]
     return sympy.ImmutableMatrix(sympy.BlockMatrix(blocks).as_explicit())
+
+
+def extended_matrices(
+    P: Sequence[sympy.MatrixBase], order: int
+) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix]:
+    r"""Return :math:`R_{ext} = \tfrac{1}{\sqrt2}[[Q, -Q], [I, I]]` and its inverse."""
+    Q = q_matrix(P, order)
+    eye = sympy.eye(Q.rows)
+    R_ext = sympy.ImmutableMatrix(
+        sympy.BlockMatrix([[Q, -Q], [eye, eye]]).as_explicit() / sympy.sqrt(2)
+    )
+    Q_inv = Q.inv()
+    R_inv = sympy.ImmutableMatrix(
+        sympy.BlockMatrix([[Q_inv, eye], [-Q_inv, eye]]).as_explicit() / sympy.sqrt(2)
+    )
+    return R_ext, R_inv
 
 
 def coefficient_matrix(
@@ -220,13 +239,7 @@ def derive_ports(model: PortedSystem) -> Ports:
     N, n = model.order, model.size
     Q = q_matrix(model.P, N)
     eye = sympy.eye(N * n)
-    R_ext = sympy.ImmutableMatrix(
-        sympy.BlockMatrix([[Q, -Q], [eye, eye]]).as_explicit() / sympy.sqrt(2)
-    )
-    Q_inv = Q.inv()
-    R_inv = sympy.ImmutableMatrix(
-        sympy.BlockMatrix([[Q_inv, eye], [-Q_inv, eye]]).as_explicit() / sympy.sqrt(2)
-    )
+    R_ext, R_inv = extended_matrices(model.P, N)
     U = coefficient_matrix(model.inputs, N, n, "inputs")
     Y = coefficient_matrix(model.outputs, N, n, "outputs")
     defaults = model.parameter_defaults
@@ -257,6 +270,12 @@ def derive_ports(model: PortedSystem) -> Ports:
         largest = _max_abs(residual, defaults)
         identities[key] = largest
         if not all(vanishes(x) for x in residual):
+            if key == "WB_Sigma_WBt":  # the inputs alone are wrong: say so, naming them
+                from phdesign.symbolic.conjugate import inadmissible_inputs_message
+
+                raise PortError(
+                    inadmissible_inputs_message(residual, model.inputs, model.interval, defaults)
+                )
             at = " at the parameter defaults" if residual.free_symbols else ""
             raise PortError(
                 f"port identity {statements[key]} fails: largest residual |entry| = "
