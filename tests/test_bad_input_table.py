@@ -289,6 +289,7 @@ COMMAND_ROWS = [
     row(f"{SIM} --noise-intensity 1,1", "intensity: expected 1 values", NumericError),
     row(f"{SIM} --seed 3", "--seed needs --noise-intensity or --input-noise", NumericError),
     row(f"{SIM} --noise-intensity 1 --scheme midpoint", "scheme does not apply", NumericError),
+    row(f"{SIM} --noise-intensity 1 --dt 0.01", "--dt asks for a sampled one", NumericError),
     row("tune wave --sensors 2 --max-rms -1", "--max-rms must be a positive number", NumericError),
     row(
         "tune wave --sensors 2 --objective rms", "--objective rms needs --min-decay", NumericError
