@@ -48,6 +48,9 @@ def row(argv: str, message: str, error: type[Exception] | None, **files: str) ->
 BEAM_SENSORS = "classify euler-bernoulli --sensors"
 BEAM_GAIN = "classify euler-bernoulli --sensors 3,4 --gain"
 SIM = "simulate wave --sensors 2"
+NOISE = "noise euler-bernoulli --sensors 3,4"
+TRADE = "tradeoff euler-bernoulli --sensors 3,4"
+TUNE_BEAM = "tune euler-bernoulli --sensors 3,4"
 EXPORT = "export euler-bernoulli --sensors 3,4 --gain 0.1,1 --format json"
 COMMAND_ROWS = [
     # model selection and parameters
@@ -231,6 +234,69 @@ COMMAND_ROWS = [
     row("tune wave", "tune: one of the arguments --sensors --cm is required", None),
     row("tune wave --sensors 5", "output index 5 is out of range; expected 1..2", ObserverError),
     row("tune wave --sensors 2 --starts 0", "--starts", NumericError),
+    # noise figures, trade-off, noise-aware tuning and stochastic simulation (issue 14)
+    row("noise wave", "noise needs --sensors or --cm", ObserverError),
+    row(f"{NOISE} --intensity -1", "--intensity: intensities must be finite and", NumericError),
+    row(
+        f"{NOISE} --intensity nan,1",
+        "non-negative (variances per unit time); found nan",
+        NumericError,
+    ),
+    row(f"{NOISE} --intensity 1,2,3", "expected 2 values (one per channel)", NumericError),
+    row(f"{NOISE} --intensity x", "--intensity: expected comma-separated numbers", NumericError),
+    row(f"{NOISE} --input-noise -0.5", "--input-noise: intensities must be finite", NumericError),
+    row(f"{NOISE} --at 2", "displacement point 2 is outside the interval [0, 1]", NumericError),
+    row("noise wave --sensors 2 --at 1", "the model 'wave' defines no displacement", NumericError),
+    row(f"{NOISE} --integral x9:1", "integral weight: unknown component 'x9'", ParameterError),
+    row(f"{NOISE} --integral e1:1", "'e1' is an effort; weigh state components", ParameterError),
+    row(
+        f"{NOISE} --integral x2:q*z",
+        "integral weight expression: unknown symbol 'q'",
+        ExpressionError,
+    ),
+    row(f"{NOISE} --trace e9(1)", "component index in 'e9(1)' is out of range", ExpressionError),
+    row(f"{NOISE} --trace e1(0.5)", "is at an interior or outside point 0.5", ExpressionError),
+    row(f"{NOISE} --tol 0", "--tol must be positive; found 0", NumericError),
+    row(
+        f"{NOISE} --plot {{tmp}}/noise.png",
+        "exists; pass --force",
+        OutputFileError,
+        **{"noise.png": "an earlier picture"},
+    ),
+    row("tradeoff wave", "one of the arguments --sensors --cm is required", None),
+    row("tradeoff wave --sensors 2", "the trade-off needs a performance output", NumericError),
+    row(f"{TRADE} --grid 0.1:1", "--grid: expected lo:hi:count or one value", NumericError),
+    row(
+        f"{TRADE} --grid 1:0.1:3,1", "expected 0 < lo < hi and a count of at least 2", NumericError
+    ),
+    row(
+        f"{TRADE} --grid 0.1:1:3", "grid: expected 2 axes (one per sensor); found 1", NumericError
+    ),
+    row(f"{TRADE} --direction 0.1,-1", "--direction: expected 2 positive values", NumericError),
+    row(f"{TRADE} --grid 1,1 --scales 1:2:3", "--scales belongs to a ray", NumericError),
+    row(
+        f"{TRADE} -o {{tmp}}/trade.csv",
+        "exists; pass --force",
+        OutputFileError,
+        **{"trade.csv": "earlier results"},
+    ),
+    row("simulate wave --noise-intensity 1", "--noise-intensity needs an observer", ObserverError),
+    row(
+        f"{SIM} --noise-intensity -1",
+        "--noise-intensity: intensities must be finite",
+        NumericError,
+    ),
+    row(f"{SIM} --noise-intensity 1,1", "intensity: expected 1 values", NumericError),
+    row(f"{SIM} --seed 3", "--seed needs --noise-intensity or --input-noise", NumericError),
+    row(f"{SIM} --noise-intensity 1 --scheme midpoint", "scheme does not apply", NumericError),
+    row(f"{SIM} --noise-intensity 1 --dt 0.01", "--dt asks for a sampled one", NumericError),
+    row("tune wave --sensors 2 --max-rms -1", "--max-rms must be a positive number", NumericError),
+    row(
+        "tune wave --sensors 2 --objective rms", "--objective rms needs --min-decay", NumericError
+    ),
+    row("tune wave --sensors 2 --intensity 2", "--intensity needs --max-rms", NumericError),
+    row("tune wave --sensors 2 --max-rms 0.5", "needs a performance output", NumericError),
+    row(f"{TUNE_BEAM} --max-rms 0.1 --full", "drop --full", NumericError),
     # export and the sampled simulation (issue 15): checked before any work, nothing written
     row(
         f"{EXPORT} --dt 0 -o {{tmp}}/o.json", "--dt must be a finite positive number", NumericError

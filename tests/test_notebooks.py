@@ -44,12 +44,13 @@ def kernel_name(tmp_path_factory: pytest.TempPathFactory) -> str:
     mp.undo()
 
 
-def test_there_are_four_notebooks():
+def test_there_are_six_notebooks():
     assert [p.stem for p in PATHS] == [
         "01_quickstart",
         "02_euler_bernoulli_paper",
         "03_wave_and_timoshenko",
         "04_higher_order",
+        "05_noise_tradeoff",
         "06_implementation",
     ]
 

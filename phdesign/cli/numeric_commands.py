@@ -29,6 +29,12 @@ from phdesign.cli.common import (
     write_output,
 )
 from phdesign.cli.export_command import add_sampling_arguments, sampled_simulation
+from phdesign.cli.noise_commands import (
+    add_noise_tuning_arguments,
+    add_stochastic_arguments,
+    noise_tuning,
+    stochastic_simulation,
+)
 from phdesign.errors import NumericError
 
 __all__ = ["register"]
@@ -84,6 +90,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument("--plot", metavar="FILE", help="also draw a summary figure to FILE")
     sim.add_argument("--force", action="store_true", help="overwrite existing files")
     add_sampling_arguments(sim)  # --dt, --sampler, --observer-resolution (export command)
+    add_stochastic_arguments(sim)
     sim.set_defaults(handler=_simulate)
 
     tn = subparsers.add_parser("tune", help="observer gain minimizing the converged abscissa")
@@ -94,6 +101,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     tn.add_argument("--full", action="store_true", help="full L instead of positive diagonal")
     tn.add_argument("--starts", type=int, default=6, help="number of starts")
     tn.add_argument("--seed", type=int, default=0, help="seed of the random starts")
+    add_noise_tuning_arguments(tn)
     add_json_argument(tn)
     tn.set_defaults(handler=_tune)
 
@@ -173,8 +181,10 @@ def _simulate(args: argparse.Namespace) -> int:
         from phdesign.plots import check_plot_path
 
         check_plot_path(args.plot, args.force)
+    # a noisy run (--noise-intensity, --input-noise), else None
+    noisy = stochastic_simulation(args)
     # a sampled or lower-order observer (--dt, --sampler, --observer-resolution), else None
-    res = sampled_simulation(args, nm, C_m, L, x0, xh0) or simulate(
+    res = sampled_simulation(args, nm, C_m, L, x0, xh0) or (noisy or simulate)(
         nm,
         C_m,
         L,
@@ -210,6 +220,8 @@ def _tune(args: argparse.Namespace) -> int:
     from phdesign.numeric.bridge import gain_to_numeric, to_numeric
     from phdesign.numeric.tune import tune
 
+    if (noisy := noise_tuning(args)) is not None:  # --max-rms / --objective rms
+        return noisy
     _check_positive("--starts", args.starts)
     model = load_model(args)
     nm = to_numeric(model)

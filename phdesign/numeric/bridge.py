@@ -39,6 +39,7 @@ __all__ = [
     "input_function",
     "to_numeric",
     "trace_index",
+    "trace_row",
 ]
 
 
@@ -389,11 +390,55 @@ def gain_to_numeric(matrix: Any, name: str = "L") -> np.ndarray:
         raise ParameterError(f"{name}: cannot convert to a numeric matrix ({exc})") from exc
 
 
+def trace_row(text: str, nm: NumericModel, model: Any = None) -> np.ndarray:
+    """Read a linear combination of boundary traces, ``"e1(1)"``, as a row over ``v``.
+
+    The text is parsed by the symbolic layer's trace grammar (points ``a``, ``b`` or the
+    endpoint values); parameters in coefficients take the values of ``model`` (the
+    defaults, or the overrides it carries).
+
+    Returns
+    -------
+    ndarray (2 N n,)
+        ``r`` with ``r @ v`` the combination, in the trace ordering of the module docstring.
+
+    Examples
+    --------
+    >>> from phdesign.numeric.bridge import NumericModel, constant_H
+    >>> P = (np.zeros((1, 1)), np.ones((1, 1)))
+    >>> nm = NumericModel("t", (0.0, 1.0), 1, 1, P, constant_H([[1.0]]), [[0, 1]], [[1, 0]])
+    >>> trace_row("2*e1(1) - e1(0)", nm).tolist()
+    [2.0, -1.0]
+    """
+    import sympy
+
+    from phdesign.symbolic import expressions as ex
+
+    values = _parameter_values(model, None) if model is not None else {}
+    if model is not None:  # exact endpoints, so that "e1(1)" names the endpoint 1
+        interval = tuple(sympy.sympify(x).subs(values) for x in model.interval)
+    else:
+        interval = tuple(sympy.Rational(repr(x)) for x in nm.interval)
+    expr = ex.parse_trace_expression(
+        text, interval, nm.order, nm.size, parameters=[str(s) for s in values]
+    )
+    row = np.zeros(2 * nm.n_ports)
+    for trace, coefficient in ex.linear_coefficients(expr).items():
+        value = coefficient.subs(values)
+        if value.free_symbols:
+            message = _free_symbols_message(f"trace expression {text!r}", value.free_symbols)
+            raise ParameterError(message)
+        index = trace_index(trace.component, trace.derivative, trace.side, nm.order, nm.size)
+        row[index] = float(value)
+    return row
+
+
 def initial_state_function(
     text: str | None,
     nm: NumericModel,
     parameters: Mapping[str, Any] | None = None,
     model: Any = None,
+    what: str = "initial state",
 ) -> Callable[[np.ndarray], np.ndarray]:
     """Parse an initial state ``'x1: 0, x2: z - 0.9'`` into a vectorized callable.
 
@@ -431,7 +476,7 @@ def initial_state_function(
     for part in _split_top_level(text):
         if ":" not in part:
             raise ParameterError(
-                f"initial state item {part.strip()!r}: expected 'name: expression', "
+                f"{what} item {part.strip()!r}: expected 'name: expression', "
                 f"e.g. '{nm.state_names[0]}: z - 0.9'"
             )
         key, expr_text = (s.strip() for s in part.split(":", 1))
@@ -441,17 +486,13 @@ def initial_state_function(
             this, idx = "e", efforts[key]
         else:
             known = ", ".join([*nm.state_names, *(f"x{i + 1}" for i in range(n)), *efforts])
-            raise ParameterError(
-                f"initial state: unknown component {key!r}; expected one of {known}"
-            )
+            raise ParameterError(f"{what}: unknown component {key!r}; expected one of {known}")
         if kind is not None and this != kind:
-            raise ParameterError(
-                "initial state: give either state components or efforts, not both"
-            )
+            raise ParameterError(f"{what}: give either state components or efforts, not both")
         kind = this
         if idx in exprs:
-            raise ParameterError(f"initial state: component {key!r} given twice")
-        exprs[idx] = _parse_z_expression(expr_text, model, parameters)
+            raise ParameterError(f"{what}: component {key!r} given twice")
+        exprs[idx] = _parse_z_expression(expr_text, model, parameters, f"{what} expression")
     from phdesign.symbolic.model import Z
 
     funcs = {i: sympy.lambdify(Z, e, modules="numpy") for i, e in exprs.items()}
@@ -487,7 +528,9 @@ def _split_top_level(text: str) -> list[str]:
     return [p for p in parts if p.strip()]
 
 
-def _parse_z_expression(text: str, model: Any, parameters: Mapping[str, Any] | None) -> Any:
+def _parse_z_expression(
+    text: str, model: Any, parameters: Mapping[str, Any] | None, what: str
+) -> Any:
     """Parse an expression in z (and parameters) safely and substitute parameter values."""
     from phdesign.symbolic import expressions as ex
     from phdesign.symbolic.model import Z
@@ -495,9 +538,7 @@ def _parse_z_expression(text: str, model: Any, parameters: Mapping[str, Any] | N
     values: dict[Any, Any] = {}
     if model is not None:
         values = _parameter_values(model, parameters)
-    expr = ex.parse_scalar(
-        text, parameters=[str(s) for s in values], allow_z=True, what="initial state expression"
-    )
+    expr = ex.parse_scalar(text, parameters=[str(s) for s in values], allow_z=True, what=what)
     # parse_scalar builds its own z and parameter symbols; map them by name.
     by_name = {str(s): v for s, v in values.items()}
     subs = {
@@ -508,7 +549,7 @@ def _parse_z_expression(text: str, model: Any, parameters: Mapping[str, Any] | N
     expr = expr.xreplace(subs)
     free = set(expr.free_symbols) - {Z}
     if free:
-        raise ParameterError(_free_symbols_message(f"initial state expression {text!r}", free))
+        raise ParameterError(_free_symbols_message(f"{what} {text!r}", free))
     return expr
 
 

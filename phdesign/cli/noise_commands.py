@@ -1,0 +1,430 @@
+"""Commands ``noise`` and ``tradeoff``, and the noise options of ``simulate`` and ``tune``.
+
+Argument parsing and printing only: the figures come from
+:mod:`phdesign.numeric.noise`, :mod:`phdesign.numeric.tradeoff`,
+:mod:`phdesign.numeric.noise_tune` and :mod:`phdesign.numeric.stochastic`, imported inside
+the handlers.  Each command prints ``str(result)`` or ``result.to_dict()`` as JSON.
+
+Noise options (shared):
+
+``--intensity 0.01,0.04``
+    sensor noise intensities σᵢ² (E[ν νᵀ] = diag(σ²) δ), one per sensor or one for all;
+    default 1.
+``--input-noise 0.5``
+    white noise on the plant inputs u, of these intensities (one per input or one for
+    all); the observer does not see it.
+``--at 1``, ``--trace 'e1(1)'``, ``--integral 'x2: sin(pi*z)'``
+    performance outputs: the displacement at points, combinations of boundary traces, and
+    integrals of state components against weights (repeatable; default: the displacement
+    at b when the model defines one).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from typing import Any
+
+from phdesign.cli.common import (
+    add_json_argument,
+    add_model_argument,
+    add_observer_arguments,
+    emit,
+    emit_json,
+    write_output,
+)
+from phdesign.errors import NumericError, ObserverError
+
+__all__ = [
+    "add_noise_arguments",
+    "add_noise_tuning_arguments",
+    "add_stochastic_arguments",
+    "noise_tuning",
+    "register",
+    "stochastic_simulation",
+]
+
+
+def add_noise_arguments(
+    parser: argparse.ArgumentParser, *, sensor_flag: str = "--intensity"
+) -> None:
+    """Add the sensor/input noise intensities and the performance outputs."""
+    parser.add_argument(
+        sensor_flag,
+        metavar="S2",
+        dest="intensity",
+        help="sensor noise intensities sigma_i^2, one per sensor or one for all (default 1)",
+    )
+    parser.add_argument(
+        "--input-noise",
+        metavar="W",
+        help="white noise on the plant inputs, of these intensities (one per input or one "
+        "for all); the observer does not know it",
+    )
+    _add_performance_arguments(parser)
+
+
+def _add_performance_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--at", metavar="Z", help="performance: the displacement at these points, e.g. 1 or 0.5,1"
+    )
+    parser.add_argument(
+        "--trace",
+        action="append",
+        default=[],
+        metavar="EXPR",
+        help="performance: a boundary trace combination, e.g. 'e1(1)' (repeatable)",
+    )
+    parser.add_argument(
+        "--integral",
+        action="append",
+        default=[],
+        metavar="WEIGHTS",
+        help="performance: the integral of state components against weights, e.g. "
+        "'x2: sin(pi*z)' (repeatable)",
+    )
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Add the ``noise`` and ``tradeoff`` commands."""
+    from phdesign.cli.numeric_commands import _add_discretization
+
+    nz = subparsers.add_parser(
+        "noise",
+        help="what a gain costs in sensor noise: error variances, L2-gain, error energy",
+    )
+    add_model_argument(nz)
+    add_observer_arguments(nz)
+    add_noise_arguments(nz)
+    _add_discretization(nz, "first of the refinement")
+    nz.add_argument("--tol", type=float, help="relative agreement of a converged figure")
+    add_json_argument(nz)
+    nz.add_argument("--plot", metavar="FILE", help="draw the frequency response to FILE")
+    nz.add_argument("--force", action="store_true", help="overwrite an existing plot file")
+    nz.set_defaults(handler=_noise)
+
+    tr = subparsers.add_parser(
+        "tradeoff", help="decay rate against error RMS over a ray or a grid of gains"
+    )
+    add_model_argument(tr)
+    group = tr.add_mutually_exclusive_group(required=True)
+    group.add_argument("--sensors", metavar="I,J", help="measured outputs, 1-based")
+    group.add_argument("--cm", metavar="ROWS", help="C_m in full, e.g. '[[0,0,1,0]]'")
+    family = tr.add_mutually_exclusive_group()
+    family.add_argument(
+        "--direction", metavar="L0", help="the ray s*diag(L0), e.g. 0.1,1 (default all ones)"
+    )
+    family.add_argument(
+        "--grid",
+        metavar="AXES",
+        help="a grid of diagonal gains: per sensor lo:hi:count (log-spaced) or one value, "
+        "comma-separated, e.g. 0.01:1:5,0.1:10:5",
+    )
+    tr.add_argument(
+        "--scales", metavar="LO:HI:N", help="scales s of the ray, log-spaced (default 0.1:10:12)"
+    )
+    add_noise_arguments(tr)
+    tr.add_argument(
+        "--method", choices=("galerkin", "fd"), default="galerkin", help="discretization"
+    )
+    fmt = tr.add_mutually_exclusive_group()
+    fmt.add_argument("--csv", action="store_true", help="CSV table")
+    fmt.add_argument("--json", action="store_true", help="JSON output")
+    tr.add_argument("--output", "-o", metavar="FILE", help="write the table to FILE")
+    tr.add_argument("--plot", metavar="FILE", help="draw decay rate against RMS to FILE")
+    tr.add_argument("--force", action="store_true", help="overwrite existing files")
+    tr.set_defaults(handler=_tradeoff, gain=None)  # the family gives the gains
+
+
+# ----------------------------------------------------------------------------- parsing
+def _numbers(text: str, flag: str) -> list[float]:
+    values = []
+    for part in str(text).split(","):
+        try:
+            values.append(float(part))
+        except ValueError:
+            raise NumericError(
+                f"{flag}: expected comma-separated numbers like 0.01,0.04; found {part.strip()!r}"
+            ) from None
+    return values
+
+
+def _intensities(text: str | None, count: int, flag: str) -> Any:
+    if text is None:
+        return None
+    from phdesign.numeric.noise import check_intensity
+
+    return check_intensity(_numbers(text, flag), count, flag)
+
+
+def _performance(args: argparse.Namespace, nm: Any, model: Any) -> list[Any] | None:
+    from phdesign.numeric import functionals as fn
+
+    items: list[Any] = []
+    if args.at is not None:
+        items += [fn.displacement_at(nm, z.strip()) for z in str(args.at).split(",")]
+    items += [fn.trace_functional(nm, t, model) for t in args.trace]
+    items += [fn.integral_functional(nm, w, model) for w in args.integral]
+    return items or None
+
+
+def _observer(args: argparse.Namespace, command: str) -> tuple[Any, Any, Any, Any]:
+    from phdesign.cli.numeric_commands import _numeric_setup
+
+    model, nm, C_m, L = _numeric_setup(args)
+    if C_m is None:
+        raise ObserverError(
+            f"{command} needs --sensors or --cm: the noise enters through the observer's "
+            "measurements"
+        )
+    return model, nm, C_m, L
+
+
+def _noise_inputs(args: argparse.Namespace, nm: Any, model: Any, q: int) -> dict[str, Any]:
+    return {
+        "intensity": _intensities(args.intensity, q, "--intensity"),
+        "input_intensity": _intensities(args.input_noise, nm.n_ports, "--input-noise"),
+        "performance": _performance(args, nm, model),
+        "model": model,
+    }
+
+
+# ----------------------------------------------------------------------------- commands
+def _noise(args: argparse.Namespace) -> int:
+    from phdesign.numeric.noise import noise
+
+    for name in ("resolution", "tol"):
+        value = getattr(args, name)
+        if value is not None and not value > 0:
+            raise NumericError(f"--{name} must be positive; found {value}")
+    model, nm, C_m, L = _observer(args, "noise")
+    if args.plot:
+        from phdesign.plots import check_plot_path
+
+        check_plot_path(args.plot, args.force)
+    report = noise(
+        nm,
+        C_m,
+        L,
+        **_noise_inputs(args, nm, model, C_m.shape[0]),
+        method=args.method,
+        resolution=args.resolution,
+        tol=args.tol,
+    )
+    if args.json:
+        emit_json(report.to_dict())
+    else:
+        emit(str(report))
+    if args.plot:
+        report.plot(args.plot, force=args.force)
+    return 0
+
+
+def _range(text: str, flag: str) -> Any:
+    import numpy as np
+
+    parts = str(text).split(":")
+    if len(parts) == 1:
+        value = _numbers(parts[0], flag)[0]
+        return np.array([value])
+    if len(parts) != 3:
+        raise NumericError(f"{flag}: expected lo:hi:count or one value; found {text!r}")
+    lo, hi = (_numbers(p, flag)[0] for p in parts[:2])
+    try:
+        count = int(parts[2])
+    except ValueError:
+        raise NumericError(f"{flag}: the count in {text!r} must be an integer") from None
+    if not (0 < lo < hi < float("inf")) or count < 2:
+        raise NumericError(
+            f"{flag}: expected 0 < lo < hi and a count of at least 2 in lo:hi:count; "
+            f"found {text!r}"
+        )
+    return np.geomspace(lo, hi, count)
+
+
+def _tradeoff(args: argparse.Namespace) -> int:
+    from phdesign.numeric.tradeoff import tradeoff
+
+    model, nm, C_m, _ = _observer(args, "tradeoff")
+    q = C_m.shape[0]
+    if args.grid is not None and args.scales is not None:
+        raise NumericError("--scales belongs to a ray; a --grid gives its own values")
+    direction = None
+    if args.direction is not None:
+        direction = _numbers(args.direction, "--direction")
+        if len(direction) not in (1, q) or min(direction) <= 0:
+            raise NumericError(
+                f"--direction: expected {q} positive values (one per sensor) or one; "
+                f"found {args.direction!r}"
+            )
+    grid = None
+    if args.grid is not None:
+        grid = [_range(axis, "--grid") for axis in str(args.grid).split(",")]
+    scales = None if args.scales is None else _range(args.scales, "--scales")
+    if args.output:
+        from phdesign.io import check_output_path
+
+        check_output_path(args.output, args.force)
+    if args.plot:
+        from phdesign.plots import check_plot_path
+
+        check_plot_path(args.plot, args.force)
+    result = tradeoff(
+        nm,
+        C_m,
+        direction=direction,
+        scales=scales,
+        grid=grid,
+        **_noise_inputs(args, nm, model, q),
+        method=args.method,
+    )
+    if args.json:
+        from phdesign.io import dumps_json
+
+        text = dumps_json(result.to_dict())
+    else:
+        text = result.to_csv() if args.csv else str(result)
+    if args.output:
+        write_output(args.output, text, args.force)
+    else:
+        emit(text)
+    if args.plot:
+        result.plot(args.plot, force=args.force)
+    return 0
+
+
+# ----------------------------------------------------------------------------- simulate
+def add_stochastic_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``--noise-intensity``, ``--input-noise`` and ``--seed`` to ``simulate``."""
+    parser.add_argument(
+        "--noise-intensity",
+        metavar="S2",
+        help="sensor noise intensities sigma_i^2 (one per sensor or one for all): a "
+        "stochastic run, exact at the samples",
+    )
+    parser.add_argument(
+        "--input-noise",
+        metavar="W",
+        help="white noise on the plant inputs, of these intensities (one per input or one "
+        "for all)",
+    )
+    parser.add_argument("--seed", type=int, help="seed of the noise (with the noise options)")
+
+
+def stochastic_simulation(args: argparse.Namespace) -> Any:
+    """Return the stochastic simulator bound to the noise options, or None without them."""
+    noisy = args.noise_intensity is not None or args.input_noise is not None
+    if not noisy:
+        if args.seed is not None:
+            raise NumericError("--seed needs --noise-intensity or --input-noise")
+        return None
+    sampled = [
+        flag
+        for flag, name in (
+            ("--dt", "dt"),
+            ("--sampler", "sampler"),
+            ("--observer-resolution", "observer_resolution"),
+        )
+        if getattr(args, name, None) is not None
+    ]
+    if sampled:
+        raise NumericError(
+            f"the noise options run the continuous observer; {sampled[0]} asks for a sampled "
+            "one: give one or the other"
+        )
+    from functools import partial
+
+    from phdesign.numeric.stochastic import simulate_noisy
+
+    sensors = getattr(args, "sensors", None) or getattr(args, "cm", None)
+    if args.noise_intensity is not None and sensors is None:
+        raise ObserverError("--noise-intensity needs an observer: give --sensors or --cm")
+    return partial(
+        simulate_noisy,
+        noise_intensity=_listed_intensities(args.noise_intensity, "--noise-intensity"),
+        input_intensity=_listed_intensities(args.input_noise, "--input-noise"),
+        seed=args.seed,
+    )
+
+
+def _listed_intensities(text: str | None, flag: str) -> Any:
+    """Intensities checked for sign and finiteness (the library checks their count)."""
+    if text is None:
+        return None
+    values = _numbers(text, flag)
+    return _intensities(text, len(values), flag)
+
+
+# ----------------------------------------------------------------------------- tune
+def add_noise_tuning_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the noise-aware objectives to ``tune`` (and the noise options they need)."""
+    parser.add_argument(
+        "--max-rms",
+        type=float,
+        metavar="R",
+        help="minimize the abscissa subject to the error RMS of the performance outputs <= R",
+    )
+    parser.add_argument(
+        "--objective",
+        choices=("abscissa", "rms"),
+        default="abscissa",
+        help="what to minimize (rms: the error RMS, with --min-decay)",
+    )
+    parser.add_argument(
+        "--min-decay",
+        type=float,
+        metavar="A",
+        help="with --objective rms: require the spectral abscissa <= -A",
+    )
+    add_noise_arguments(parser)
+
+
+def noise_tuning(args: argparse.Namespace) -> int | None:
+    """Run the noise-aware tuning when its options are given; None otherwise."""
+    wanted = args.max_rms is not None or args.objective == "rms" or args.min_decay is not None
+    extras = [
+        flag
+        for flag, value in (
+            ("--intensity", args.intensity),
+            ("--input-noise", args.input_noise),
+            ("--at", args.at),
+            ("--trace", args.trace),
+            ("--integral", args.integral),
+        )
+        if value
+    ]
+    if not wanted:
+        if extras:
+            raise NumericError(f"{extras[0]} needs --max-rms or --objective rms")
+        return None
+    if args.objective == "abscissa" and args.min_decay is not None:
+        raise NumericError("--min-decay goes with --objective rms")
+    if args.objective == "rms" and args.max_rms is not None:
+        raise NumericError("--max-rms goes with the abscissa objective")
+    if args.full:
+        raise NumericError("noise-aware tuning searches positive diagonal gains; drop --full")
+    for flag, value in (("--max-rms", args.max_rms), ("--min-decay", args.min_decay)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise NumericError(f"{flag} must be a positive number; found {value}")
+    if args.objective == "rms" and args.min_decay is None:
+        raise NumericError("--objective rms needs --min-decay A (the decay rate to keep)")
+    from phdesign.cli.common import load_model, sensor_matrix_from_args
+    from phdesign.numeric.bridge import gain_to_numeric, to_numeric
+    from phdesign.numeric.noise_tune import tune_noise
+
+    model = load_model(args)
+    nm = to_numeric(model)
+    C_m = gain_to_numeric(sensor_matrix_from_args(args, model), "C_m")
+    result = tune_noise(
+        nm,
+        C_m,
+        objective=args.objective,
+        max_rms=args.max_rms,
+        min_decay=args.min_decay,
+        **_noise_inputs(args, nm, model, C_m.shape[0]),
+    )
+    if args.json:
+        emit_json({"model": model.name, **result.to_dict()})
+    else:
+        emit(str(result))
+    return 0
