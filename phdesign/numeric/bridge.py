@@ -85,6 +85,9 @@ class NumericModel:
         How to reconstruct a physical displacement, if the model has one.
     H_constant : bool
         True when H does not depend on z (lets discretizations skip quadrature work).
+    parameters : mapping of str to float
+        The parameter values substituted (defaults with the caller's overrides), by name:
+        the values an initial state written in the parameters is evaluated with.
     """
 
     name: str
@@ -101,6 +104,7 @@ class NumericModel:
     displacement: DisplacementSpec | None = None
     H_constant: bool = False
     extra: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    parameters: Mapping[str, float] = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         a, b = (float(s) for s in self.interval)
@@ -168,25 +172,10 @@ def _free_symbols_message(what: str, symbols: set[Any]) -> str:
 
 
 def _parameter_values(model: Any, parameters: Mapping[str, Any] | None) -> dict[Any, Any]:
-    """Defaults of ``model`` overridden by ``parameters`` (keys by name)."""
-    import sympy
-
-    if parameters and hasattr(model, "with_parameters"):
+    """Defaults of ``model`` overridden by ``parameters`` (keys by name), checked by the model."""
+    if parameters:
         model = model.with_parameters({str(k): v for k, v in parameters.items()})
-        parameters = None
-    values: dict[Any, Any] = dict(model.parameter_defaults)
-    by_name = {str(s): s for s in values}
-    for key, val in (parameters or {}).items():
-        name = str(key)
-        if name not in by_name:
-            known = ", ".join(sorted(by_name)) or "none"
-            raise ParameterError(f"unknown parameter {name!r}; the model's parameters: {known}")
-        try:
-            expr = sympy.sympify(val) if not isinstance(val, sympy.Basic) else val
-        except (sympy.SympifyError, TypeError) as exc:
-            raise ParameterError(f"parameter {name!r}: cannot read value {val!r}") from exc
-        values[by_name[name]] = expr
-    return values
+    return dict(model.parameter_defaults)
 
 
 def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> NumericModel:
@@ -211,9 +200,14 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
     """
     import sympy
 
+    from phdesign.arguments import require_model
     from phdesign.symbolic.model import Z
-    from phdesign.symbolic.ports import derive_ports
 
+    require_model(model)
+    if parameters is not None and not isinstance(parameters, Mapping):
+        raise ParameterError(
+            f"parameters must be a mapping of names to values; found {type(parameters).__name__}"
+        )
     values = _parameter_values(model, parameters)
     N, n = int(model.order), int(model.size)
 
@@ -233,7 +227,7 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         for k, Pk in enumerate(model.P)
     ]
     Hs = subs_matrix("H", model.H, True)
-    ports = derive_ports(model)
+    ports = model.ports
     U = np.array(subs_matrix("U", ports.U, False).evalf(), dtype=float)
     Y = np.array(subs_matrix("Y", ports.Y, False).evalf(), dtype=float)
 
@@ -270,6 +264,7 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         state_names=tuple(model.state_names),
         displacement=disp,
         H_constant=H_constant,
+        parameters={str(k): float(v) for k, v in values.items()},
     )
     # H must be positive definite after substitution (the symbolic check used defaults).
     zs = np.linspace(nm.interval[0], nm.interval[1], 33)
@@ -329,6 +324,13 @@ def initial_state_function(
     >>> initial_state_function("e1: 2*z", nm)(np.array([0.5]))
     array([[0.5]])
     """
+    from phdesign.arguments import require_numeric_model
+
+    require_numeric_model(nm)
+    if text is not None and not isinstance(text, str):
+        raise ParameterError(
+            f"initial state must be text such as 'x1: z - 0.9'; found {type(text).__name__}"
+        )
     n = nm.size
     if text is None or not text.strip():
         return lambda z: np.zeros((np.atleast_1d(z).size, n))
@@ -362,7 +364,7 @@ def initial_state_function(
         kind = this
         if idx in exprs:
             raise ParameterError(f"initial state: component {key!r} given twice")
-        exprs[idx] = _parse_z_expression(expr_text, model, parameters)
+        exprs[idx] = _parse_z_expression(expr_text, nm, model, parameters)
     from phdesign.symbolic.model import Z
 
     funcs = {i: sympy.lambdify(Z, e, modules="numpy") for i, e in exprs.items()}
@@ -398,23 +400,39 @@ def _split_top_level(text: str) -> list[str]:
     return [p for p in parts if p.strip()]
 
 
-def _parse_z_expression(text: str, model: Any, parameters: Mapping[str, Any] | None) -> Any:
-    """Parse an expression in z (and parameters) safely and substitute parameter values."""
+def _exact_value(value: Any) -> Any:
+    import sympy
+
+    return sympy.Float(value) if isinstance(value, float) else value
+
+
+def _parse_z_expression(
+    text: str, nm: NumericModel, model: Any, parameters: Mapping[str, Any] | None
+) -> Any:
+    """Parse an expression in z (and parameters) safely and substitute the parameter values.
+
+    The values are those the numeric model was built with (``nm.parameters``: defaults
+    and the overrides given to :func:`to_numeric`), overridden again by ``parameters``.
+    """
     from phdesign.symbolic import expressions as ex
     from phdesign.symbolic.model import Z
 
-    values: dict[Any, Any] = {}
-    if model is not None:
-        values = _parameter_values(model, parameters)
+    values: dict[str, Any] = dict(nm.parameters)
+    if not values and model is not None:  # a NumericModel built by hand: the model's defaults
+        values = {str(s): v for s, v in model.parameter_defaults.items()}
+    for name, value in (parameters or {}).items():
+        if str(name) not in values:
+            known = ", ".join(values) or "none"
+            raise ParameterError(f"unknown parameter {name!r}; the model's parameters are {known}")
+        values[str(name)] = ex.exact_number(value, f"parameter {name}")
     expr = ex.parse_scalar(
-        text, parameters=[str(s) for s in values], allow_z=True, what="initial state expression"
+        text, parameters=list(values), allow_z=True, what="initial state expression"
     )
     # parse_scalar builds its own z and parameter symbols; map them by name.
-    by_name = {str(s): v for s, v in values.items()}
     subs = {
-        s: (Z if str(s) == "z" else by_name[str(s)])
+        s: (Z if str(s) == "z" else _exact_value(values[str(s)]))
         for s in expr.free_symbols
-        if str(s) == "z" or str(s) in by_name
+        if str(s) == "z" or str(s) in values
     }
     expr = expr.xreplace(subs)
     free = set(expr.free_symbols) - {Z}

@@ -28,7 +28,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
 
 import sympy
 
@@ -46,6 +47,9 @@ from phdesign.symbolic.expressions import (
     trace_of,
     vanishes,
 )
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from phdesign.symbolic.ports import Ports
 
 __all__ = ["BCPHS", "Displacement", "Z"]
 
@@ -214,6 +218,13 @@ class BCPHS:
         )
 
     # ------------------------------------------------------------------ views
+    @cached_property
+    def ports(self) -> Ports:
+        """The boundary port structure (:func:`~phdesign.symbolic.ports.derive_ports`), cached."""
+        from phdesign.symbolic.ports import derive_ports
+
+        return derive_ports(self)
+
     @property
     def parameter_defaults(self) -> dict[sympy.Symbol, sympy.Expr]:
         """The parameters' default values, keyed by symbol."""
@@ -372,9 +383,7 @@ def _validate(model: BCPHS) -> list[str]:
                 f"found component {d.component}, integrations {d.integrations}"
             )
     _check_ports(model, symbols)
-    from phdesign.symbolic.ports import derive_ports  # ports depend on a built model
-
-    derive_ports(model)
+    model.ports  # noqa: B018 - derives the ports (checking the identities) and caches them
     checks.append("port identities: exact")
     return checks
 
