@@ -95,7 +95,9 @@ def matrix_text(M: Any) -> str:
     """A small matrix: ``diag(0.1, 1)`` when diagonal, else its rows."""
     rows = [list(r) for r in (M.tolist() if hasattr(M, "tolist") else M)]
     square = all(len(r) == len(rows) for r in rows)
-    if square and all(rows[i][j] == 0 for i in range(len(rows)) for j in range(len(rows)) if i != j):
+    if square and all(
+        rows[i][j] == 0 for i in range(len(rows)) for j in range(len(rows)) if i != j
+    ):
         return f"diag({', '.join(number_text(rows[i][i]) for i in range(len(rows)))})"
     return "[" + ", ".join("[" + ", ".join(number_text(x) for x in r) + "]" for r in rows) + "]"
 

@@ -58,9 +58,7 @@ def require_numeric_model(value: object, name: str = "nm") -> None:
         hint = ""
         if isinstance(value, str) or type(value).__name__ == "BCPHS":
             hint = " (phdesign.numeric.bridge.to_numeric(model) makes one from a model)"
-        raise ArgumentError(
-            f"{name}: expected a NumericModel{hint}; found {_found(value)}"
-        )
+        raise ArgumentError(f"{name}: expected a NumericModel{hint}; found {_found(value)}")
 
 
 def positive_int(

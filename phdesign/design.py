@@ -76,8 +76,8 @@ def numeric_matrix(M: sympy.MatrixBase, name: str, what: str) -> np.ndarray:
         names = ", ".join(sorted(map(str, M.free_symbols)))
         raise ObserverError(
             f"{what} needs numbers for {name}; {name} = {matrix_text(M)} is symbolic ({names}): "
-            "give numbers (e.g. gain=[0.1, 1]) or tune() a gain; symbolic gains are for "
-            "classify(), which answers for all of their positive values"
+            "give numbers (the gain [0.1, 1], or --gain 0.1,1 on the command line) or tune "
+            "one; symbolic gains are for classify, which answers for all their positive values"
         )
     return np.array(M.evalf(17).tolist(), dtype=float)
 
@@ -186,7 +186,7 @@ class Plant:
         """Simulate the plant alone from ``x0`` (text or a function of z; zero by default)."""
         from phdesign.numeric.simulate import simulate
 
-        return simulate(
+        result = simulate(
             self.numeric,
             x0=self.initial_state(x0, "x0"),
             t_end=t_end,
@@ -196,6 +196,14 @@ class Plant:
             u=u,
             scheme=scheme,
         )
+        return self.labelled(result)
+
+    def labelled(self, result: SimulationResult, **labels: str) -> SimulationResult:
+        """The result with the model's name (and the design's ``labels``) in its ``info``.
+
+        Presentation only: the plots' titles and the JSON name what was simulated.
+        """
+        return replace(result, info={**result.info, "model": self.model.name, **labels})
 
     def __repr__(self) -> str:
         extra = f", parameters={self.parameters}" if self.parameters else ""
@@ -400,8 +408,7 @@ class Observer:
             scheme=scheme,
             z_w=z_w,
         )
-        # presentation only: the plot's title names the design
-        return replace(result, info={**result.info, "model": self.model.name, **self._labels()})
+        return self.plant.labelled(result, **self._labels())
 
     def tune(
         self, *, full: bool = False, starts: int = 6, seed: int = 0, resolution: int | None = None
@@ -496,4 +503,3 @@ class Observer:
         if self.tuning is not None:
             rows.append(["tuned abscissa", str(self.tuning.spectral_abscissa)])
         return html_table(["observer", ""], rows)
-

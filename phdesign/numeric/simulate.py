@@ -41,6 +41,7 @@ import scipy.linalg as sl
 from phdesign.errors import NumericError
 from phdesign.numeric.arguments import check_simulate_arguments
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.display import SimulationDisplay
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
 
 __all__ = [
@@ -57,8 +58,8 @@ __all__ = [
 ENERGY_BALANCE_RTOL = 1e-8
 
 
-@dataclass(frozen=True)
-class SimulationResult:
+@dataclass(frozen=True, repr=False)
+class SimulationResult(SimulationDisplay):
     """Time series of a plant (and observer) simulation.
 
     Attributes

@@ -220,9 +220,7 @@ class Classification:
             if r.proposition == proposition and r.variant == variant:
                 return r
         known = ", ".join(r.name for r in self.results)
-        raise ObserverError(
-            f"no variant {proposition}.{variant}; expected one of {known}"
-        )
+        raise ObserverError(f"no variant {proposition}.{variant}; expected one of {known}")
 
     @property
     def best(self) -> VariantResult | None:

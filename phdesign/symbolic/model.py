@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 import sympy
 
 from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
+from phdesign.symbolic.display import ModelDisplay
 from phdesign.symbolic.expressions import (
     Z,
     canonical,
@@ -71,8 +72,8 @@ class Displacement:
     integrations: int
 
 
-@dataclass(frozen=True)
-class BCPHS:
+@dataclass(frozen=True, repr=False)
+class BCPHS(ModelDisplay):
     r"""A validated symbolic BC-PHS (see the module docstring for the equations).
 
     Build one with :meth:`define` (from strings and numbers) or from a model file

@@ -45,7 +45,7 @@ Matrix([
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Protocol
 
@@ -53,6 +53,7 @@ import sympy
 
 from phdesign.arguments import require_model
 from phdesign.errors import PortError
+from phdesign.symbolic.display import PortsDisplay
 from phdesign.symbolic.expressions import (
     Trace,
     canonical,
@@ -164,8 +165,8 @@ def coefficient_matrix(
     return sympy.ImmutableMatrix(rows)
 
 
-@dataclass(frozen=True)
-class Ports:
+@dataclass(frozen=True, repr=False)
+class Ports(PortsDisplay):
     """The boundary port structure of a model (all matrices exact).
 
     Attributes
@@ -185,6 +186,8 @@ class Ports:
     identities : dict
         Largest absolute entry of each identity's residual (zero for a valid model),
         keyed by :data:`IDENTITY_NAMES`.
+    model : BCPHS or None
+        The model the ports belong to (for printing: names and endpoints).
     """
 
     trace_vector: tuple[sympy.Symbol, ...]
@@ -196,6 +199,7 @@ class Ports:
     W_C: sympy.ImmutableMatrix
     Sigma: sympy.ImmutableMatrix
     identities: dict[str, sympy.Expr]
+    model: PortedSystem | None = field(default=None, compare=False)
 
     def boundary_variables(self) -> sympy.ImmutableMatrix:
         r"""Return :math:`(f_\partial; e_\partial)` as expressions in the traces."""
@@ -275,6 +279,7 @@ def derive_ports(model: PortedSystem) -> Ports:
         W_C=sympy.ImmutableMatrix(W_C),
         Sigma=Sigma,
         identities=identities,
+        model=model,
     )
 
 
