@@ -58,7 +58,39 @@ _EXPORTS: dict[str, str] = {
     "PhdesignError": "phdesign.errors",
 }
 
-__all__ = sorted([*_EXPORTS, "__version__"])
+__all__ = [
+    "BCPHS",
+    "Classification",
+    "Displacement",
+    "Observer",
+    "PhdesignError",
+    "Plant",
+    "Ports",
+    "SensorSearch",
+    "SimulationResult",
+    "SpectrumReport",
+    "TuneResult",
+    "__version__",
+    "builtin_names",
+    "classify",
+    "derive_ports",
+    "discretize",
+    "gain_matrix",
+    "load",
+    "load_builtin",
+    "measurement_matrix",
+    "model_from_toml",
+    "model_to_toml",
+    "port_inverse",
+    "read_model",
+    "search_sensors",
+    "sensor_matrix",
+    "simulate",
+    "spectrum",
+    "to_numeric",
+    "tune",
+    "write_model",
+]
 
 if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDEs
     from phdesign.design import Observer, Plant

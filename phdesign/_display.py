@@ -1,4 +1,4 @@
-"""How results show themselves: numbers, matrices, sensors and small HTML tables.
+r"""How results show themselves: numbers, matrices, sensors and small HTML tables.
 
 One formatter per kind of value, shared by every result object (its ``__str__``, which is
 the text the command line prints, its ``__repr__`` and its ``_repr_html_``), so that the
@@ -51,10 +51,11 @@ def _fraction(x: Any) -> tuple[int, int] | None:
 
 
 def number_text(x: Any) -> str:
-    """A number as a person writes it.
+    """Return a number as a person writes it.
 
     Integers as integers; exact rationals as their decimal when it terminates within 20
-    digits (``1/10`` is ``0.1``, a float read exactly shows as written), else as a fraction; floats with six significant digits;
+    digits (``1/10`` is ``0.1``, a float read exactly shows as written), else as a
+    fraction; floats with six significant digits;
     anything else (an expression of symbolic gains) as sympy prints it.
     """
     exact = _fraction(x)
@@ -81,7 +82,7 @@ def number_text(x: Any) -> str:
 
 
 def kappa_text(exact: Any, value: float | None, unbounded: bool = False) -> str:
-    r"""The best constant :math:`\kappa^*`: ``unbounded``, six digits, or the expression."""
+    r"""Return :math:`\kappa^*` as text: ``unbounded``, six digits, or the expression."""
     if unbounded:
         return "unbounded"
     if value is not None:
@@ -92,7 +93,7 @@ def kappa_text(exact: Any, value: float | None, unbounded: bool = False) -> str:
 
 
 def matrix_text(M: Any) -> str:
-    """A small matrix: ``diag(0.1, 1)`` when diagonal, else its rows."""
+    """Return a small matrix as text: ``diag(0.1, 1)`` when diagonal, else its rows."""
     rows = [list(r) for r in (M.tolist() if hasattr(M, "tolist") else M)]
     square = all(len(r) == len(rows) for r in rows)
     if square and all(
@@ -103,7 +104,7 @@ def matrix_text(M: Any) -> str:
 
 
 def sensors_text(C_m: Any) -> str:
-    """The measurements ``C_m y``: ``y3, y4`` for unit rows, ``0.5·y3 + y4`` otherwise."""
+    """Return the measurements ``C_m y`` as text: ``y3, y4``, or ``0.5·y3 + y4``."""
     parts = []
     for row in C_m.tolist() if hasattr(C_m, "tolist") else C_m:
         terms = []
@@ -127,7 +128,7 @@ def html_table(
     caption: str | None = None,
     footer: str | None = None,
 ) -> str:
-    """A small HTML table (escaped), for the ``_repr_html_`` of result objects."""
+    """Return a small HTML table (escaped), for the ``_repr_html_`` of result objects."""
     head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
     body = "".join(
         "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows

@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import operator
 from collections.abc import Sequence
+
 from phdesign.errors import ArgumentError, NumericError, PhdesignError
 
 __all__ = [
@@ -65,7 +66,7 @@ def positive_int(
     value: object, name: str, error: type[PhdesignError] = NumericError, minimum: int = 1
 ) -> int:
     """Return ``value`` as an int if it is an integer ``>= minimum``, else raise ``error``."""
-    if isinstance(value, bool) or isinstance(value, float | complex | str):
+    if isinstance(value, bool | float | complex | str):
         number = None
     else:
         try:
@@ -81,7 +82,7 @@ def positive_int(
 def positive_number(value: object, name: str, error: type[PhdesignError] = NumericError) -> float:
     """Return ``value`` as a float if it is a finite number > 0, else raise ``error``."""
     number: float | None
-    if isinstance(value, bool) or isinstance(value, str | complex):
+    if isinstance(value, bool | str | complex):
         number = None
     else:
         try:

@@ -141,13 +141,13 @@ class Plant:
         return to_numeric(self.model, self.parameters or None)
 
     def discrete(self, resolution: int | None = None) -> DiscretePHS:
-        """The discretized plant at ``resolution`` (default: the plant's)."""
+        """Return the discretized plant at ``resolution`` (default: the plant's)."""
         from phdesign.numeric.discretize import discretize
 
         return discretize(self.numeric, self.method, resolution or self.resolution)
 
     def initial_state(self, x0: str | Callable[[Any], Any] | None, name: str) -> Any:
-        """An initial state as a function of z: text (``"x1: z - 0.9"``) is parsed here."""
+        """Return an initial state as a function of z (text ``"x1: z - 0.9"`` is parsed)."""
         if x0 is None or callable(x0):
             return x0
         if not isinstance(x0, str):
@@ -162,7 +162,7 @@ class Plant:
     def spectrum(
         self, *, max_resolution: int | None = None, tol: float | None = None, count: int = 6
     ) -> SpectrumReport:
-        """The converged spectrum of the plant with u = 0."""
+        """Return the converged spectrum of the plant with u = 0."""
         from phdesign.numeric.spectrum import spectrum
 
         return spectrum(
@@ -199,7 +199,7 @@ class Plant:
         return self.labelled(result)
 
     def labelled(self, result: SimulationResult, **labels: str) -> SimulationResult:
-        """The result with the model's name (and the design's ``labels``) in its ``info``.
+        """Return the result with the model's name (and the design's ``labels``) in its ``info``.
 
         Presentation only: the plots' titles and the JSON name what was simulated.
         """
@@ -217,8 +217,9 @@ class Observer:
 
     Parameters
     ----------
-    model : BCPHS
-        The plant (:func:`phdesign.load`).
+    model : BCPHS or Plant
+        The plant (:func:`phdesign.load`), or a :class:`Plant` with its parameter
+        overrides and discretization (shared by several designs).
     sensors : int or sequence of int, optional
         The measured outputs, 1-based: ``[3, 4]`` measures :math:`y_3, y_4` (unit rows).
     C_m : matrix, optional
@@ -267,7 +268,7 @@ class Observer:
 
     def __init__(
         self,
-        model: BCPHS,
+        model: BCPHS | Plant,
         sensors: int | Sequence[int] | None = None,
         *,
         C_m: Any = None,
@@ -277,11 +278,12 @@ class Observer:
         resolution: int | None = None,
         tuning: TuneResult | None = None,
     ) -> None:
-        plant = model if isinstance(model, Plant) else None
-        if plant is None:
+        if not isinstance(model, Plant):
             plant = Plant(model, dict(parameters or {}), method, resolution)
         elif parameters or method != "galerkin" or resolution is not None:
             raise ArgumentError("give parameters, method and resolution to the Plant, not twice")
+        else:
+            plant = model
         n_outputs = plant.model.order * plant.model.size
         if (sensors is None) == (C_m is None):
             raise ObserverError(
@@ -316,7 +318,7 @@ class Observer:
         return self.L is not None and bool(self.L.free_symbols)
 
     def with_gain(self, gain: Any) -> Observer:
-        """The same sensors with another gain."""
+        """Return an observer with the same sensors and another gain."""
         return self._copy(gain=gain_matrix(gain, self.q), tuning=None)
 
     def _copy(self, gain: Any, tuning: TuneResult | None) -> Observer:
@@ -349,7 +351,9 @@ class Observer:
     def spectrum(
         self, *, max_resolution: int | None = None, tol: float | None = None, count: int = 6
     ) -> SpectrumReport:
-        r"""The converged spectrum of the error system :math:`\tilde u = -C_m^\top L C_m \tilde y`.
+        r"""Return the converged spectrum of the error system.
+
+        The error system is the plant with :math:`\tilde u = -C_m^\top L C_m \tilde y`.
 
         Only eigenvalues that agree at two resolutions are kept; the report says whether
         the abscissa converged (:func:`phdesign.numeric.spectrum.spectrum`).

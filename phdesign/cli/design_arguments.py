@@ -164,7 +164,7 @@ def join_negative_values(argv: list[str], parser: argparse.ArgumentParser) -> li
     negative number; a value such as ``-1,1`` or ``-0.5,[..]`` is glued to the option that
     takes it (only options that take a value, so flags are never changed).
     """
-    takes_value = set()
+    takes_value: set[str] = set()
     actions = list(parser._actions)
     while actions:
         action = actions.pop()

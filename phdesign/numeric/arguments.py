@@ -1,4 +1,4 @@
-r"""The argument checks of the numeric front door: :func:`spectrum`, :func:`simulate`, :func:`tune`.
+r"""The argument checks of the numeric front door: spectrum, simulate and tune.
 
 Each public numeric function calls one checker of this module first, so that a wrong
 argument is refused before any work with a phdesign error that names it (never an
@@ -15,10 +15,10 @@ Examples
 >>> from phdesign.models import load_builtin
 >>> from phdesign.numeric.bridge import to_numeric
 >>> nm = to_numeric(load_builtin("wave"))
->>> check_sensors_and_gain(nm, np.array([[0.0, 0.0]]), np.eye(1))
+>>> check_sensors_and_gain(nm, np.array([[0.0, 0.0]]), np.eye(1))  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-phdesign.errors.ObserverError: C_m must have full row rank (independent measurements); expected rank 1 but found 0
+phdesign.errors.ObserverError: C_m must have full row rank ...; expected rank 1 but found 0
 """
 
 from __future__ import annotations

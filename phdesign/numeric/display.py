@@ -79,7 +79,7 @@ class SimulationDisplay:
         force: bool = False,
         title: str | None = None,
     ) -> Figure:
-        """Draw the summary figure (:func:`phdesign.plots.plot_simulation`); save it to ``path``."""
+        """Draw the summary figure (:func:`phdesign.plots.plot_simulation`), saved to ``path``."""
         from phdesign.plots import plot_simulation
 
         return plot_simulation(

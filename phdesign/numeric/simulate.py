@@ -41,8 +41,8 @@ import scipy.linalg as sl
 from phdesign.errors import NumericError
 from phdesign.numeric.arguments import check_simulate_arguments
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.display import SimulationDisplay
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
+from phdesign.numeric.display import SimulationDisplay
 
 __all__ = [
     "ENERGY_BALANCE_RTOL",

@@ -32,8 +32,9 @@ Examples
 (True, Min(l2, l1/(l1**2 + 1)))
 >>> result.result("3.3", 3).reason
 'ẽ2(0) is left free by these sensors; fails for all positive gains'
->>> classify(beam, sensor_matrix([4], 4), [0.5])
-Classification(model='euler-bernoulli', sensors='y4', L='diag(0.5)', verdict='exponential', best='3.4.4', kappa=0.4)
+>>> classify(beam, sensor_matrix([4], 4), [0.5])  # doctest: +NORMALIZE_WHITESPACE
+Classification(model='euler-bernoulli', sensors='y4', L='diag(0.5)',
+               verdict='exponential', best='3.4.4', kappa=0.4)
 """
 
 from __future__ import annotations
@@ -309,7 +310,7 @@ class Classification:
         return "\n".join(lines)
 
     def _not_applicable(self) -> list[str]:
-        """The variants that do not apply, grouped by proposition and reason."""
+        """Return the variants that do not apply, grouped by proposition and reason."""
         groups: dict[tuple[str, str], list[int]] = {}
         for r in self.results:
             if not r.applicable:

@@ -124,7 +124,7 @@ class PortsDisplay:
         return "ports" if m is None else f"model {m.name}: N = {m.order}, n = {m.size}"
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``phdesign ports --json`` (matrices as rows of exact strings)."""
+        """Return the JSON of ``phdesign ports --json`` (matrices as rows of exact strings)."""
         m = self.model
 
         def rows(M: sympy.MatrixBase) -> list[list[str]]:

@@ -334,7 +334,7 @@ def _exact(rows: list[list[Any]], what: str) -> sympy.ImmutableMatrix:
 
 
 def _number(x: object, what: str) -> sympy.Expr:
-    """An exact number (symbols of symbolic gains kept), as an :class:`ObserverError`."""
+    """Return ``x`` as an exact number (symbols kept), or raise ObserverError."""
     if isinstance(x, sympy.Basic) and x.has(sympy.nan, sympy.zoo, sympy.oo, -sympy.oo):
         raise ObserverError(f"{what} must be a finite number; found {x}")
     if isinstance(x, sympy.Expr) and x.free_symbols:
@@ -377,9 +377,9 @@ def port_inverse(model: BCPHS) -> sympy.ImmutableMatrix:
     >>> from phdesign.models import load_builtin
     >>> port_inverse(load_builtin("wave"))  # v = (e1(1), e2(1), e1(0), e2(0))
     Matrix([
-    [0, 0, 0, 1],
-    [0, 1, 0, 0],
-    [1, 0, 0, 0],
+    [0, 0,  0, 1],
+    [0, 1,  0, 0],
+    [1, 0,  0, 0],
     [0, 0, -1, 0]])
     """
     from phdesign.arguments import require_model

@@ -11,7 +11,8 @@ for :math:`k \ge 1`,
     \qquad Q_{ij} = (-1)^{i-1} P_{i+j-1} \ (i + j - 1 \le N), \ 0 \text{ otherwise},
 
 (block indices :math:`i, j = 1..N`). The paper prints :math:`(-1)^{j-1}`, which has the
-wrong sign for every even :math:`k` (see the conventions in the documentation). Proof sketch: moving :math:`j-1`
+wrong sign for every even :math:`k` (see the conventions in the documentation).
+Proof sketch: moving :math:`j-1`
 derivatives of :math:`\partial_z^k e` onto :math:`e^\top` leaves boundary terms
 :math:`(-1)^{i-1} (\partial^{i-1} e)^\top P_k \partial^{k-i} e`, :math:`i = 1..k`, whose
 symmetrization is the :math:`(i, k+1-i)` block of :math:`Q`, and the remaining integral

@@ -376,7 +376,7 @@ def variant_cases(
 
 
 def verdict_of(convergences: Iterable[str]) -> str:
-    """The verdict from the kinds of convergence of the holding variants.
+    """Return the verdict from the kinds of convergence of the holding variants.
 
     *exponential* if a variant of 3.2, 3.3 or 3.4 holds, *asymptotic* if only 3.1 holds,
     *inconclusive* if none does: the propositions are sufficient, never "unstable".

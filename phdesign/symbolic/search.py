@@ -31,8 +31,9 @@ Examples
 ((2,), (4,))
 >>> found.subset([4]).best, found.subset([4]).kappa
 ('3.4.4', 0.5)
->>> found
-SensorSearch(model='euler-bernoulli', sets=15, gains='diag(1, 1, 1, 1)', minimal_exponential=[[2], [4]])
+>>> found  # doctest: +NORMALIZE_WHITESPACE
+SensorSearch(model='euler-bernoulli', sets=15, gains='diag(1, 1, 1, 1)',
+             minimal_exponential=[[2], [4]])
 """
 
 from __future__ import annotations
