@@ -190,7 +190,7 @@ COMMAND_ROWS = [
     row(
         "spectrum wave --sensors 3", "output index 3 is out of range; expected 1..2", ObserverError
     ),
-    row("spectrum euler-bernoulli --sensors 3,4 --gain symbolic", "l1", ParameterError),
+    row("spectrum euler-bernoulli --sensors 3,4 --gain symbolic", "l1", ObserverError),
     row("spectrum wave --resolution 0", "--resolution", NumericError),
     row("spectrum wave --method spectral", "argument --method: invalid choice: 'spectral'", None),
     row("spectrum airy --method fd", "N = 1 and 2", NumericError),

@@ -37,12 +37,16 @@ __all__ = [
 
 
 def add_observer_arguments(
-    parser: argparse.ArgumentParser, *, symbolic: bool = False, gain: bool = True
+    parser: argparse.ArgumentParser,
+    *,
+    symbolic: bool = False,
+    gain: bool = True,
+    required: bool = False,
 ) -> None:
     """Add ``--sensors`` / ``--cm`` (exclusive) and, with ``gain``, ``--gain``.
 
     ``symbolic`` says whether the command accepts ``--gain symbolic`` (classify does; the
-    numeric commands need numbers).
+    numeric commands need numbers); ``required`` whether sensors need an explicit gain.
     """
     group = parser.add_mutually_exclusive_group(required=not gain)
     group.add_argument(
@@ -54,8 +58,10 @@ def add_observer_arguments(
     forms = "'0.1,1' (diagonal, one value per sensor or one for all), '[[..]]' (full)"
     if symbolic:
         help_text = f"observer gain L: {forms} or 'symbolic' (positive symbols); default identity"
-    else:
+    elif required:
         help_text = f"observer gain L (required with --sensors/--cm): {forms}"
+    else:
+        help_text = f"observer gain L: {forms}; default identity (with a warning)"
     parser.add_argument("--gain", metavar="L", help=help_text)
 
 

@@ -51,7 +51,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         help="converged spectral abscissa of the plant (u = 0) or of the error system",
     )
     add_model_argument(sp)
-    add_observer_arguments(sp)
+    add_observer_arguments(sp, required=True)
     _add_discretization(sp, "default: the first of the refinement pairs")
     sp.add_argument(
         "--tol",
@@ -177,7 +177,7 @@ def _simulate(args: argparse.Namespace) -> int:
         raise NumericError(f"--samples must be at least 2; found {args.samples}")
     model = load_model(args)
     observer = observer_from_args(
-        args, model, command="simulate", method=args.method, resolution=args.resolution
+        args, model, default_gain=1, method=args.method, resolution=args.resolution
     )
     if args.xhat0 and observer is None:
         raise NumericError("--xhat0 needs an observer: give --sensors or --cm")
@@ -214,6 +214,8 @@ def _simulate(args: argparse.Namespace) -> int:
     if args.plot:
         res.plot(args.plot, force=args.force)
     warnings = list(res.warnings)
+    if observer is not None and args.gain is None:
+        warnings.insert(0, "no --gain given: the observer uses L = I (--gain 1)")
     if args.x0 is None:
         warnings.insert(
             0,

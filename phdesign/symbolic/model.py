@@ -347,6 +347,9 @@ def _validate(model: BCPHS) -> list[str]:
         check_shape(f"P{k}", P_k, (n, n))
     if len(model.state_names) != n:
         raise ModelError(f"state_names must hold {n} labels; found {len(model.state_names)}")
+    for label in model.state_names:
+        if not isinstance(label, str) or not label.strip():
+            raise ModelError(f"state_names must be non-empty text labels; found {label!r}")
 
     symbols = {s for s, _ in model.parameters}
     for s, value in model.parameters:

@@ -164,8 +164,12 @@ def measurement_matrix(C_m: Any, n_outputs: int) -> sympy.ImmutableMatrix:
             f"Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) with "
             f"1 <= q <= {n_outputs} but found ({len(rows)}, {len(rows[0])})"
         )
+    if len(rows[0]) != n_outputs:
+        raise ObserverError(
+            f"Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) but found "
+            f"({len(rows)}, {len(rows[0])})"
+        )
     matrix = _exact(rows, "C_m")
-    check_shape("C_m", matrix, (matrix.rows, n_outputs), error=ObserverError)
     if matrix.free_symbols:
         raise ObserverError(
             f"C_m must be numeric; found symbols {sorted(map(str, matrix.free_symbols))}"
@@ -223,7 +227,7 @@ def gain_matrix(gain: Any, q: int, per: str = "sensor") -> sympy.ImmutableMatrix
         gain = [gain]
     if isinstance(gain, sympy.MatrixBase) or getattr(gain, "ndim", 1) == 2:
         rows = _rows(gain, "gain")
-    elif isinstance(gain, Iterable):
+    elif isinstance(gain, Iterable) and not isinstance(gain, Mapping | set | frozenset):
         entries = list(gain.tolist() if hasattr(gain, "tolist") else gain)
         if entries and all(_is_scalar(x) for x in entries):
             return _check_gain(sympy.diag(*_diagonal(entries, q, per)), q)
