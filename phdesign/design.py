@@ -444,10 +444,10 @@ class Observer:
         from phdesign.numeric import export
 
         choice(system, "system", STATESPACE_SYSTEMS, ObserverError)
-        d = self.plant.discrete(resolution)
         if system == "plant":
-            return export.plant_statespace(d)
+            return export.plant_statespace(self.plant.discrete(resolution))
         C, L = self.numeric_gain("statespace")
+        d = self.plant.discrete(resolution)
         if system == "observer":
             return export.observer_statespace(d, C, L)
         return export.error_statespace(d, C, L)

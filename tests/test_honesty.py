@@ -126,9 +126,7 @@ def test_classifier_reports_its_path_and_agrees(method):
     assert variant.holds
     assert abs(variant.kappa_json() - 10 / 101) < 1e-12
     row = next(
-        r
-        for r in result.to_dict()["results"]
-        if r["proposition"] == "3.4" and r["variant"] == 3
+        r for r in result.to_dict()["results"] if r["proposition"] == "3.4" and r["variant"] == 3
     )
     expected_path = "float" if method == "float" else "exact"
     assert row["path"] == expected_path

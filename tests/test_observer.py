@@ -57,7 +57,9 @@ def test_gain_matrix_forms():
     assert all(s.is_positive for s in gain_symbols(2))
     # the command line's text reads into the same forms
     assert gain_matrix(parse_gain_text("0.1,1"), 2) == gain_matrix([0.1, 1], 2)
-    assert gain_matrix(parse_gain_text("[[1, 0.5], [0, 1]]"), 2) == gain_matrix([[1, 0.5], [0, 1]], 2)
+    assert gain_matrix(parse_gain_text("[[1, 0.5], [0, 1]]"), 2) == gain_matrix(
+        [[1, 0.5], [0, 1]], 2
+    )
 
 
 def test_measurement_matrix_exact():
@@ -105,7 +107,11 @@ BAD_DESIGNS = [
         sympy.eye(2),
         r"full row rank.*expected rank 2 but found 1",
     ),
-    (sympy.Matrix([[1, 0, 0]]), sympy.eye(1), r"C_m matrix; expected \(q, 4\).* but found \(1, 3\)"),
+    (
+        sympy.Matrix([[1, 0, 0]]),
+        sympy.eye(1),
+        r"C_m matrix; expected \(q, 4\).* but found \(1, 3\)",
+    ),
     (sympy.zeros(0, 4), sympy.eye(0), r"C_m: expected a non-empty list of non-empty rows"),
     (sympy.zeros(5, 4), sympy.eye(5), r"1 <= q <= 4"),
     (sensor_matrix([3, 4], 4), sympy.eye(3), r"L matrix; expected \(2, 2\).* but found \(3, 3\)"),
