@@ -82,11 +82,11 @@ def test_observer_forms_are_one_validation(wave, beam):
         beam, C_m=np.array([[0, 0, 1, 0], [0, 0, 0, 1]]), gain=np.diag([0.1, 1])
     )
     assert by_index == by_matrix  # exact: 0.1 is read as 1/10 both ways
-    assert by_index.L == sympy.diag(sympy.Rational(1, 10), 1)
+    assert sympy.diag(sympy.Rational(1, 10), 1) == by_index.L
     assert phd.Observer(wave, sensors=2).L is None  # no gain yet: only tune() applies
     with pytest.raises(ObserverError, match="classify needs a gain"):
         phd.Observer(wave, sensors=2).classify()
-    with pytest.raises(ObserverError, match="either sensors=.* or C_m=.*found both"):
+    with pytest.raises(ObserverError, match=r"either sensors=.* or C_m=.*found both"):
         phd.Observer(wave, sensors=[2], C_m=[[0, 1]])
     with pytest.raises(ObserverError, match="output index 3 is out of range"):
         phd.Observer(wave, sensors=[3], gain=1)
@@ -105,12 +105,14 @@ def test_tune_returns_a_new_observer_carrying_the_report(wave):
     # tuned gain approaches 1 and beats the start k = 0.5, α = ½ ln(1/3)
     obs = phd.Observer(wave, sensors=[2], gain=0.5)
     tuned = obs.tune(starts=1, resolution=12)  # a small pair: the optimum is a boundary one
-    assert obs.L == sympy.Matrix([[sympy.Rational(1, 2)]]) and obs.tuning is None
+    assert sympy.Matrix([[sympy.Rational(1, 2)]]) == obs.L
+    assert obs.tuning is None
     assert tuned.C_m == obs.C_m
     assert np.array_equal(np.array(tuned.L.tolist(), dtype=float), tuned.tuning.gain)
     assert abs(float(tuned.L[0, 0]) - 1) < 1e-3
     assert tuned.tuning.spectral_abscissa < 0.5 * math.log(1 / 3) - 5
-    assert "tuned_abscissa" in repr(tuned) and len(repr(tuned)) <= 300
+    assert "tuned_abscissa" in repr(tuned)
+    assert len(repr(tuned)) <= 300
 
 
 def test_parameters_reach_classification_and_numbers(beam):
@@ -146,7 +148,8 @@ def test_initial_state_uses_the_parameters_of_the_numeric_model(wave):
 def test_every_command_refuses_a_rank_deficient_C_m(capsys, argv):
     # issue 12 item 7: tune wave --cm '[[0,0]]' reported an "optimal, converged" gain
     status, out, err = run(capsys, *argv)
-    assert status == 2 and out == ""
+    assert status == 2
+    assert out == ""
     assert "C_m must have full row rank (independent measurements); expected rank 1" in err
 
 
@@ -223,7 +226,7 @@ def test_public_functions_name_their_arguments(wave, beam):
             lambda: phd.Observer(wave, sensors=[2], gain=1).statespace("loop"),
             ObserverError,
             r"system must be one of 'plant', 'observer', 'error'",
-        ),  # fmt: skip
+        ),
     ]
     for call, error, message in cases:
         with pytest.raises(error, match=message) as info:
@@ -272,8 +275,11 @@ def test_simulation_prints_its_csv_and_plots_a_titled_figure(capsys, wave):
     run_ = phd.Observer(wave, sensors=[2], gain=0.5, resolution=8).simulate(
         "x2: sin(pi*z)", t_end=0.2, samples=5
     )
-    assert status == 0 and out == str(run_) and err == ""  # the CSV ends with its newline
-    assert len(repr(run_)) <= 300 and "<table>" in run_._repr_html_()
+    assert status == 0
+    assert out == str(run_)
+    assert err == ""
+    assert len(repr(run_)) <= 300
+    assert "<table>" in run_._repr_html_()
     fig = run_.plot()
     assert fig._suptitle.get_text() == "wave, sensors y2, L = diag(0.5), galerkin 8"
     # no --x0: the plant is at rest and every series is zero: say so; no --gain: L = I
@@ -303,7 +309,8 @@ def test_proposition_34_rows_use_the_models_components(beam):
     result = phd.Observer(beam, sensors=[3, 4], gain=1).classify().result("3.4", 3)
     assert result.rhs == "‖ẽ(1)‖² + ‖ẽ1'(1)‖² + ‖ẽ1(0)‖²"
     symbolic = str(phd.search_sensors(beam, gain="symbolic"))
-    assert "depends on L" in symbolic and "—" not in symbolic.split("\n")[5]
+    assert "depends on L" in symbolic
+    assert "—" not in symbolic.split("\n")[5]
 
 
 def test_negative_gains_are_read_as_values(capsys):

@@ -50,10 +50,11 @@ def test_readme_api_block_runs_and_its_numbers_hold():
     # H̃/H̃(0) < 1e-2 after about 0.92 s (the README states it; 2-digit claim)
     assert abs(run.time_below(1e-2) - 0.92) < 0.01
     # tune returns a new observer with the report; the tuned abscissa beats design 2's
-    assert type(tuned).__name__ == "Observer" and tuned is not namespace["obs"]
+    assert type(tuned).__name__ == "Observer"
+    assert tuned is not namespace["obs"]
     assert tuned.tuning is not None
     assert tuned.tuning.spectral_abscissa < report.spectral_abscissa - 1.0
-    assert namespace["obs"].L == sympy.diag(sympy.Rational(1, 10), 1)  # unchanged
+    assert sympy.diag(sympy.Rational(1, 10), 1) == namespace["obs"].L  # unchanged
     assert isinstance(error_system, control.StateSpace)
     # the minimal exponential sensor sets of the beam (derived in tests/test_search.py)
     assert search.minimal["exponential"] == ((2,), (4,))
