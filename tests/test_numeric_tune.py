@@ -40,5 +40,5 @@ def test_tune_rejects_bad_sensors():
     with pytest.raises(ObserverError, match="C_m: expected a non-empty list of non-empty rows"):
         tune(numeric("wave"), np.zeros((0, 2)))
     # issue 12 item 7: a rank-deficient C_m is refused as classify refuses it
-    with pytest.raises(ObserverError, match="full row rank.*expected rank 1 but found 0"):
+    with pytest.raises(ObserverError, match=r"full row rank.*expected rank 1 but found 0"):
         tune(numeric("wave"), np.zeros((1, 2)))

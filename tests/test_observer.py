@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import sympy
 
+from phdesign.cli.design_arguments import parse_gain_text, parse_rows_text, parse_sensors_text
 from phdesign.errors import ObserverError, PhdesignError
 from phdesign.models import load_builtin
-from phdesign.cli.design_arguments import parse_gain_text, parse_rows_text, parse_sensors_text
 from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.observer import (
     ObserverDesign,
