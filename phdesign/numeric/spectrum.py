@@ -287,7 +287,7 @@ def spectrum(
     resolution, max_resolution : int, optional
         First and largest resolution (degree or nodes per group).
     tol : float, optional
-        Required agreement of the abscissa (absolute, times max(1, |α|)); default 1e-10
+        Required agreement of the abscissa (absolute, times max(1, abs(α))); default 1e-10
         for Galerkin, 1e-3 for the second-order finite differences.
     rtol_resolved : float, optional
         Relative drift under which an eigenvalue counts as resolved; default 1e-6 for

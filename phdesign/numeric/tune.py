@@ -49,7 +49,7 @@ class TuneResult:
     at_coalescence : bool
         Whether two or more eigenvalues (not conjugates) meet at the optimum.
     active : list of complex
-        Resolved eigenvalues (upper half-plane) whose real parts lie within 1e-3 |α| of α.
+        Resolved eigenvalues (upper half-plane) whose real parts lie within 1e-3 abs(α) of α.
     report : SpectrumReport
     starts : list of dict
         Every start with its local optimum.

@@ -17,16 +17,16 @@ partition :math:`x = (x_1, x_2)` of the state.
 The variants are numbered in the paper's order; in 3.1 and 3.2 variant 1 is
 the ":math:`a`" form and variant 2 the ":math:`b`" form.
 
-================  ==========  ====================================================
-proposition       applies to  right-hand side (norms squared, summed)
-================  ==========  ====================================================
-3.1 (asymptotic)  any N       1: all :math:`e^{(k)}(a)`, k < N;  2: same at b
-3.2 (exponential) N = 1       1: :math:`e(a)`;  2: :math:`e(b)`
-3.3 (exponential) N = 2       1: e(a), e'(a), e(b);  2: e(a), e'(a), e'(b);
-                              3: e(b), e'(b), e(a);  4: e(b), e'(b), e'(a)
-3.4 (exponential) N = 2 and   1: e(a), e₁'(a), e₁(b);  2: e(a), e₂'(a), e₁'(b);
-                  Asm. 3.1    3: e(b), e₁'(b), e₁(a);  4: e(b), e₂'(b), e₁'(a)
-================  ==========  ====================================================
+=================  ===========  ====================================================
+proposition        applies to   right-hand side (norms squared, summed)
+=================  ===========  ====================================================
+3.1 (asymptotic)   any N        1: all :math:`e^{(k)}(a)`, k < N;  2: same at b
+3.2 (exponential)  N = 1        1: :math:`e(a)`;  2: :math:`e(b)`
+3.3 (exponential)  N = 2        1: e(a), e'(a), e(b);  2: e(a), e'(a), e'(b);
+                                3: e(b), e'(b), e(a);  4: e(b), e'(b), e'(a)
+3.4 (exponential)  N = 2 and    1: e(a), e₁'(a), e₁(b);  2: e(a), e₂'(a), e₁'(b);
+                   Asm. 3.1     3: e(b), e₁'(b), e₁(a);  4: e(b), e₂'(b), e₁'(a)
+=================  ===========  ====================================================
 
 Here :math:`e_1 = \mathcal H_1 x_1` and :math:`e_2 = \mathcal H_2 x_2` are the
 blocks of :math:`e` under the partition of Assumption 3.1; :meth:`Variant.describe`
