@@ -163,10 +163,26 @@ class Plant:
         self, *, max_resolution: int | None = None, tol: float | None = None, count: int = 6
     ) -> SpectrumReport:
         """Return the converged spectrum of the plant with u = 0."""
+        return self.closed_spectrum(
+            None, None, max_resolution=max_resolution, tol=tol, count=count
+        )
+
+    def closed_spectrum(
+        self,
+        C_m: np.ndarray | None,
+        L: np.ndarray | None,
+        *,
+        max_resolution: int | None = None,
+        tol: float | None = None,
+        count: int = 6,
+    ) -> SpectrumReport:
+        r"""Return the converged spectrum with :math:`u = -C_m^\top L C_m y` (u = 0 without)."""
         from phdesign.numeric.spectrum import spectrum
 
         return spectrum(
             self.numeric,
+            C_m,
+            L,
             method=self.method,
             resolution=self.resolution,
             max_resolution=max_resolution,
@@ -184,19 +200,37 @@ class Plant:
         scheme: str = "expm",
     ) -> SimulationResult:
         """Simulate the plant alone from ``x0`` (text or a function of z; zero by default)."""
+        return self.run(None, None, x0, t_end=t_end, samples=samples, u=u, scheme=scheme)
+
+    def run(
+        self,
+        C_m: np.ndarray | None,
+        L: np.ndarray | None,
+        x0: str | Callable[[Any], Any] | None = None,
+        *,
+        xhat0: str | Callable[[Any], Any] | None = None,
+        labels: Mapping[str, str] | None = None,
+        **options: Any,
+    ) -> SimulationResult:
+        """Simulate the plant, with the observer of ``(C_m, L)`` when given.
+
+        ``options`` are those of :func:`phdesign.numeric.simulate.simulate` (``t_end``,
+        ``samples``, ``u``, ``scheme``, ``z_w``), checked there; ``labels`` name the design
+        in the result (presentation only: the plots' titles and the JSON).
+        """
         from phdesign.numeric.simulate import simulate
 
         result = simulate(
             self.numeric,
+            C_m,
+            L,
             x0=self.initial_state(x0, "x0"),
-            t_end=t_end,
-            samples=samples,
+            xhat0=self.initial_state(xhat0, "xhat0"),
             method=self.method,
             resolution=self.resolution,
-            u=u,
-            scheme=scheme,
+            **options,
         )
-        return self.labelled(result)
+        return self.labelled(result, **(labels or {}))
 
     def labelled(self, result: SimulationResult, **labels: str) -> SimulationResult:
         """Return the result with the model's name (and the design's ``labels``) in its ``info``.
@@ -358,18 +392,9 @@ class Observer:
         Only eigenvalues that agree at two resolutions are kept; the report says whether
         the abscissa converged (:func:`phdesign.numeric.spectrum.spectrum`).
         """
-        from phdesign.numeric.spectrum import spectrum
-
         C, L = self.numeric_gain("spectrum")
-        return spectrum(
-            self.plant.numeric,
-            C,
-            L,
-            method=self.plant.method,
-            resolution=self.plant.resolution,
-            max_resolution=max_resolution,
-            tol=tol,
-            count=count,
+        return self.plant.closed_spectrum(
+            C, L, max_resolution=max_resolution, tol=tol, count=count
         )
 
     def simulate(
@@ -395,24 +420,19 @@ class Observer:
         t_end, samples, u, scheme, z_w
             See :func:`phdesign.numeric.simulate.simulate`.
         """
-        from phdesign.numeric.simulate import simulate
-
         C, L = self.numeric_gain("simulate")
-        result = simulate(
-            self.plant.numeric,
+        return self.plant.run(
             C,
             L,
-            x0=self.plant.initial_state(x0, "x0"),
-            xhat0=self.plant.initial_state(xhat0, "xhat0"),
+            x0,
+            xhat0=xhat0,
+            labels=self._labels(),
             t_end=t_end,
             samples=samples,
-            method=self.plant.method,
-            resolution=self.plant.resolution,
             u=u,
             scheme=scheme,
             z_w=z_w,
         )
-        return self.plant.labelled(result, **self._labels())
 
     def tune(
         self, *, full: bool = False, starts: int = 6, seed: int = 0, resolution: int | None = None

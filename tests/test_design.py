@@ -366,3 +366,18 @@ def test_spectrum_legend_lists_only_what_is_in_view():
     fig = plots.plot_spectrum(lam, np.array([True, True, False]), ylim=(-5, 5))
     texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert texts == ["resolved (agree at two resolutions)"]  # 90j is out of view
+
+
+def test_library_raises_no_plain_value_errors(beam, monkeypatch):
+    # issue 11 bug: plain ValueErrors outside the error family (classify's method, the
+    # exact path of the certificate, the partition of Proposition 3.4)
+    import phdesign.symbolic.certificate as certificate
+    from phdesign.symbolic.propositions import VARIANTS
+
+    with pytest.raises(ObserverError, match="method must be one of 'auto', 'exact', 'float'"):
+        phd.classify(beam, phd.sensor_matrix([4], 4), 1, method="bogus")
+    monkeypatch.setattr(certificate, "_exact_kappa", lambda A, B: None)  # no closed form
+    with pytest.raises(ObserverError, match="method='exact': no exact root"):
+        phd.classify(beam, phd.sensor_matrix([4], 4), 1, method="exact")
+    with pytest.raises(ObserverError, match="needs the partition"):
+        VARIANTS[8].traces(order=2, size=2)
