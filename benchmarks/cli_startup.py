@@ -14,7 +14,6 @@ import sys
 
 from _timing import PYTHON, report, time_command
 
-
 #: ``import phdesign`` before issue 11 (median on the project machine, eager sympy and io).
 IMPORT_BEFORE = 0.82
 
