@@ -114,7 +114,13 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
     from phdesign.symbolic.search import SensorSearch, search_sensors
 
 
+#: Subpackages and modules reachable as attributes (``phd.plots``), imported on first use.
+_SUBMODULES = ("cli", "design", "errors", "io", "models", "numeric", "plots", "symbolic")
+
+
 def __getattr__(name: str) -> Any:
+    if name in _SUBMODULES:
+        return importlib.import_module(f"phdesign.{name}")
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'phdesign' has no attribute {name!r}")
@@ -124,4 +130,4 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *_EXPORTS})
+    return sorted({*globals(), *_EXPORTS, *_SUBMODULES})

@@ -109,7 +109,7 @@ class Plant:
     """
 
     model: BCPHS
-    parameters: Mapping[str, Any] = field(default_factory=dict)
+    parameters: Mapping[str, Any] = field(default_factory=dict, hash=False)
     method: str = "galerkin"
     resolution: int | None = None
 

@@ -95,12 +95,18 @@ class ModelDisplay:
 
     def _repr_html_(self) -> str:
         rows = [
-            [line.split(":", 1)[0], line.split(":", 1)[-1].strip()]
-            for line in str(self).split("\n")[1:]
+            ["description", self.description],
+            ["interval", _interval_text(self.interval)],
+            ["states", ", ".join(self.state_names)],
+            ["parameters", ", ".join(f"{s} = {number_text(v)}" for s, v in self.parameters)],
+            *([f"P{k}", _rows(P)] for k, P in enumerate(self.P) if not P.is_zero_matrix),
+            ["H", _rows(self.H)],
+            ["inputs", self._port_text(self.inputs, "u")],
+            ["outputs", self._port_text(self.outputs, "y")],
+            ["checks", "; ".join(self.checks)],
         ]
-        return html_table(
-            ["", ""], rows, caption=f"{self.name}: N = {self.order}, n = {self.size}"
-        )
+        caption = f"{self.name}: N = {self.order}, n = {self.size}"
+        return html_table(["", ""], [r for r in rows if r[1]], caption=caption)
 
 
 class PortsDisplay:
