@@ -24,23 +24,15 @@
 # The inputs are the velocity at $z = 0$ and the stress at $z = 1$; the outputs are their
 # power conjugates, so that $\dot H = u^\top y$. We write the model once in TOML and once
 # in code, derive its ports, classify an observer, search the sensors, and export the
-# error system to python-control.
+# error system to python-control. Everything is reached through `import phdesign as phd`;
+# every result shows itself as a table (its `print()` is what the command line prints).
 
 # %%
 import control
 import numpy as np
 
+import phdesign as phd
 from phdesign import plots
-from phdesign.io import model_from_toml, model_to_toml
-from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretize import discretize
-from phdesign.numeric.export import error_statespace, observer_statespace, plant_statespace
-from phdesign.numeric.spectrum import spectrum
-from phdesign.symbolic.classify import classify
-from phdesign.symbolic.model import BCPHS
-from phdesign.symbolic.observer import parse_gain, parse_sensors
-from phdesign.symbolic.ports import derive_ports
-from phdesign.symbolic.search import search_sensors
 
 TOML = """
 name = "tapered string"
@@ -60,15 +52,15 @@ H = [["1/rho", 0], [0, "T0*(1 + z)"]]
 inputs = ["e1(0)", "e2(1)"]
 outputs = ["-e2(0)", "e1(1)"]
 """
-string = model_from_toml(TOML)
-print(string.name, "| N =", string.order, "| n =", string.size, "| H =", string.H.tolist())
+string = phd.model_from_toml(TOML)
+string
 
 # %% [markdown]
 # The same model in code. Construction validates everything (symmetry of $P_k$,
 # $P_0 + P_0^\top \le 0$, $P_N$ invertible, $\mathcal H$ positive definite, admissible ports).
 
 # %%
-same = BCPHS.define(
+same = phd.BCPHS.define(
     name="tapered string",
     interval=(0, 1),
     order=1,
@@ -81,7 +73,7 @@ same = BCPHS.define(
 )
 assert same.H == string.H
 assert same.inputs == string.inputs
-print(model_to_toml(same)[:120], "...")
+print(phd.model_to_toml(same)[:120], "...")
 
 # %% [markdown]
 # ## Ports
@@ -90,12 +82,9 @@ print(model_to_toml(same)[:120], "...")
 # $W_B \Sigma W_B^\top = 0$, $W_C \Sigma W_C^\top = 0$, $W_C \Sigma W_B^\top = I$.
 
 # %%
-ports = derive_ports(string)
-print("Q =", ports.Q.tolist())
-print("W_B =", ports.W_B.tolist())
-print("W_C =", ports.W_C.tolist())
-print("identities:", ports.identities)
+ports = string.ports  # derived once, exactly, when the model was built
 assert all(v == 0 for v in ports.identities.values())
+ports
 
 # %% [markdown]
 # ## Classification of one design
@@ -106,14 +95,11 @@ assert all(v == 0 for v in ports.identities.values())
 # $\|\tilde e(1)\|^2 = (1 + 0.25)\, \tilde v(1)^2$ and $\kappa^* = 0.5 / 1.25 = 0.4$.
 
 # %%
-C_sym = parse_sensors("2", 2)
-result = classify(string, C_sym, parse_gain("0.5", 1))
-print("verdict:", result.verdict)
-for r in result.results:
-    if r.applicable:
-        print(f"  {r.proposition}.{r.variant}: {r.reason}")
+obs = phd.Observer(string, sensors=[2], gain=0.5)
+result = obs.classify()
 assert result.verdict == "exponential"
 assert abs(result.result("3.2", 2).kappa_float - 0.4) < 1e-12
+result
 
 # %% [markdown]
 # ## Sensor search
@@ -121,11 +107,9 @@ assert abs(result.result("3.2", 2).kappa_float - 0.4) < 1e-12
 # Every non-empty sensor subset, classified exactly; the minimal sets per verdict.
 
 # %%
-found = search_sensors(string, gain="0.5")
-for s in found.subsets:
-    print(f"  sensors {s.sensors}: {s.verdict:12} best {s.best}, κ* = {s.kappa}")
-print("minimal sets:", found.minimal)
+found = phd.search_sensors(string, gain=0.5)
 assert found.minimal["exponential"] == ((1,), (2,))
+found
 
 # %% [markdown]
 # ## Numbers: spectrum of the error system
@@ -144,10 +128,7 @@ assert found.minimal["exponential"] == ((1,), (2,))
 # number it cannot trust.
 
 # %%
-nm = to_numeric(string)
-C = np.array(C_sym.tolist(), dtype=float)
-L = np.array([[0.5]])
-report = spectrum(nm, C, L, max_resolution=60)
+report = obs.spectrum(max_resolution=60)
 tau, Z, k = 2 * (np.sqrt(2) - 1), np.sqrt(2), 0.5
 wkb = np.log(abs((Z - k) / (Z + k))) / (2 * tau)
 print(
@@ -170,10 +151,10 @@ assert report.spectral_abscissa < wkb
 # Its poles contain the resolved eigenvalues above.
 
 # %%
-d = discretize(nm, "galerkin", report.resolutions[1])
-plant_ss = plant_statespace(d)
-observer_ss = observer_statespace(d, C, L)
-error_ss = error_statespace(d, C, L)
+degree = report.resolutions[1]
+plant_ss = obs.statespace("plant", resolution=degree)
+observer_ss = obs.statespace("observer", resolution=degree)
+error_ss = obs.statespace("error", resolution=degree)
 for sys_ in (plant_ss, observer_ss, error_ss):
     print(f"{sys_.name:9}: {sys_.nstates} states, {sys_.ninputs} inputs, {sys_.noutputs} outputs")
 assert isinstance(error_ss, control.StateSpace)
@@ -188,3 +169,4 @@ fig = plots.plot_spectrum(
     xlim=(-3, 0.5),
     ylim=(-60, 60),
 )
+fig

@@ -39,7 +39,7 @@ from phdesign.numeric.simulate import simulate
 from phdesign.numeric.spectrum import eigen, match_resolved, spectrum
 from phdesign.numeric.tune import tune
 from phdesign.symbolic.classify import classify
-from phdesign.symbolic.observer import parse_gain, sensor_matrix
+from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 from phdesign.symbolic.ports import derive_ports
 from phdesign.symbolic.search import search_sensors
 
@@ -63,7 +63,7 @@ assert all(v == 0 for v in ports.identities.values())
 
 # %%
 C_sym = sensor_matrix([3, 4], 4)
-two = classify(beam, C_sym, parse_gain("symbolic", 2))
+two = classify(beam, C_sym, gain_matrix("symbolic", 2))
 print("verdict:", two.verdict)
 for r in two.results:
     if r.applicable:
@@ -71,7 +71,7 @@ for r in two.results:
 assert two.verdict == "exponential"
 assert two.result("3.4", 3).holds
 assert not two.result("3.3", 3).holds
-three = classify(beam, sensor_matrix([2, 3, 4], 4), parse_gain("symbolic", 3))
+three = classify(beam, sensor_matrix([2, 3, 4], 4), gain_matrix("symbolic", 3))
 print(
     "three sensors (y2, y3, y4):", three.verdict, "via 3.3.3, κ* =", three.result("3.3", 3).kappa
 )
@@ -139,12 +139,16 @@ assert abs(r2.w[0, -1] - (1 / 6 - 0.45)) < 1e-6
 
 # %%
 fig1 = plots.plot_hamiltonians(r2)
+fig1
 
 # %% [markdown]
 # ## Figures 2 to 4: deflection, its estimate, the error, and the end tip (design 2)
 
 # %%
 fig2 = plots.plot_deflection_panels(r2)
+fig2
+
+# %%
 tip = r2.w[:, -1]
 tip_err = tip - r2.w_hat[:, -1]
 after_1s = r2.t >= 1.0
@@ -212,7 +216,11 @@ assert all(row["converged"] for row in table.values())
 
 # %%
 fig5 = plots.plot_tip_error(runs)
+fig5
+
+# %%
 fig6 = plots.plot_error_energy(runs)
+fig6
 
 # %% [markdown]
 # ## The error system's spectrum for each design
@@ -345,6 +353,7 @@ fig8 = plots.plot_gain_map(
         "re-tuned": g_retuned,
     },
 )
+fig8
 
 # %% [markdown]
 # The optimum sits where the slowest error modes coalesce (a double eigenvalue: the

@@ -28,7 +28,7 @@ from phdesign.numeric.bridge import initial_state_function, to_numeric
 from phdesign.numeric.simulate import simulate
 from phdesign.numeric.spectrum import spectrum
 from phdesign.symbolic.classify import classify
-from phdesign.symbolic.observer import parse_gain, sensor_matrix
+from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 from phdesign.symbolic.search import search_sensors
 
 # %% [markdown]
@@ -44,7 +44,7 @@ from phdesign.symbolic.search import search_sensors
 
 # %%
 wave = load_builtin("wave")
-verdict = classify(wave, sensor_matrix([2], 2), parse_gain("symbolic", 1))
+verdict = classify(wave, sensor_matrix([2], 2), gain_matrix("symbolic", 1))
 print("sensor y2, symbolic gain:", verdict.verdict, "|", verdict.result("3.2", 2).reason)
 assert verdict.verdict == "exponential"
 nm_wave = to_numeric(wave)
@@ -69,6 +69,7 @@ assert np.all(errors < 1e-8)
 fig = plots.plot_abscissa_sweep(
     gains, computed, exact=exact_abscissa, exact_label="exact ½ ln|(1−k)/(1+k)|"
 )
+fig
 
 # %% [markdown]
 # The best gain is the matched damper $k = 1$: there the exact spectrum is empty. phdesign
@@ -103,6 +104,9 @@ exact = exact_abscissa(0.5) + 1j * (m + 0.5) * np.pi
 fig = plots.plot_spectrum(
     fine, mask, abscissa=rep.spectral_abscissa, exact=exact, xlim=(-1.5, 0.2), ylim=(-40, 40)
 )
+fig
+
+# %%
 print(f"{mask.sum()} of {fine.size} eigenvalues resolved at degrees {p} and {p_fine}")
 
 # %% [markdown]
@@ -117,7 +121,7 @@ print(f"{mask.sum()} of {fine.size} eigenvalues resolved at degrees {p} and {p_f
 
 # %%
 timo = load_builtin("timoshenko")
-found = search_sensors(timo, gain="1")
+found = search_sensors(timo, gain=1)
 print("minimal sensor sets:", found.minimal)
 assert found.minimal["exponential"] == ((1, 2), (3, 4))
 
@@ -147,6 +151,7 @@ assert reps["{y2, y3}"].spectral_abscissa < 0
 for label, r in reps.items():
     print(f"{label}: rightmost {', '.join(f'{z:.4f}' for z in r.rightmost[:3])}")
 fig = plots.plot_error_energy(runs)
+fig
 
 # %% [markdown]
 # Both designs converge here; only $\{y_3, y_4\}$ (or $\{y_1, y_2\}$) comes with a

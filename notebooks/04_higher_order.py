@@ -32,7 +32,7 @@ from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretize import discretize, feedback_matrix
 from phdesign.numeric.spectrum import eigen, spectrum
 from phdesign.symbolic.classify import classify
-from phdesign.symbolic.observer import parse_gain, sensor_matrix
+from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 from phdesign.symbolic.ports import derive_ports
 from phdesign.symbolic.search import search_sensors
 
@@ -51,7 +51,7 @@ assert all(v == 0 for v in ports.identities.values())
 # escapes.
 
 # %%
-full = classify(airy, sensor_matrix([1, 2, 3], 3), parse_gain("symbolic", 3))
+full = classify(airy, sensor_matrix([1, 2, 3], 3), gain_matrix("symbolic", 3))
 print("sensors y1, y2, y3:", full.verdict)
 for r in full.results:
     print(f"  {r.proposition}.{r.variant}: applicable={r.applicable}, {r.reason}")
@@ -59,12 +59,12 @@ assert full.verdict == "asymptotic"
 assert full.result("3.1", 1).holds
 assert full.result("3.1", 2).holds
 assert not any(r.applicable for r in full.results if r.proposition != "3.1")
-one = classify(airy, sensor_matrix([1], 3), parse_gain("1", 1))
+one = classify(airy, sensor_matrix([1], 3), gain_matrix(1, 1))
 print("sensor y1 only:", one.verdict, "|", one.result("3.1", 1).reason)
 assert one.verdict == "inconclusive"
 
 # %%
-found = search_sensors(airy, gain="1")
+found = search_sensors(airy, gain=1)
 for s in found.subsets:
     print(f"  sensors {s.sensors}: {s.verdict:12} best {s.best}, κ* = {s.kappa}")
 print("minimal sets:", found.minimal)
@@ -136,6 +136,7 @@ verdict, rep, alpha, lam, keep = rows[(2, 3)]
 fig = plots.plot_spectrum(
     lam, keep, abscissa=alpha, title="airy, sensors y2, y3, L = I", xlim=(-2500, 100)
 )
+fig
 
 # %% [markdown]
 # ## What this says

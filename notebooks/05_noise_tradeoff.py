@@ -24,7 +24,6 @@
 # $-\alpha$ (the converged spectral abscissa of the error system).
 
 # %%
-import matplotlib.pyplot as plt
 import numpy as np
 
 from phdesign.models import load_builtin
@@ -165,7 +164,7 @@ ax.plot(
 )
 ax.plot(budget_rms, budget_rate, "D", ms=9, color="tab:blue", mec="black", label="rms <= 0.3")
 ax.legend(loc="upper left")
-plt.show()
+fig
 
 # %% [markdown]
 # ## What to pick

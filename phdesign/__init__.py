@@ -1,26 +1,133 @@
 """phdesign: boundary observers for 1D boundary-controlled port-Hamiltonian systems.
 
-The public entry points of the symbolic layer are re-exported here; the numeric
-backend lives in :mod:`phdesign.numeric` and is imported only when used.
+A flat namespace for notebooks and scripts::
+
+    import phdesign as phd
+    beam = phd.load("euler-bernoulli")
+    obs = phd.Observer(beam, sensors=[3, 4], gain=[0.1, 1])
+    obs.classify()
+
+Every name is imported on first use (PEP 562), so ``import phdesign`` stays light: the
+command line and ``phdesign.plots`` start without sympy, numpy or matplotlib until a name
+that needs them is touched.
 """
 
-from phdesign.errors import PhdesignError
-from phdesign.io import model_from_toml, model_to_toml, read_model, write_model
-from phdesign.models import builtin_names, load_builtin
-from phdesign.symbolic.model import BCPHS, Displacement
-from phdesign.symbolic.ports import Ports, derive_ports
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+__version__ = "0.1.0"
+
+#: Public name -> module that defines it.
+_EXPORTS: dict[str, str] = {
+    # models
+    "BCPHS": "phdesign.symbolic.model",
+    "Displacement": "phdesign.symbolic.model",
+    "load": "phdesign.models",
+    "load_builtin": "phdesign.models",
+    "builtin_names": "phdesign.models",
+    "read_model": "phdesign.io",
+    "write_model": "phdesign.io",
+    "model_from_toml": "phdesign.io",
+    "model_to_toml": "phdesign.io",
+    # ports and the observer's exact layer
+    "Ports": "phdesign.symbolic.ports",
+    "derive_ports": "phdesign.symbolic.ports",
+    "port_inverse": "phdesign.symbolic.observer",
+    "sensor_matrix": "phdesign.symbolic.observer",
+    "measurement_matrix": "phdesign.symbolic.observer",
+    "gain_matrix": "phdesign.symbolic.observer",
+    "classify": "phdesign.symbolic.classify",
+    "Classification": "phdesign.symbolic.classify",
+    "search_sensors": "phdesign.symbolic.search",
+    "SensorSearch": "phdesign.symbolic.search",
+    # the design objects
+    "Observer": "phdesign.design",
+    "Plant": "phdesign.design",
+    # numbers
+    "to_numeric": "phdesign.numeric.bridge",
+    "discretize": "phdesign.numeric.discretize",
+    "spectrum": "phdesign.numeric.spectrum",
+    "SpectrumReport": "phdesign.numeric.spectrum",
+    "simulate": "phdesign.numeric.simulate",
+    "SimulationResult": "phdesign.numeric.simulate",
+    "tune": "phdesign.numeric.tune",
+    "TuneResult": "phdesign.numeric.tune",
+    # errors
+    "PhdesignError": "phdesign.errors",
+}
 
 __all__ = [
     "BCPHS",
+    "Classification",
     "Displacement",
+    "Observer",
     "PhdesignError",
+    "Plant",
     "Ports",
+    "SensorSearch",
+    "SimulationResult",
+    "SpectrumReport",
+    "TuneResult",
+    "__version__",
     "builtin_names",
+    "classify",
     "derive_ports",
+    "discretize",
+    "gain_matrix",
+    "load",
     "load_builtin",
+    "measurement_matrix",
     "model_from_toml",
     "model_to_toml",
+    "port_inverse",
     "read_model",
+    "search_sensors",
+    "sensor_matrix",
+    "simulate",
+    "spectrum",
+    "to_numeric",
+    "tune",
     "write_model",
 ]
-__version__ = "0.1.0"
+
+if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDEs
+    from phdesign.design import Observer, Plant
+    from phdesign.errors import PhdesignError
+    from phdesign.io import model_from_toml, model_to_toml, read_model, write_model
+    from phdesign.models import builtin_names, load, load_builtin
+    from phdesign.numeric.bridge import to_numeric
+    from phdesign.numeric.discretize import discretize
+    from phdesign.numeric.simulate import SimulationResult, simulate
+    from phdesign.numeric.spectrum import SpectrumReport, spectrum
+    from phdesign.numeric.tune import TuneResult, tune
+    from phdesign.symbolic.classify import Classification, classify
+    from phdesign.symbolic.model import BCPHS, Displacement
+    from phdesign.symbolic.observer import (
+        gain_matrix,
+        measurement_matrix,
+        port_inverse,
+        sensor_matrix,
+    )
+    from phdesign.symbolic.ports import Ports, derive_ports
+    from phdesign.symbolic.search import SensorSearch, search_sensors
+
+
+#: Subpackages and modules reachable as attributes (``phd.plots``), imported on first use.
+_SUBMODULES = ("cli", "design", "errors", "io", "models", "numeric", "plots", "symbolic")
+
+
+def __getattr__(name: str) -> Any:
+    if name in _SUBMODULES:
+        return importlib.import_module(f"phdesign.{name}")
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'phdesign' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_EXPORTS, *_SUBMODULES})

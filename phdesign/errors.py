@@ -1,8 +1,9 @@
 """Exceptions raised by phdesign and the one shared checker for matrix shapes.
 
 Every exception a user can provoke with bad input derives from
-:class:`PhdesignError` and from :class:`ValueError` or :class:`TypeError`, so
-callers may catch either the phdesign family or the builtin one.  Messages
+:class:`PhdesignError` and from :class:`ValueError` (a bad value) or :class:`TypeError`
+(an argument of the wrong kind, :class:`ArgumentError`), so callers may catch either the
+phdesign family or the builtin one.  Any other exception escaping phdesign is a bug.  Messages
 name the matrix, parameter or expression at fault and give what was expected
 against what was found.
 
@@ -60,8 +61,17 @@ class OutputFileError(PhdesignError, ValueError):
     """An output path is not writable or would overwrite a file without --force."""
 
 
-def check_shape(name: str, matrix: Any, expected: tuple[int, ...]) -> None:
-    """Raise :class:`ShapeError` unless ``matrix.shape == expected``.
+class ArgumentError(PhdesignError, TypeError):
+    """An argument of a library function is of the wrong kind (e.g. a name for a model)."""
+
+
+def check_shape(
+    name: str,
+    matrix: Any,
+    expected: tuple[int, ...],
+    error: type[PhdesignError] = ShapeError,
+) -> None:
+    """Raise ``error`` (:class:`ShapeError` by default) unless ``matrix.shape == expected``.
 
     Parameters
     ----------
@@ -71,10 +81,13 @@ def check_shape(name: str, matrix: Any, expected: tuple[int, ...]) -> None:
         The matrix to check (numpy array or sympy matrix).
     expected : tuple of int
         The required shape.
+    error : PhdesignError subclass
+        The exception to raise, for callers whose family is not the model's (e.g. an
+        :class:`ObserverError` for sensors and gains).
     """
     found = tuple(int(s) for s in matrix.shape)
     if found != tuple(expected):
-        raise ShapeError(
+        raise error(
             f"Incompatible dimensions of {name} matrix; "
             f"expected {tuple(expected)} but found {found}"
         )

@@ -48,7 +48,7 @@ def row(argv: str, message: str, error: type[Exception] | None, **files: str) ->
 BEAM_SENSORS = "classify euler-bernoulli --sensors"
 BEAM_GAIN = "classify euler-bernoulli --sensors 3,4 --gain"
 SIM = "simulate wave --sensors 2"
-NOISE = "noise euler-bernoulli --sensors 3,4"
+NOISE = "noise euler-bernoulli --sensors 3,4 --gain 0.1,1"
 TRADE = "tradeoff euler-bernoulli --sensors 3,4"
 TUNE_BEAM = "tune euler-bernoulli --sensors 3,4"
 EXPORT = "export euler-bernoulli --sensors 3,4 --gain 0.1,1 --format json"
@@ -194,7 +194,7 @@ COMMAND_ROWS = [
     row(
         "spectrum wave --sensors 3", "output index 3 is out of range; expected 1..2", ObserverError
     ),
-    row("spectrum euler-bernoulli --sensors 3,4 --gain symbolic", "l1", ParameterError),
+    row("spectrum euler-bernoulli --sensors 3,4 --gain symbolic", "l1", ObserverError),
     row("spectrum wave --resolution 0", "--resolution", NumericError),
     row("spectrum wave --method spectral", "argument --method: invalid choice: 'spectral'", None),
     row("spectrum airy --method fd", "N = 1 and 2", NumericError),
@@ -246,7 +246,11 @@ COMMAND_ROWS = [
     row(f"{NOISE} --intensity x", "--intensity: expected comma-separated numbers", NumericError),
     row(f"{NOISE} --input-noise -0.5", "--input-noise: intensities must be finite", NumericError),
     row(f"{NOISE} --at 2", "displacement point 2 is outside the interval [0, 1]", NumericError),
-    row("noise wave --sensors 2 --at 1", "the model 'wave' defines no displacement", NumericError),
+    row(
+        "noise wave --sensors 2 --gain 1 --at 1",
+        "the model 'wave' defines no displacement",
+        NumericError,
+    ),
     row(f"{NOISE} --integral x9:1", "integral weight: unknown component 'x9'", ParameterError),
     row(f"{NOISE} --integral e1:1", "'e1' is an effort; weigh state components", ParameterError),
     row(
@@ -339,12 +343,12 @@ COMMAND_ROWS = [
         **{"o.json": "an earlier export"},
     ),
     row(
-        "export wave --sensors 2 --dt 1e-3 --format c -o {tmp}",
+        "export wave --sensors 2 --gain 1 --dt 1e-3 --format c -o {tmp}",
         "output folder .* exists; pass --force to replace it",
         OutputFileError,
     ),
     row(
-        "export wave --sensors 2 --dt 1e-3 --format c -o {tmp}/obs",
+        "export wave --sensors 2 --gain 1 --dt 1e-3 --format c -o {tmp}/obs",
         "is a file; --format c writes a folder",
         OutputFileError,
         obs="a file",
@@ -356,7 +360,7 @@ COMMAND_ROWS = [
         OutputFileError,
     ),
     row(
-        "export wave --sensors 2 --dt 1e-3 --format c -o /proc/phdesign-export",
+        "export wave --sensors 2 --gain 1 --dt 1e-3 --format c -o /proc/phdesign-export",
         "cannot write '/proc/phdesign-export'",
         OutputFileError,
     ),
@@ -371,14 +375,14 @@ COMMAND_ROWS = [
         NumericError,
     ),
     row(
-        "export wave --sensors 2 --dt 1e-3 --at 1 --format json -o {tmp}/o.json",
+        "export wave --sensors 2 --gain 1 --dt 1e-3 --at 1 --format json -o {tmp}/o.json",
         "--at: model 'wave' has no displacement",
         NumericError,
     ),
     row(f"{EXPORT} --dt 1e-3 --t-end 0 -o {{tmp}}/o.json", "--t-end must be", NumericError),
     row(f"{EXPORT} --dt 1e-3 --output-tol=-1 -o {{tmp}}/o.json", "--output-tol", NumericError),
     row(
-        "export wave --sensors 2 --dt 1e-3 -o {tmp}/o.json",
+        "export wave --sensors 2 --gain 1 --dt 1e-3 -o {tmp}/o.json",
         "the following arguments are required: --format",
         None,
     ),

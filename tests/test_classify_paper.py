@@ -15,7 +15,7 @@ import sympy
 from phdesign.models import load_builtin
 from phdesign.symbolic.certificate import certify
 from phdesign.symbolic.classify import classify
-from phdesign.symbolic.observer import ObserverDesign, gain_symbols, parse_gain, sensor_matrix
+from phdesign.symbolic.observer import ObserverDesign, gain_matrix, gain_symbols, sensor_matrix
 
 R = sympy.Rational
 
@@ -50,7 +50,7 @@ def test_three_sensors_paper_IV_C_symbolic(beam):
     # three independent coordinates, so κ* = min(l1, l2/(1+l2^2), l3/(1+l3^2)).
     # (The paper lists (Hx̃)(1) twice in the left column; the terms are those above.)
     l1, l2, l3 = gain_symbols(3)
-    result = classify(beam, sensor_matrix([2, 3, 4], 4), parse_gain("symbolic", 3))
+    result = classify(beam, sensor_matrix([2, 3, 4], 4), gain_matrix("symbolic", 3))
     assert result.verdict == "exponential"
     r = result.result("3.3", 3)
     assert r.holds
@@ -78,7 +78,7 @@ def test_two_sensors_paper_IV_D_symbolic(beam):
     # Sensors y3, y4, L = diag(l1, l2). Error BC: e1(0) = e1'(0) = 0,
     # e2(1) = -l1 e1'(1), e2'(1) = l2 e1(1).  LHS = l1 e1'(1)^2 + l2 e1(1)^2.
     l1, l2 = gain_symbols(2)
-    result = classify(beam, sensor_matrix([3, 4], 4), parse_gain("symbolic", 2))
+    result = classify(beam, sensor_matrix([3, 4], 4), gain_matrix("symbolic", 2))
     # 3.1 variant 2: sum over k of ||e^(k)(1)||^2 = (1 + l2^2) e1(1)^2 + (1 + l1^2) e1'(1)^2
     r31 = result.result("3.1", 2)
     assert r31.holds
@@ -103,7 +103,7 @@ def test_two_sensors_paper_IV_D_symbolic(beam):
 
 def test_two_sensors_exact_matches_symbolic(beam):
     l1, l2 = gain_symbols(2)
-    symbolic = classify(beam, sensor_matrix([3, 4], 4), parse_gain("symbolic", 2))
+    symbolic = classify(beam, sensor_matrix([3, 4], 4), gain_matrix("symbolic", 2))
     for g1, g2 in [(R(1, 3), 2), (1, 1), (R(7, 2), R(1, 10))]:
         numeric = classify(beam, sensor_matrix([3, 4], 4), sympy.diag(g1, g2))
         for r_sym, r_num in zip(symbolic.results, numeric.results, strict=True):
@@ -241,7 +241,7 @@ def test_airy_is_at_best_asymptotic():
 
 
 def test_json_keys(beam):
-    data = classify(beam, sensor_matrix([3, 4], 4), sympy.diag(1, 2)).to_json_dict()
+    data = classify(beam, sensor_matrix([3, 4], 4), sympy.diag(1, 2)).to_dict()
     for key in ("model", "order", "size", "sensors", "gain", "partitioned", "results"):
         assert key in data
     assert data["verdict"] == "exponential"
@@ -273,7 +273,7 @@ def test_airy_symbolic_gains_with_irrational_ports():
     made the exact check of Y K = I fail structurally (regression).
     """
     l1, l2 = gain_symbols(2)
-    result = classify(load_builtin("airy"), sensor_matrix([1, 3], 3), parse_gain("symbolic", 2))
+    result = classify(load_builtin("airy"), sensor_matrix([1, 3], 3), gain_matrix("symbolic", 2))
     assert result.verdict == "asymptotic"
     variant = result.result("3.1", 1)
     assert variant.holds

@@ -140,7 +140,7 @@ def test_search_matches_classify_on_random_models(shape, seed):
     st.data(),
 )
 def test_symbolic_gains_agree_with_numeric_gains(shape, seed, data):
-    from phdesign.symbolic.observer import gain_symbols, parse_gain
+    from phdesign.symbolic.observer import gain_matrix, gain_symbols
 
     m = model(shape, seed)
     nn = m.order * m.size
@@ -149,7 +149,7 @@ def test_symbolic_gains_agree_with_numeric_gains(shape, seed, data):
     )
     q = len(sensors)
     C_m = sensor_matrix(sensors, nn)
-    symbolic = classify(m, C_m, parse_gain("symbolic", q))
+    symbolic = classify(m, C_m, gain_matrix("symbolic", q))
     values = data.draw(st.lists(st.integers(1, 12), min_size=q, max_size=q))
     gains = [sympy.Rational(v, 4) for v in values]
     numeric = classify(m, C_m, sympy.diag(*gains))

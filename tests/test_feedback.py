@@ -26,7 +26,7 @@ from phdesign.numeric.spectrum import spectrum
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.feedback import close_inputs, closed_ports
 from phdesign.symbolic.model import BCPHS
-from phdesign.symbolic.observer import parse_gain, sensor_matrix
+from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 from phdesign.symbolic.ports import derive_ports, q_matrix
 from phdesign.symbolic.search import search_sensors
 
@@ -86,7 +86,7 @@ def test_the_plants_damper_enters_the_left_hand_side_of_the_propositions():
     = (1 + k²) ỹ2², so κ* = k/(1 + k²) = 2/5 at k = 1/2: it holds only through the
     plant's own dissipation, and on the undamped string the same sensor leaves e1(1) free.
     """
-    l1 = parse_gain("symbolic", 1)
+    l1 = gain_matrix("symbolic", 1)
     damped = classify(load_builtin("wave-damper"), sensor_matrix([1], 1), l1)
     at_b = damped.result("3.2", 2)
     assert at_b.holds
@@ -94,7 +94,7 @@ def test_the_plants_damper_enters_the_left_hand_side_of_the_propositions():
     # at a: RHS = e1(0)² + e2(0)² = (1 + l²) ỹ1², LHS ≥ l ỹ1²: κ* = l/(1 + l²)
     (gain,) = l1.free_symbols
     assert sympy.simplify(damped.result("3.2", 1).kappa - gain / (1 + gain**2)) == 0
-    undamped = classify(load_builtin("wave"), sensor_matrix([1], 2), parse_gain("symbolic", 1))
+    undamped = classify(load_builtin("wave"), sensor_matrix([1], 2), gain_matrix("symbolic", 1))
     assert undamped.result("3.2", 2).holds is False
     # the witness: ỹ2 = e1(1) free (ũ2 = e2(1) = 0 without a sensor there)
     assert [t.label((0, 1)) for t in undamped.result("3.2", 2).free] == ["e1(1)"]
@@ -109,7 +109,7 @@ def test_beam_with_a_tip_damper_is_exponential_with_the_tip_rotation_sensor_alon
     The open beam with y3 alone is inconclusive (README): the damper makes the difference.
     """
     beam = load_builtin("beam-tip-damper")  # k = 1
-    result = classify(beam, sensor_matrix([3], 3), parse_gain("symbolic", 1))
+    result = classify(beam, sensor_matrix([3], 3), gain_matrix("symbolic", 1))
     assert result.verdict == "exponential"
     (gain,) = result.L.free_symbols
     kappa = result.result("3.4", 3).kappa

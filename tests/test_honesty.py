@@ -20,7 +20,7 @@ from phdesign.numeric.bridge import initial_state_function, to_numeric
 from phdesign.numeric.simulate import ENERGY_BALANCE_RTOL, simulate
 from phdesign.numeric.spectrum import spectrum
 from phdesign.symbolic.classify import classify
-from phdesign.symbolic.observer import parse_gain, sensor_matrix
+from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 
 TIP_SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])  # beam y3, y4
 
@@ -119,16 +119,14 @@ def test_classifier_reports_its_path_and_agrees(method):
     result = classify(
         load_builtin("euler-bernoulli"),
         sensor_matrix([3, 4], 4),
-        parse_gain("0.1,1", 2),
+        gain_matrix([0.1, 1], 2),
         method=method,
     )
     variant = result.result("3.4", 3)
     assert variant.holds
     assert abs(variant.kappa_json() - 10 / 101) < 1e-12
     row = next(
-        r
-        for r in result.to_json_dict()["results"]
-        if r["proposition"] == "3.4" and r["variant"] == 3
+        r for r in result.to_dict()["results"] if r["proposition"] == "3.4" and r["variant"] == 3
     )
     expected_path = "float" if method == "float" else "exact"
     assert row["path"] == expected_path

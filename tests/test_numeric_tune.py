@@ -35,7 +35,10 @@ def test_single_start_improves_on_identity_and_uses_the_converged_abscissa():
 
 
 def test_tune_rejects_bad_sensors():
-    with pytest.raises(ObserverError, match="columns"):
+    with pytest.raises(ObserverError, match=r"C_m matrix; expected \(q, 2\) but found \(1, 3\)"):
         tune(numeric("wave"), np.array([[1.0, 0.0, 0.0]]))
-    with pytest.raises(ObserverError, match="at least one sensor"):
+    with pytest.raises(ObserverError, match="C_m: expected a non-empty list of non-empty rows"):
         tune(numeric("wave"), np.zeros((0, 2)))
+    # issue 12 item 7: a rank-deficient C_m is refused as classify refuses it
+    with pytest.raises(ObserverError, match=r"full row rank.*expected rank 1 but found 0"):
+        tune(numeric("wave"), np.zeros((1, 2)))

@@ -6,18 +6,18 @@ import numpy as np
 import pytest
 import sympy
 
+from phdesign.cli.design_arguments import parse_gain_text, parse_rows_text, parse_sensors_text
 from phdesign.errors import ObserverError, PhdesignError
 from phdesign.models import load_builtin
+from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.observer import (
     ObserverDesign,
     error_system,
+    gain_matrix,
     gain_symbols,
-    parse_cm,
-    parse_gain,
-    parse_sensors,
+    measurement_matrix,
     port_matrices,
     sensor_matrix,
-    vanishes,
 )
 from phdesign.symbolic.ports import trace_index
 from phdesign.symbolic.ports import trace_index as ports_trace_index
@@ -40,22 +40,33 @@ def test_trace_index_agrees_with_ports_layer():
 def test_sensor_matrix_picks_unit_rows():
     C = sensor_matrix([2, 4], 4)
     assert sympy.Matrix([[0, 1, 0, 0], [0, 0, 0, 1]]) == C
-    assert parse_sensors(" 2, 4", 4) == C
+    assert sensor_matrix(parse_sensors_text(" 2, 4"), 4) == C  # the CLI's --sensors text
+    assert sensor_matrix(np.array([2, 4]), 4) == C  # numpy integers are indices too
+    assert sensor_matrix(3, 4) == sensor_matrix([3], 4)  # one sensor
 
 
-def test_parse_gain_forms():
-    assert parse_gain("0.1,1", 2) == sympy.diag(sympy.Rational(1, 10), 1)  # exact decimal
-    assert parse_gain("2", 3) == sympy.diag(2, 2, 2)  # one value reused per sensor
-    assert parse_gain("[[1, 0.5], [0, 1]]", 2) == sympy.Matrix([[1, sympy.Rational(1, 2)], [0, 1]])
-    L = parse_gain("symbolic", 2)
+def test_gain_matrix_forms():
+    assert gain_matrix([0.1, 1], 2) == sympy.diag(sympy.Rational(1, 10), 1)  # exact decimal
+    assert gain_matrix(2, 3) == sympy.diag(2, 2, 2)  # one value reused per sensor
+    assert gain_matrix(["1/3"], 1) == sympy.Matrix([[sympy.Rational(1, 3)]])  # text numbers
+    assert gain_matrix([[1, 0.5], [0, 1]], 2) == sympy.Matrix([[1, sympy.Rational(1, 2)], [0, 1]])
+    assert gain_matrix(np.array([0.5, 2.0]), 2) == sympy.diag(sympy.Rational(1, 2), 2)
+    assert gain_matrix(np.eye(2), 2) == sympy.eye(2)
+    L = gain_matrix("symbolic", 2)
     assert sympy.diag(*gain_symbols(2)) == L
     assert all(s.is_positive for s in gain_symbols(2))
+    # the command line's text reads into the same forms
+    assert gain_matrix(parse_gain_text("0.1,1"), 2) == gain_matrix([0.1, 1], 2)
+    assert gain_matrix(parse_gain_text("[[1, 0.5], [0, 1]]"), 2) == gain_matrix(
+        [[1, 0.5], [0, 1]], 2
+    )
 
 
-def test_parse_cm_exact():
-    assert parse_cm("[[0, 0, 1, 0], [0, 0, 0.5, 1]]", 4) == sympy.Matrix(
+def test_measurement_matrix_exact():
+    assert measurement_matrix([[0, 0, 1, 0], [0, 0, 0.5, 1]], 4) == sympy.Matrix(
         [[0, 0, 1, 0], [0, 0, sympy.Rational(1, 2), 1]]
     )
+    assert measurement_matrix(parse_rows_text("[[0, 1]]", "--cm"), 2) == sympy.Matrix([[0, 1]])
 
 
 # (callable, args, regex): every path of the sensor/gain checks
@@ -64,20 +75,27 @@ BAD_INPUTS = [
     (sensor_matrix, ([0], 4), r"output index 0 is out of range"),
     (sensor_matrix, ([3, 3], 4), r"output index 3 is repeated"),
     (sensor_matrix, ([], 4), r"expected at least one output index"),
-    (parse_sensors, ("3,x", 4), r"expected comma-separated output indices.*'x'"),
-    (parse_cm, ("[[1,0]", 2), r"--cm: expected a JSON list of rows"),
-    (parse_cm, ("[[1,0,0]]", 2), r"C_m matrix; expected \(q, 2\) but found \(1, 3\)"),
-    (parse_cm, ("[[1,0],[1]]", 2), r"row 2 has 1 entries; expected 2"),
-    (parse_cm, ("[[NaN, 0]]", 2), r"finite number; found nan"),
-    (parse_gain, ("1,2,3", 2), r"expected 2 diagonal values .* found 3"),
-    (parse_gain, ("nan", 2), r"entry 1 must be a finite positive number; found 'nan'"),
-    (parse_gain, ("[[1,0],[0,1],[0,0]]", 2), r"L matrix; expected \(2, 2\).*found \(3, 2\)"),
-    (parse_gain, ("[[1,0]", 2), r"--gain: expected a JSON list of rows"),
+    (sensor_matrix, ("3,4", 4), r"sensors: expected a list of output indices.*the text '3,4'"),
+    (sensor_matrix, ([3.0], 4), r"sensors: expected integer output indices; found 3.0"),
+    (parse_sensors_text, ("3,x",), r"expected comma-separated output indices.*'x'"),
+    (parse_rows_text, ("[[1,0]", "--cm"), r"--cm: expected a JSON list of rows"),
+    (measurement_matrix, ([[1, 0, 0]], 2), r"C_m matrix; expected \(q, 2\).* but found \(1, 3\)"),
+    (measurement_matrix, ([[1, 0], [1]], 2), r"row 2 has 1 entries; expected 2"),
+    (measurement_matrix, ([[float("nan"), 0]], 2), r"finite number; found nan"),
+    (measurement_matrix, ("[[0, 1]]", 2), r"C_m: expected a matrix .*found str"),
+    (measurement_matrix, ([[0, 0]], 2), r"full row rank.*expected rank 1 but found 0"),
+    (gain_matrix, ([1, 2, 3], 2), r"expected 2 diagonal values \(one per sensor\).* found 3"),
+    (gain_matrix, (["nan"], 2), r"entry 1 must be a finite positive number; found 'nan'"),
+    (gain_matrix, ([[1, 0], [0, 1], [0, 0]], 2), r"L matrix; expected \(2, 2\).*found \(3, 2\)"),
+    (gain_matrix, ("0.1,1", 2), r"gain: .*found the text '0.1,1' \(write gain=\[0.1, 1\]"),
+    (gain_matrix, ([1], 0), r"q \(the number of sensors\) must be a positive integer; found 0"),
+    (gain_matrix, ({"l": 1}, 1), r"gain: expected a number, a list of numbers, a matrix"),
+    (parse_rows_text, ("[[1,0]", "--gain"), r"--gain: expected a JSON list of rows"),
 ]
 
 
 @pytest.mark.parametrize(("function", "args", "message"), BAD_INPUTS)
-def test_bad_sensor_and_gain_text(function, args, message):
+def test_bad_sensor_and_gain_input(function, args, message):
     with pytest.raises(ObserverError, match=message):
         function(*args)
 
@@ -89,9 +107,14 @@ BAD_DESIGNS = [
         sympy.eye(2),
         r"full row rank.*expected rank 2 but found 1",
     ),
-    (sympy.Matrix([[1, 0, 0]]), sympy.eye(1), r"C_m matrix; expected \(1, 4\) but found \(1, 3\)"),
-    (sympy.zeros(0, 4), sympy.eye(0), r"1 <= q <= 4"),
-    (sensor_matrix([3, 4], 4), sympy.eye(3), r"L matrix; expected \(2, 2\) but found \(3, 3\)"),
+    (
+        sympy.Matrix([[1, 0, 0]]),
+        sympy.eye(1),
+        r"C_m matrix; expected \(q, 4\).* but found \(1, 3\)",
+    ),
+    (sympy.zeros(0, 4), sympy.eye(0), r"C_m: expected a non-empty list of non-empty rows"),
+    (sympy.zeros(5, 4), sympy.eye(5), r"1 <= q <= 4"),
+    (sensor_matrix([3, 4], 4), sympy.eye(3), r"L matrix; expected \(2, 2\).* but found \(3, 3\)"),
     (sensor_matrix([3, 4], 4), sympy.diag(1, -1), r"positive definite.*minor 2 = -4"),
     # L + L^T = [[2, 3], [3, 2]] is indefinite although the diagonal is positive
     (sensor_matrix([3, 4], 4), sympy.Matrix([[1, 3], [0, 1]]), r"minor 2 = -5"),
@@ -104,7 +127,7 @@ BAD_DESIGNS = [
     (
         np.array([[0.0, 0.0, 1.0, 0.0]]),
         np.array([[np.inf]]),
-        r"L\[1\]\[1\] must be a finite number; found oo",
+        r"L\[1\]\[1\] must be a finite number; found inf",
     ),
 ]
 
@@ -127,7 +150,7 @@ def test_beam_error_boundary_condition(beam):
     # ũ = -C_mᵀ L C_m ỹ = (0, 0, -l1 ỹ3, -l2 ỹ4) with ỹ3 = e1'(1), ỹ4 = -e1(1):
     # e1(0) = 0, e1'(0) = 0, e2(1) = -l1 e1'(1), e2'(1) = l2 e1(1).
     l1, l2 = gain_symbols(2)
-    es = ObserverDesign(beam, sensor_matrix([3, 4], 4), parse_gain("symbolic", 2)).error_system()
+    es = ObserverDesign(beam, sensor_matrix([3, 4], 4), gain_matrix("symbolic", 2)).error_system()
     v = sympy.Matrix(sympy.symbols("v0:8"))
     idx = {
         name: trace_index(i, k, s, 2, 2)
@@ -154,7 +177,7 @@ def test_beam_error_boundary_condition(beam):
 def test_admissible_traces_have_dimension_Nn(name):
     model = load_builtin(name)
     nn = model.order * model.size
-    es = ObserverDesign(model, sensor_matrix([1], nn), parse_gain("3/2", 1)).error_system()
+    es = ObserverDesign(model, sensor_matrix([1], nn), gain_matrix("3/2", 1)).error_system()
     assert es.K.shape == (2 * nn, nn)
     assert es.K.rank() == nn  # dim K = Nn
     assert all(vanishes(x) for x in es.boundary_matrix * es.K)  # K solves the error BC

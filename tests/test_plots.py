@@ -254,9 +254,19 @@ def test_plot_simulation_writes_png_and_refuses_to_overwrite(tmp_path):
     assert not (tmp_path / "sim.xyz").exists()
 
 
-def test_plot_simulation_without_displacement_or_file():
-    fig = plots.plot_simulation(make_result(displacement=False))
-    assert len(fig.axes) == 2
+def test_plot_simulation_without_displacement_draws_the_outputs():
+    # issue 11: a model without a displacement gets a y/ŷ panel and the output error
+    res = make_result(displacement=False)
+    fig = plots.plot_simulation(res)
+    assert [ax.get_title() for ax in fig.axes] == [
+        "Hamiltonians",
+        "decay (log scale)",
+        "boundary outputs (dashed: observer)",
+        "output error",
+    ]
+    lines = lines_by_label(fig.axes[2])
+    np.testing.assert_array_equal(lines["y1 = y1"].get_ydata(), res.y[:, 0])
+    assert lines["ŷ2"].get_linestyle() == "--"
 
 
 def test_plot_simulation_on_a_real_wave_simulation(tmp_path):

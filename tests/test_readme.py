@@ -1,9 +1,18 @@
-"""The README's Python examples run as written, and its first commands name real commands."""
+"""The README's Python examples run as written, and its first commands name real commands.
+
+The first block is the API of issue 11, line by line as a notebook runs it: every
+expression's value is kept and checked against numbers that do not come from the code
+under test (the paper's corrected §IV-D constant, the spectrum tests' converged abscissa).
+"""
 
 from __future__ import annotations
 
+import ast
 import re
 from pathlib import Path
+
+import pytest
+import sympy
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 
@@ -12,17 +21,77 @@ def python_blocks() -> list[str]:
     return re.findall(r"```python\n(.*?)```", README.read_text(encoding="utf-8"), flags=re.S)
 
 
-def test_readme_examples_run(capsys):
+def run_like_a_notebook(code: str, namespace: dict) -> list[object]:
+    """Execute ``code`` statement by statement; return the value of each expression line."""
+    values = []
+    for statement in ast.parse(code).body:
+        if isinstance(statement, ast.Expr):
+            expression = ast.Expression(statement.value)
+            values.append(eval(compile(expression, str(README), "eval"), namespace))
+        else:
+            module = ast.Module([statement], type_ignores=[])
+            exec(compile(module, str(README), "exec"), namespace)  # our own README
+    return values
+
+
+@pytest.mark.slow  # obs.tune() is a global search (6 starts)
+def test_readme_api_block_runs_and_its_numbers_hold():
+    import control
+
     namespace: dict[str, object] = {}
-    for block in python_blocks():
-        exec(compile(block, str(README), "exec"), namespace)  # our own README, not user input
-    printed = capsys.readouterr().out.split("\n")
-    # paper §IV-D corrected: κ* = min(l2, l1/(1 + l1²)); abscissa from the spectrum tests
-    assert printed[0] == "exponential Min(l2, l1/(l1**2 + 1))"
-    assert abs(float(printed[1].split()[0]) - (-2.9106562986)) < 1e-8
-    assert printed[1].split()[1] == "True"
-    assert abs(float(printed[2]) - 0.92) < 0.01
-    assert type(namespace["error_system"]).__name__ == "StateSpace"
+    values = run_like_a_notebook(python_blocks()[0], namespace)
+    classification, report, run, tuned, error_system, search = values
+    # paper §IV-D corrected: 3.4 variant 3 holds with κ* = min(l2, l1/(1 + l1²)) = 10/101
+    assert classification.verdict == "exponential"
+    assert classification.result("3.4", 3).kappa == sympy.Rational(10, 101)
+    # converged abscissa of the error system (tests/test_numeric_spectrum.py, 13 digits)
+    assert report.converged
+    assert abs(report.spectral_abscissa - (-2.9106562986)) < 1e-8
+    # H̃/H̃(0) < 1e-2 after about 0.92 s (the README states it; 2-digit claim)
+    assert abs(run.time_below(1e-2) - 0.92) < 0.01
+    # tune returns a new observer with the report; the tuned abscissa beats design 2's
+    assert type(tuned).__name__ == "Observer"
+    assert tuned is not namespace["obs"]
+    assert tuned.tuning is not None
+    assert tuned.tuning.spectral_abscissa < report.spectral_abscissa - 1.0
+    assert sympy.diag(sympy.Rational(1, 10), 1) == namespace["obs"].L  # unchanged
+    assert isinstance(error_system, control.StateSpace)
+    # the minimal exponential sensor sets of the beam (derived in tests/test_search.py)
+    assert search.minimal["exponential"] == ((2,), (4,))
+    for value in (classification, run, tuned, search):
+        assert len(repr(value)) <= 300, type(value).__name__
+        assert callable(getattr(value, "_repr_html_", None)), type(value).__name__
+    RESULTS.update(report=report, tuning=tuned.tuning)
+
+
+RESULTS: dict[str, object] = {}
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="SpectrumReport and TuneResult print themselves in the spec branch (issue 11); "
+    "this test passes once it is merged: then remove this mark",
+)
+def test_readme_spectrum_and_tuning_reports_print_themselves():
+    if not RESULTS:
+        pytest.skip("runs after test_readme_api_block_runs_and_its_numbers_hold")
+    for value in RESULTS.values():
+        assert len(repr(value)) <= 300, type(value).__name__
+        assert callable(getattr(value, "_repr_html_", None)), type(value).__name__
+
+
+def test_readme_model_in_code_is_the_builtin_beam():
+    namespace: dict[str, object] = {"phdesign": __import__("phdesign")}
+    exec(compile(python_blocks()[1], str(README), "exec"), namespace)
+    beam = namespace["beam"]
+    builtin = __import__("phdesign").load("euler-bernoulli")
+    assert (beam.P, beam.H, beam.inputs, beam.outputs) == (
+        builtin.P,
+        builtin.H,
+        builtin.inputs,
+        builtin.outputs,
+    )
 
 
 def test_readme_starts_with_install_and_test_commands():
@@ -30,3 +99,7 @@ def test_readme_starts_with_install_and_test_commands():
     first_block = re.search(r"```bash\n(.*?)```", text, flags=re.S).group(1).splitlines()
     assert first_block[0].startswith("pip install -e . && phdesign classify euler-bernoulli")
     assert "python -m pytest" in first_block[1]
+    assert "python -m sphinx -W" in first_block[1]
+    # the README points at no design notes outside the repository
+    assert "DESIGN.md" not in text
+    assert "steering" not in text

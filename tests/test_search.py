@@ -89,7 +89,7 @@ def test_beam_minimal_sets(beam):
 
 def test_search_agrees_with_classify(beam):
     gains = (sympy.Rational(1, 2), 2, 1, 3)
-    found = search_sensors(beam, gain=",".join(map(str, gains)))
+    found = search_sensors(beam, gain=gains)
     for sensors in itertools.chain.from_iterable(
         itertools.combinations(range(1, 5), q) for q in range(1, 5)
     ):
@@ -167,11 +167,13 @@ def test_gain_checks(beam):
         ObserverError,
         match=r"expected 4 diagonal values \(one per output\) or a single one; found 2",
     ):
-        search_sensors(beam, gain="1,2")
-    with pytest.raises(ObserverError, match=r"output 2 must be > 0"):
-        search_sensors(beam, gain="1,-2,1,1")
-    with pytest.raises(ObserverError, match=r"diagonal gains"):
-        search_sensors(beam, gain="[[1]]")
+        search_sensors(beam, gain=[1, 2])
+    with pytest.raises(ObserverError, match=r"L \+ Lᵀ must be positive definite.*minor 2 = -8"):
+        search_sensors(beam, gain=[1, -2, 1, 1])
+    with pytest.raises(ObserverError, match=r"takes diagonal gains"):
+        search_sensors(beam, gain=[[1, 1, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+    with pytest.raises(ObserverError, match=r"write gain=\[0.1, 1\]"):
+        search_sensors(beam, gain="1,2")  # text lists are the command line's
     symbolic = search_sensors(beam, gain="symbolic")  # verdicts only: they are gain-free
     assert symbolic.minimal == search_sensors(beam).minimal
     assert all(s.kappa is None for s in symbolic.subsets)
@@ -186,7 +188,7 @@ def test_progress_callback_on_long_search():
 def test_pure_python_and_numpy_kappa_paths_agree(beam, monkeypatch):
     import phdesign.symbolic.search as search
 
-    gain = "0.5,2,1,3"
+    gain = [0.5, 2, 1, 3]
     pure = search.search_sensors(beam, gain=gain)
     monkeypatch.setattr(search, "PURE_PYTHON_JOBS", 0)  # force the batched numpy path
     batched = search.search_sensors(beam, gain=gain)

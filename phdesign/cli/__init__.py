@@ -5,7 +5,9 @@ the heavy numeric imports happen inside the command handlers, so ``phdesign port
 and ``phdesign classify`` start without numpy-heavy backends, control or matplotlib.
 
 Exit status: 0 on success, 2 on bad input with exactly one line on stderr
-(``phdesign: error: ...``), never a traceback.
+(``phdesign: error: ...``), never a traceback.  Bad input is what phdesign's own errors
+(:class:`~phdesign.errors.PhdesignError`) report; any other exception is a bug and is
+not disguised as bad input.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import importlib
 import sys
 from collections.abc import Sequence
 
+from phdesign.cli.design_arguments import join_negative_values
 from phdesign.errors import PhdesignError
 
 __all__ = ["build_parser", "main", "run"]
@@ -75,11 +78,14 @@ def main(argv: Sequence[str] | None = None, *, reraise: bool = False) -> int:
         which exception the library raises behind a message).
     """
     try:
-        args = build_parser().parse_args(argv)
+        parser = build_parser()
+        args = parser.parse_args(
+            join_negative_values(list(sys.argv[1:] if argv is None else argv), parser)
+        )
         return int(args.handler(args) or 0)
     except _UsageError as error:
         return _fail(str(error))
-    except (PhdesignError, ValueError, TypeError) as error:
+    except PhdesignError as error:  # bad input; any other exception is a bug and surfaces
         if reraise:
             raise
         return _fail(str(error))

@@ -4,22 +4,20 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from phdesign.errors import ObserverError, ParameterError
-from phdesign.symbolic.model import BCPHS
+from phdesign.errors import ParameterError
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from phdesign.symbolic.model import BCPHS
 
 __all__ = [
     "add_json_argument",
     "add_model_argument",
-    "add_observer_arguments",
     "emit",
     "emit_json",
     "load_model",
-    "observer_matrices",
     "parse_parameter_overrides",
-    "sensor_matrix_from_args",
     "write_output",
 ]
 
@@ -38,7 +36,11 @@ def add_model_argument(parser: argparse.ArgumentParser) -> None:
 
 def add_json_argument(parser: argparse.ArgumentParser) -> None:
     """Add ``--json``: print machine-readable JSON instead of a table."""
-    parser.add_argument("--json", action="store_true", help="print JSON (see DESIGN.md)")
+    parser.add_argument(
+        "--json",
+        action="store_true",
+        help="print JSON instead of text (keys: see the command-line reference)",
+    )
 
 
 def parse_parameter_overrides(items: list[str]) -> dict[str, str]:
@@ -56,62 +58,11 @@ def parse_parameter_overrides(items: list[str]) -> dict[str, str]:
 
 
 def load_model(args: argparse.Namespace) -> BCPHS:
-    """Load MODEL: a built-in name, else a TOML file; then apply ``--param``."""
-    from phdesign.io import read_model
-    from phdesign.models import builtin_names, load_builtin
+    """Load MODEL (a built-in name, else a TOML file, :func:`phdesign.load`); apply ``--param``."""
+    from phdesign.models import load
 
-    name = args.model
-    if name in builtin_names():
-        model = load_builtin(name)
-    elif Path(name).suffix == ".toml" or Path(name).exists():
-        model = read_model(name)
-    else:
-        model = load_builtin(name)  # raises the error listing built-in names
     overrides = parse_parameter_overrides(getattr(args, "param", []))
-    return model.with_parameters(overrides) if overrides else model
-
-
-def add_observer_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add ``--sensors`` / ``--cm`` (exclusive) and ``--gain``."""
-    group = parser.add_mutually_exclusive_group()
-    group.add_argument(
-        "--sensors", metavar="I,J", help="measured outputs, 1-based indices, e.g. 3,4"
-    )
-    group.add_argument("--cm", metavar="ROWS", help="C_m in full, e.g. '[[0,0,1,0]]'")
-    parser.add_argument(
-        "--gain",
-        metavar="L",
-        help="observer gain: '0.1,1' (diagonal), '[[..]]' (full) or 'symbolic'",
-    )
-
-
-def sensor_matrix_from_args(args: argparse.Namespace, model: BCPHS) -> Any:
-    """Return ``C_m`` from ``--sensors`` or ``--cm``, or ``None`` when neither is given."""
-    from phdesign.symbolic import observer
-
-    n_outputs = model.n_ports  # the external outputs ([feedback] closes the others)
-    if args.sensors is not None:
-        return observer.parse_sensors(args.sensors, n_outputs)
-    if args.cm is not None:
-        return observer.parse_cm(args.cm, n_outputs)
-    return None
-
-
-def observer_matrices(args: argparse.Namespace, model: BCPHS) -> tuple[Any, Any] | None:
-    """Return ``(C_m, L)`` from ``--sensors``/``--cm`` and ``--gain``, or ``None``.
-
-    Without ``--gain`` the gain is the identity.
-    """
-    from phdesign.symbolic import observer
-
-    C_m = sensor_matrix_from_args(args, model)
-    if C_m is None:
-        if getattr(args, "gain", None) is not None:
-            raise ObserverError("--gain needs --sensors or --cm to say which outputs are measured")
-        return None
-    q = C_m.shape[0]
-    gain = args.gain if args.gain is not None else ",".join(["1"] * q)
-    return C_m, observer.parse_gain(gain, q)
+    return load(args.model, overrides or None)
 
 
 def emit(text: str) -> None:

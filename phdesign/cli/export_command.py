@@ -18,12 +18,11 @@ from typing import Any
 from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
-    add_observer_arguments,
     emit,
     emit_json,
     load_model,
-    observer_matrices,
 )
+from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
 from phdesign.errors import NumericError, ObserverError, OutputFileError
 
 __all__ = ["add_sampling_arguments", "register", "sampled_simulation"]
@@ -136,7 +135,7 @@ def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
 
 def _export(args: argparse.Namespace) -> int:
     from phdesign.codegen import check_export_path
-    from phdesign.numeric.bridge import gain_to_numeric, initial_state_function, to_numeric
+    from phdesign.numeric.bridge import initial_state_function
     from phdesign.numeric.sampled import export_observer, verification_plant_degree
     from phdesign.numeric.sampling import check_sampling
 
@@ -151,11 +150,11 @@ def _export(args: argparse.Namespace) -> int:
             "pip install 'phdesign[codegen]'"
         )
     model = load_model(args)
-    nm = to_numeric(model)
-    obs = observer_matrices(args, model)
-    if obs is None:
+    observer = observer_from_args(args, model, command="export")
+    if observer is None:
         raise ObserverError("export needs --sensors or --cm to say which outputs are measured")
-    C_m, L = gain_to_numeric(obs[0], "C_m"), gain_to_numeric(obs[1], "L")
+    nm = observer.plant.numeric
+    C_m, L = observer.numeric_gain("export")
     verification_plant_degree(nm, args.order, args.plant_resolution, args.reduce)
     points = _points(args.at, nm)
     x0 = initial_state_function(args.x0, nm, model=model) if args.x0 else None

@@ -28,11 +28,11 @@ from typing import Any
 from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
-    add_observer_arguments,
     emit,
     emit_json,
     write_output,
 )
+from phdesign.cli.design_arguments import add_observer_arguments
 from phdesign.errors import NumericError, ObserverError
 
 __all__ = [
@@ -169,15 +169,29 @@ def _performance(args: argparse.Namespace, nm: Any, model: Any) -> list[Any] | N
 
 
 def _observer(args: argparse.Namespace, command: str) -> tuple[Any, Any, Any, Any]:
-    from phdesign.cli.numeric_commands import _numeric_setup
+    """Return (model, NumericModel, C_m, L); ``tradeoff`` takes no gain (L is None)."""
+    from phdesign.cli.common import load_model
+    from phdesign.cli.design_arguments import observer_from_args
 
-    model, nm, C_m, L = _numeric_setup(args)
-    if C_m is None:
+    model = load_model(args)
+    family = command == "tradeoff"  # the ray or grid gives the gains
+    observer = observer_from_args(
+        args,
+        model,
+        command="" if family else command,
+        method=args.method,
+        resolution=getattr(args, "resolution", None),
+    )
+    if observer is None:
         raise ObserverError(
             f"{command} needs --sensors or --cm: the noise enters through the observer's "
             "measurements"
         )
-    return model, nm, C_m, L
+    from phdesign.design import numeric_matrix
+
+    C_m = numeric_matrix(observer.C_m, "C_m", command)
+    L = None if family else observer.numeric_gain(command)[1]
+    return model, observer.plant.numeric, C_m, L
 
 
 def _noise_inputs(args: argparse.Namespace, nm: Any, model: Any, q: int) -> dict[str, Any]:
@@ -408,13 +422,15 @@ def noise_tuning(args: argparse.Namespace) -> int | None:
             raise NumericError(f"{flag} must be a positive number; found {value}")
     if args.objective == "rms" and args.min_decay is None:
         raise NumericError("--objective rms needs --min-decay A (the decay rate to keep)")
-    from phdesign.cli.common import load_model, sensor_matrix_from_args
-    from phdesign.numeric.bridge import gain_to_numeric, to_numeric
+    from phdesign.cli.common import load_model
+    from phdesign.cli.design_arguments import observer_from_args
+    from phdesign.design import numeric_matrix
     from phdesign.numeric.noise_tune import tune_noise
 
     model = load_model(args)
-    nm = to_numeric(model)
-    C_m = gain_to_numeric(sensor_matrix_from_args(args, model), "C_m")
+    observer = observer_from_args(args, model)  # argparse requires --sensors or --cm here
+    nm = observer.plant.numeric
+    C_m = numeric_matrix(observer.C_m, "C_m", "tune")
     result = tune_noise(
         nm,
         C_m,

@@ -20,14 +20,12 @@ from typing import Any
 from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
-    add_observer_arguments,
     emit,
     emit_json,
     load_model,
-    observer_matrices,
-    sensor_matrix_from_args,
     write_output,
 )
+from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
 from phdesign.cli.export_command import add_sampling_arguments, sampled_simulation
 from phdesign.cli.noise_commands import (
     add_noise_tuning_arguments,
@@ -45,8 +43,8 @@ def _add_discretization(parser: argparse.ArgumentParser, default_hint: str) -> N
         "--method",
         choices=("galerkin", "fd"),
         default="galerkin",
-        help="discretization: Legendre-Galerkin (default, spectral) or staggered finite "
-        "differences (the paper's setting)",
+        help="discretization: Legendre-Galerkin (spectral) or staggered finite "
+        "differences (the paper's setting); default: %(default)s",
     )
     parser.add_argument(
         "--resolution", type=int, metavar="N", help=f"degree / nodes per group ({default_hint})"
@@ -60,10 +58,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         help="converged spectral abscissa of the plant (u = 0) or of the error system",
     )
     add_model_argument(sp)
-    add_observer_arguments(sp)
-    _add_discretization(sp, "first of the refinement pairs")
-    sp.add_argument("--tol", type=float, help="required agreement of the abscissa")
-    sp.add_argument("--count", type=int, default=6, help="rightmost eigenvalues to report")
+    add_observer_arguments(sp, required=True)
+    _add_discretization(sp, "default: the first of the refinement pairs")
+    sp.add_argument(
+        "--tol",
+        type=float,
+        help="required agreement of the abscissa; default 1e-10 (galerkin), 1e-3 (fd)",
+    )
+    sp.add_argument(
+        "--count",
+        type=int,
+        default=6,
+        help="rightmost eigenvalues to report; default: %(default)s",
+    )
     add_json_argument(sp)
     sp.set_defaults(handler=_spectrum)
 
@@ -72,20 +79,34 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     add_model_argument(sim)
     add_observer_arguments(sim)
-    _add_discretization(sim, "Galerkin 40, FD 70")
+    _add_discretization(sim, "default: Galerkin 40 (16 for N >= 3), FD 70")
     sim.add_argument(
-        "--x0", metavar="EXPRS", help="plant initial state, e.g. 'x1: 0, x2: z - 0.9'"
+        "--x0",
+        metavar="EXPRS",
+        help="plant initial state, e.g. 'x1: 0, x2: z - 0.9'; default zero (then every "
+        "series is zero: a warning says so)",
     )
-    sim.add_argument("--xhat0", metavar="EXPRS", help="observer initial state (default zero)")
+    sim.add_argument("--xhat0", metavar="EXPRS", help="observer initial state; default zero")
     sim.add_argument(
-        "--u", metavar="EXPRS", help="plant inputs in t, e.g. 'u2: sin(2*t)' (others zero)"
+        "--t-end", type=float, default=5.0, metavar="T", help="final time; default: %(default)s"
     )
-    sim.add_argument("--t-end", type=float, default=5.0, metavar="T", help="final time")
-    sim.add_argument("--samples", type=int, default=501, help="output samples on [0, T]")
-    sim.add_argument("--scheme", choices=("expm", "midpoint"), default="expm")
+    sim.add_argument(
+        "--samples", type=int, default=501, help="output samples on [0, T]; default: %(default)s"
+    )
+    sim.add_argument(
+        "--scheme",
+        choices=("expm", "midpoint"),
+        default="expm",
+        help="time stepping: exact matrix exponential or implicit midpoint; default: %(default)s",
+    )
+    sim.add_argument(
+        "--u", metavar="EXPRS", help="plant inputs in t, e.g. 'u2: sin(2*t)'; default zero"
+    )
     fmt = sim.add_mutually_exclusive_group()
     fmt.add_argument("--csv", action="store_true", help="CSV output (the default)")
-    fmt.add_argument("--json", action="store_true", help="JSON output")
+    fmt.add_argument(
+        "--json", action="store_true", help="JSON output (keys: see the command-line reference)"
+    )
     sim.add_argument("--output", "-o", metavar="FILE", help="write to FILE instead of stdout")
     sim.add_argument("--plot", metavar="FILE", help="also draw a summary figure to FILE")
     sim.add_argument("--force", action="store_true", help="overwrite existing files")
@@ -95,31 +116,33 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
 
     tn = subparsers.add_parser("tune", help="observer gain minimizing the converged abscissa")
     add_model_argument(tn)
-    group = tn.add_mutually_exclusive_group(required=True)
-    group.add_argument("--sensors", metavar="I,J", help="measured outputs, 1-based")
-    group.add_argument("--cm", metavar="ROWS", help="C_m in full, e.g. '[[0,0,1,0]]'")
+    add_observer_arguments(tn, gain=False)
     tn.add_argument("--full", action="store_true", help="full L instead of positive diagonal")
-    tn.add_argument("--starts", type=int, default=6, help="number of starts")
-    tn.add_argument("--seed", type=int, default=0, help="seed of the random starts")
+    tn.add_argument("--starts", type=int, default=6, help="number of starts; default: %(default)s")
+    tn.add_argument(
+        "--seed", type=int, default=0, help="seed of the random starts; default: %(default)s"
+    )
     add_noise_tuning_arguments(tn)
     add_json_argument(tn)
     tn.set_defaults(handler=_tune)
 
 
-def _numeric_setup(args: argparse.Namespace) -> tuple[Any, Any, Any, Any]:
+def _numeric_setup(args: argparse.Namespace, command: str) -> tuple[Any, Any, Any, Any]:
     """Return (model, NumericModel, C_m, L) with C_m/L as float arrays or None.
 
-    ``--param`` is applied by :func:`load_model`; the bridge then substitutes defaults.
+    The sensors and gain go through :class:`phdesign.Observer` (one validation for every
+    command); ``--param`` is applied by :func:`load_model`.
     """
-    from phdesign.numeric.bridge import gain_to_numeric, to_numeric
+    from phdesign.design import Plant
 
     model = load_model(args)
-    nm = to_numeric(model)
-    obs = observer_matrices(args, model)
-    if obs is None:
-        return model, nm, None, None
-    C_m, L = obs
-    return model, nm, gain_to_numeric(C_m, "C_m"), gain_to_numeric(L, "L")
+    observer = observer_from_args(
+        args, model, command=command, method=args.method, resolution=args.resolution
+    )
+    if observer is None:
+        return model, Plant(model, method=args.method).numeric, None, None
+    C_m, L = observer.numeric_gain(command)
+    return model, observer.plant.numeric, C_m, L
 
 
 def _check_positive(name: str, value: float | int | None) -> None:
@@ -133,7 +156,7 @@ def _spectrum(args: argparse.Namespace) -> int:
     _check_positive("--resolution", args.resolution)
     _check_positive("--tol", args.tol)
     _check_positive("--count", args.count)
-    model, nm, C_m, L = _numeric_setup(args)
+    model, nm, C_m, L = _numeric_setup(args, "spectrum")
     rep = spectrum(
         nm, C_m, L, method=args.method, resolution=args.resolution, tol=args.tol, count=args.count
     )
@@ -159,20 +182,27 @@ def _spectrum(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from phdesign.numeric.bridge import initial_state_function, input_function
-    from phdesign.numeric.simulate import simulate
+    from phdesign.design import Plant
+    from phdesign.numeric.bridge import input_function
 
     _check_positive("--resolution", args.resolution)
     _check_positive("--t-end", args.t_end)
     if args.samples < 2:
         raise NumericError(f"--samples must be at least 2; found {args.samples}")
-    model, nm, C_m, L = _numeric_setup(args)
-    if args.xhat0 and C_m is None:
+    model = load_model(args)
+    observer = observer_from_args(
+        args, model, default_gain=1, method=args.method, resolution=args.resolution
+    )
+    if args.xhat0 and observer is None:
         raise NumericError("--xhat0 needs an observer: give --sensors or --cm")
-    x0 = initial_state_function(args.x0, nm, model=model)
-    xh0 = initial_state_function(args.xhat0, nm, model=model)
-    u = input_function(args.u, nm, model=model)
-    # refuse unwritable or existing outputs before the (possibly long) simulation
+    plant = (
+        observer.plant if observer is not None else Plant(model, {}, args.method, args.resolution)
+    )
+    # read the initial states and inputs and refuse unwritable or existing outputs before
+    # the (possibly long) simulation
+    x0 = plant.initial_state(args.x0, "x0")
+    xhat0 = plant.initial_state(args.xhat0, "xhat0")
+    u = input_function(args.u, plant.numeric, model=model)
     if args.output:
         from phdesign.io import check_output_path
 
@@ -181,52 +211,70 @@ def _simulate(args: argparse.Namespace) -> int:
         from phdesign.plots import check_plot_path
 
         check_plot_path(args.plot, args.force)
-    # a noisy run (--noise-intensity, --input-noise), else None
+    C_m, L = (None, None) if observer is None else observer.numeric_gain("simulate")
+    # a sampled or lower-order observer (--dt, --sampler, --observer-resolution), a noisy
+    # run (--noise-intensity, --input-noise), else the continuous noiseless one
     noisy = stochastic_simulation(args)
-    # a sampled or lower-order observer (--dt, --sampler, --observer-resolution), else None
-    res = sampled_simulation(args, nm, C_m, L, x0, xh0) or (noisy or simulate)(
-        nm,
-        C_m,
-        L,
-        x0=x0,
-        xhat0=xh0,
-        t_end=args.t_end,
-        samples=args.samples,
-        method=args.method,
-        resolution=args.resolution,
-        scheme=args.scheme,
-        u=u,
-    )
+    res = sampled_simulation(args, plant.numeric, C_m, L, x0, xhat0)
+    if res is None and noisy is not None:
+        res = noisy(
+            plant.numeric,
+            C_m,
+            L,
+            x0=x0,
+            xhat0=xhat0,
+            t_end=args.t_end,
+            samples=args.samples,
+            method=args.method,
+            resolution=args.resolution,
+            scheme=args.scheme,
+            u=u,
+        )
+    if res is not None:
+        res = plant.labelled(res, **({} if observer is None else observer.labels()))
+    else:
+        options = {"t_end": args.t_end, "samples": args.samples, "scheme": args.scheme, "u": u}
+        if observer is not None:
+            res = observer.simulate(x0, xhat0=xhat0, **options)
+        else:
+            res = plant.simulate(x0, **options)
     if args.json:
         import json
 
         text = json.dumps({"model": model.name, **res.to_dict()})
     else:
-        text = res.to_csv()
+        text = str(res)
     if args.output:
         write_output(args.output, text, args.force)
     else:
         emit(text)
     if args.plot:
-        from phdesign.plots import plot_simulation
-
-        plot_simulation(res, args.plot, force=args.force, title=model.name)
-    for warning in res.warnings:
+        res.plot(args.plot, force=args.force)
+    warnings = list(res.warnings)
+    if observer is not None and args.gain is None:
+        warnings.insert(0, "no --gain given: the observer uses L = I (--gain 1)")
+    if args.x0 is None:
+        warnings.insert(
+            0,
+            "no --x0 given: the plant starts at rest (x0 = 0), so without an input every "
+            "series is zero",
+        )
+    for warning in warnings:
         print(f"phdesign: warning: {warning}", file=sys.stderr)
     return 0
 
 
 def _tune(args: argparse.Namespace) -> int:
-    from phdesign.numeric.bridge import gain_to_numeric, to_numeric
+    from phdesign.design import numeric_matrix
     from phdesign.numeric.tune import tune
 
     if (noisy := noise_tuning(args)) is not None:  # --max-rms / --objective rms
         return noisy
     _check_positive("--starts", args.starts)
     model = load_model(args)
-    nm = to_numeric(model)
-    C_m = sensor_matrix_from_args(args, model)  # argparse requires --sensors or --cm here
-    res = tune(nm, gain_to_numeric(C_m, "C_m"), full=args.full, starts=args.starts, seed=args.seed)
+    observer = observer_from_args(args, model)  # argparse requires --sensors or --cm here
+    C_m = numeric_matrix(observer.C_m, "C_m", "tune")
+    res = tune(observer.plant.numeric, C_m, full=args.full, starts=args.starts, seed=args.seed)
     if args.json:
         emit_json({"model": model.name, **res.to_dict()})
         return 0

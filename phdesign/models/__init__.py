@@ -1,9 +1,10 @@
 """The built-in models, shared by tests, notebooks and the command line.
 
-``wave``, ``timoshenko``, ``euler-bernoulli`` and ``airy`` are the paper's and the
-design notes' models; ``wave-damper`` (the string with a damper at z = 1) and
+``wave``, ``timoshenko``, ``euler-bernoulli`` and ``airy`` (described in the documentation's
+model gallery); ``wave-damper`` (the string with a damper at z = 1) and
 ``beam-tip-damper`` (the clamped beam with a damper at its tip) close one input with a
-boundary feedback (``[feedback]``).  Each is stored as a TOML model file in this package.
+boundary feedback (``[feedback]``).  Each is stored as a TOML model file in this package;
+:func:`load` reads a built-in model by name or a model file by path.
 
 Examples
 --------
@@ -15,13 +16,16 @@ Examples
 
 from __future__ import annotations
 
+import os
+from collections.abc import Mapping
 from functools import cache
 from importlib import resources
+from pathlib import Path
 
-from phdesign.errors import ModelFileError
+from phdesign.errors import ArgumentError, ModelFileError, ParameterError
 from phdesign.symbolic.model import BCPHS
 
-__all__ = ["builtin_names", "builtin_toml", "load_builtin"]
+__all__ = ["builtin_names", "builtin_toml", "load", "load_builtin"]
 
 
 def builtin_names() -> tuple[str, ...]:
@@ -38,7 +42,7 @@ def builtin_toml(name: str) -> str:
     ModelFileError
         If there is no such built-in model.
     """
-    if name not in builtin_names():
+    if not isinstance(name, str) or name not in builtin_names():
         raise ModelFileError(
             f"unknown model {name!r}; expected a built-in model ({', '.join(builtin_names())}) "
             "or the path of a TOML file"
@@ -52,3 +56,44 @@ def load_builtin(name: str) -> BCPHS:
     from phdesign.io import model_from_toml
 
     return model_from_toml(builtin_toml(name), source=f"built-in model {name!r}")
+
+
+def load(source: str | os.PathLike[str], parameters: Mapping[str, object] | None = None) -> BCPHS:
+    """Return a model: a built-in one by name, or the model file at a path.
+
+    Parameters
+    ----------
+    source : str or path
+        A built-in name (:func:`builtin_names`) or the path of a TOML model file.
+    parameters : mapping of str to number, optional
+        New defaults for some parameters (``{"d": 0.5}``).
+
+    Raises
+    ------
+    ModelFileError
+        Neither a built-in name nor a readable model file.
+
+    Examples
+    --------
+    >>> load("wave", parameters={"rho": 2}).parameter_defaults
+    {rho: 2, T: 1}
+    """
+    from phdesign.io import read_model
+
+    if not isinstance(source, str | os.PathLike):
+        raise ArgumentError(
+            f"source: expected a built-in model name or the path of a TOML file; found "
+            f"{type(source).__name__}"
+        )
+    if parameters is not None and not isinstance(parameters, Mapping):
+        raise ParameterError(
+            f"parameters must be a mapping of names to values; found {type(parameters).__name__}"
+        )
+    name = os.fspath(source)
+    if isinstance(source, str) and name in builtin_names():
+        model = load_builtin(name)
+    elif Path(name).suffix == ".toml" or Path(name).exists():
+        model = read_model(name)
+    else:
+        model = load_builtin(name)  # raises the error listing the built-in names
+    return model.with_parameters(parameters) if parameters else model

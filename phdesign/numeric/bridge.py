@@ -112,6 +112,9 @@ class NumericModel:
     units : mapping
         Units stated by the model (``t``, ``z``, ``energy``, ``displacement``, parameters,
         states).
+    parameters : mapping of str to float
+        The parameter values substituted (defaults with the caller's overrides), by name:
+        the values an initial state or an input written in the parameters is evaluated with.
     """
 
     name: str
@@ -131,6 +134,7 @@ class NumericModel:
     feedback: PortFeedback | None = None
     P0: Callable[[np.ndarray], np.ndarray] | None = field(default=None, compare=False)
     units: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
+    parameters: Mapping[str, float] = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         a, b = (float(s) for s in self.interval)
@@ -221,25 +225,10 @@ def _free_symbols_message(what: str, symbols: set[Any]) -> str:
 
 
 def _parameter_values(model: Any, parameters: Mapping[str, Any] | None) -> dict[Any, Any]:
-    """Defaults of ``model`` overridden by ``parameters`` (keys by name)."""
-    import sympy
-
-    if parameters and hasattr(model, "with_parameters"):
+    """Defaults of ``model`` overridden by ``parameters`` (keys by name), checked by the model."""
+    if parameters:
         model = model.with_parameters({str(k): v for k, v in parameters.items()})
-        parameters = None
-    values: dict[Any, Any] = dict(model.parameter_defaults)
-    by_name = {str(s): s for s in values}
-    for key, val in (parameters or {}).items():
-        name = str(key)
-        if name not in by_name:
-            known = ", ".join(sorted(by_name)) or "none"
-            raise ParameterError(f"unknown parameter {name!r}; the model's parameters: {known}")
-        try:
-            expr = sympy.sympify(val) if not isinstance(val, sympy.Basic) else val
-        except (sympy.SympifyError, TypeError) as exc:
-            raise ParameterError(f"parameter {name!r}: cannot read value {val!r}") from exc
-        values[by_name[name]] = expr
-    return values
+    return dict(model.parameter_defaults)
 
 
 def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> NumericModel:
@@ -264,9 +253,14 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
     """
     import sympy
 
+    from phdesign.arguments import require_model
     from phdesign.symbolic.model import Z
-    from phdesign.symbolic.ports import derive_ports
 
+    require_model(model)
+    if parameters is not None and not isinstance(parameters, Mapping):
+        raise ParameterError(
+            f"parameters must be a mapping of names to values; found {type(parameters).__name__}"
+        )
     values = _parameter_values(model, parameters)
     N, n = int(model.order), int(model.size)
 
@@ -294,7 +288,7 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
     else:
         P.insert(0, np.array(P0s.evalf(), dtype=float))
     Hs = subs_matrix("H", model.H, True)
-    ports = derive_ports(model)
+    ports = model.ports
     U = np.array(subs_matrix("U", ports.U, False).evalf(), dtype=float)
     Y = np.array(subs_matrix("Y", ports.Y, False).evalf(), dtype=float)
 
@@ -333,6 +327,7 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         feedback=feedback,
         P0=P0fun,
         units=dict(getattr(model, "units", ())),
+        parameters={str(k): float(v) for k, v in values.items()},
     )
     # H must be positive definite after substitution (the symbolic check used defaults).
     zs = np.linspace(nm.interval[0], nm.interval[1], 33)
@@ -422,7 +417,7 @@ def trace_row(text: str, nm: NumericModel, model: Any = None) -> np.ndarray:
     expr = ex.parse_trace_expression(
         text, interval, nm.order, nm.size, parameters=[str(s) for s in values]
     )
-    row = np.zeros(2 * nm.n_ports)
+    row = np.zeros(2 * nm.order * nm.size)  # the trace vector of the open plant
     for trace, coefficient in ex.linear_coefficients(expr).items():
         value = coefficient.subs(values)
         if value.free_symbols:
@@ -463,6 +458,13 @@ def initial_state_function(
     >>> initial_state_function("e1: 2*z", nm)(np.array([0.5]))
     array([[0.5]])
     """
+    from phdesign.arguments import require_numeric_model
+
+    require_numeric_model(nm)
+    if text is not None and not isinstance(text, str):
+        raise ParameterError(
+            f"initial state must be text such as 'x1: z - 0.9'; found {type(text).__name__}"
+        )
     n = nm.size
     if text is None or not text.strip():
         return lambda z: np.zeros((np.atleast_1d(z).size, n))
@@ -492,7 +494,7 @@ def initial_state_function(
         kind = this
         if idx in exprs:
             raise ParameterError(f"{what}: component {key!r} given twice")
-        exprs[idx] = _parse_z_expression(expr_text, model, parameters, f"{what} expression")
+        exprs[idx] = _parse_z_expression(expr_text, nm, model, parameters, f"{what} expression")
     from phdesign.symbolic.model import Z
 
     funcs = {i: sympy.lambdify(Z, e, modules="numpy") for i, e in exprs.items()}
@@ -528,23 +530,54 @@ def _split_top_level(text: str) -> list[str]:
     return [p for p in parts if p.strip()]
 
 
+def _exact_value(value: Any) -> Any:
+    import sympy
+
+    return sympy.Float(value) if isinstance(value, float) else value
+
+
+def _substituted_values(
+    nm: NumericModel, model: Any, parameters: Mapping[str, Any] | None
+) -> dict[str, Any]:
+    """Parameter values by name: those ``nm`` was built with, overridden by ``parameters``.
+
+    ``nm.parameters`` holds the defaults and the overrides given to :func:`to_numeric`;
+    a NumericModel built by hand has none, and then the model's defaults are used.
+    """
+    from phdesign.symbolic import expressions as ex
+
+    values: dict[str, Any] = dict(nm.parameters)
+    if not values and model is not None:
+        values = {str(s): v for s, v in model.parameter_defaults.items()}
+    for name, value in (parameters or {}).items():
+        if str(name) not in values:
+            known = ", ".join(values) or "none"
+            raise ParameterError(f"unknown parameter {name!r}; the model's parameters are {known}")
+        values[str(name)] = ex.exact_number(value, f"parameter {name}")
+    return values
+
+
 def _parse_z_expression(
-    text: str, model: Any, parameters: Mapping[str, Any] | None, what: str
+    text: str,
+    nm: NumericModel,
+    model: Any,
+    parameters: Mapping[str, Any] | None,
+    what: str = "initial state expression",
 ) -> Any:
-    """Parse an expression in z (and parameters) safely and substitute parameter values."""
+    """Parse an expression in z (and parameters) safely and substitute the parameter values.
+
+    The values are those of :func:`_substituted_values`.
+    """
     from phdesign.symbolic import expressions as ex
     from phdesign.symbolic.model import Z
 
-    values: dict[Any, Any] = {}
-    if model is not None:
-        values = _parameter_values(model, parameters)
-    expr = ex.parse_scalar(text, parameters=[str(s) for s in values], allow_z=True, what=what)
+    values = _substituted_values(nm, model, parameters)
+    expr = ex.parse_scalar(text, parameters=list(values), allow_z=True, what=what)
     # parse_scalar builds its own z and parameter symbols; map them by name.
-    by_name = {str(s): v for s, v in values.items()}
     subs = {
-        s: (Z if str(s) == "z" else by_name[str(s)])
+        s: (Z if str(s) == "z" else _exact_value(values[str(s)]))
         for s in expr.free_symbols
-        if str(s) == "z" or str(s) in by_name
+        if str(s) == "z" or str(s) in values
     }
     expr = expr.xreplace(subs)
     free = set(expr.free_symbols) - {Z}
@@ -589,8 +622,10 @@ def input_function(
     from phdesign.symbolic.parser import check_text, parse
 
     check_text(text, "--u")
-    values = _parameter_values(model, parameters) if model is not None else {}
-    by_name = {str(s): v for s, v in values.items()}
+    by_name = {
+        name: _exact_value(value)
+        for name, value in _substituted_values(nm, model, parameters).items()
+    }
     time = sympy.Symbol("t", real=True)
 
     def resolve(name: str, expression: str) -> Any:

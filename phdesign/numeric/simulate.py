@@ -39,8 +39,10 @@ import numpy as np
 import scipy.linalg as sl
 
 from phdesign.errors import NumericError
+from phdesign.numeric.arguments import check_simulate_arguments
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
+from phdesign.numeric.display import SimulationDisplay
 
 __all__ = [
     "ENERGY_BALANCE_RTOL",
@@ -56,8 +58,8 @@ __all__ = [
 ENERGY_BALANCE_RTOL = 1e-8
 
 
-@dataclass(frozen=True)
-class SimulationResult:
+@dataclass(frozen=True, repr=False)
+class SimulationResult(SimulationDisplay):
     """Time series of a plant (and observer) simulation.
 
     Attributes
@@ -352,6 +354,20 @@ def simulate(
     -------
     SimulationResult
     """
+    check_simulate_arguments(
+        nm,
+        C_m,
+        L,
+        x0=x0,
+        xhat0=xhat0,
+        t_end=t_end,
+        samples=samples,
+        method=method,
+        resolution=resolution,
+        u=u,
+        scheme=scheme,
+        z_w=z_w,
+    )
     if not (np.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a positive number; found {t_end}")
     if int(samples) < 2:

@@ -34,6 +34,7 @@ import numpy as np
 import scipy.linalg as sl
 
 from phdesign.errors import NumericError
+from phdesign.numeric.arguments import check_spectrum_arguments
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
 
@@ -286,7 +287,7 @@ def spectrum(
     resolution, max_resolution : int, optional
         First and largest resolution (degree or nodes per group).
     tol : float, optional
-        Required agreement of the abscissa (absolute, times max(1, |α|)); default 1e-10
+        Required agreement of the abscissa (absolute, times max(1, abs(α))); default 1e-10
         for Galerkin, 1e-3 for the second-order finite differences.
     rtol_resolved : float, optional
         Relative drift under which an eigenvalue counts as resolved; default 1e-6 for
@@ -298,6 +299,17 @@ def spectrum(
     -------
     SpectrumReport
     """
+    check_spectrum_arguments(
+        nm,
+        C_m,
+        L,
+        method=method,
+        resolution=resolution,
+        max_resolution=max_resolution,
+        tol=tol,
+        rtol_resolved=rtol_resolved,
+        count=count,
+    )
     if (C_m is None) != (L is None):
         raise NumericError("give both the sensors C_m and the gain L, or neither")
     K = None if C_m is None or L is None else feedback_matrix(C_m, L, nm.n_ports)

@@ -5,7 +5,7 @@ The error system is :math:`E \dot{\tilde e} = (J - R - B C_m^\top L C_m B^\top)\
 are *resolved* (agree between the resolutions p and 1.5 p, see
 :mod:`phdesign.numeric.spectrum`), never over all discrete eigenvalues: the unresolved
 high frequencies of any semi-discretization have real parts that tend to the undamped
-value and would flatten the landscape (the h² trap of DESIGN.md).
+value and would flatten the landscape (the h² trap: see the theory page of the documentation).
 
 The search runs Nelder-Mead from several starts in log-space,
 :math:`L = \operatorname{diag}(e^{s})` (or, with ``full=True``, :math:`L = e^{S} + W` with
@@ -26,6 +26,7 @@ import scipy.linalg as sl
 from scipy.optimize import minimize
 
 from phdesign.errors import NumericError, ObserverError
+from phdesign.numeric.arguments import check_tune_arguments
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.spectrum import SpectrumReport, resolved_abscissa, spectrum
@@ -48,7 +49,7 @@ class TuneResult:
     at_coalescence : bool
         Whether two or more eigenvalues (not conjugates) meet at the optimum.
     active : list of complex
-        Resolved eigenvalues (upper half-plane) whose real parts lie within 1e-3 |α| of α.
+        Resolved eigenvalues (upper half-plane) whose real parts lie within 1e-3 abs(α) of α.
     report : SpectrumReport
     starts : list of dict
         Every start with its local optimum.
@@ -136,6 +137,16 @@ def tune(
     -------
     TuneResult
     """
+    check_tune_arguments(
+        nm,
+        C_m,
+        full=full,
+        starts=starts,
+        seed=seed,
+        log_range=log_range,
+        resolution=resolution,
+        maxiter=maxiter,
+    )
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
     q = C.shape[0]
     if q == 0:

@@ -37,12 +37,16 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from itertools import combinations
+from typing import TYPE_CHECKING
 
 import sympy
 
 from phdesign.symbolic.expressions import vanishes
 
-__all__ = ["AssumptionCheck", "Partition", "check_assumption"]
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from phdesign.symbolic.model import BCPHS
+
+__all__ = ["AssumptionCheck", "Partition", "check_assumption", "model_assumption"]
 
 #: Beyond this size the subset search (C(n, n/2) subsets) is not attempted.
 MAX_SIZE = 16
@@ -81,7 +85,7 @@ class Partition:
         second = ", ".join(name(i) for i in self.x2)
         return f"x1 = ({first}), x2 = ({second})"
 
-    def to_json_dict(self) -> dict[str, object]:
+    def to_dict(self) -> dict[str, object]:
         """JSON form: 1-based components and the blocks as strings."""
         return {
             "x1": list(self.x1),
@@ -108,6 +112,13 @@ class AssumptionCheck:
     holds: bool
     partitions: tuple[Partition, ...]
     reason: str
+
+
+def model_assumption(model: BCPHS) -> AssumptionCheck | None:
+    """Check Assumption 3.1 on a model of order 2; ``None`` for other orders."""
+    if model.order != 2:
+        return None
+    return check_assumption(model.P[1], model.P[2], model.H, model.parameter_defaults)
 
 
 def _is_zero(expr: sympy.Expr) -> bool:

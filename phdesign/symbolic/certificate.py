@@ -52,7 +52,9 @@ from typing import Any
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
-from phdesign.symbolic.observer import ErrorSystem, vanishes
+from phdesign.errors import ObserverError
+from phdesign.symbolic.expressions import vanishes
+from phdesign.symbolic.observer import ErrorSystem
 
 __all__ = ["Certificate", "certify", "float_kappa"]
 
@@ -176,7 +178,10 @@ def certify(
                 True, exact, float(exact.evalf(30)), False, None, (), "exact", None, pencil
             )
         if method == "exact":
-            raise ValueError("no exact root available for this pencil; use method='float'")
+            raise ObserverError(
+                "method='exact': no exact root is available for this pencil; use "
+                "method='float' or 'auto'"
+            )
     return Certificate(True, None, float_kappa(A_r, B_r), False, None, (), "float", None, pencil)
 
 

@@ -15,12 +15,16 @@ Proposition 3.4 is tried with every partition :math:`x = (x_1, x_2)` that satisf
 Assumption 3.1 (the assumption is symmetric in the blocks, the proposition is not);
 a variant holds when it holds for one of them, and the result names that partition.
 
+The :class:`Classification` prints itself: ``str()`` is the table ``phdesign classify``
+prints, ``repr()`` one line, ``_repr_html_`` a table for notebooks and :meth:`to_dict`
+the JSON of the command line.
+
 Examples
 --------
 >>> from phdesign.models import load_builtin
->>> from phdesign.symbolic.observer import sensor_matrix, parse_gain
+>>> from phdesign.symbolic.observer import sensor_matrix
 >>> beam = load_builtin("euler-bernoulli")
->>> result = classify(beam, sensor_matrix([3, 4], 4), parse_gain("symbolic", 2))
+>>> result = classify(beam, sensor_matrix([3, 4], 4), "symbolic")
 >>> result.verdict
 'exponential'
 >>> r = result.result("3.4", 3)
@@ -28,6 +32,9 @@ Examples
 (True, Min(l2, l1/(l1**2 + 1)))
 >>> result.result("3.3", 3).reason
 'ẽ2(0) is left free by these sensors; fails for all positive gains'
+>>> classify(beam, sensor_matrix([4], 4), [0.5])  # doctest: +NORMALIZE_WHITESPACE
+Classification(model='euler-bernoulli', sensors='y4', L='diag(0.5)',
+               verdict='exponential', best='3.4.4', kappa=0.4)
 """
 
 from __future__ import annotations
@@ -38,16 +45,37 @@ from typing import Any
 
 import sympy
 
-from phdesign.symbolic.assumption import AssumptionCheck, Partition, check_assumption
+from phdesign._display import (
+    REPR_LIMIT,
+    html_table,
+    kappa_text,
+    matrix_text,
+    number_text,
+    sensors_text,
+    shorten,
+)
+from phdesign.arguments import choice
+from phdesign.errors import ObserverError
+from phdesign.symbolic.assumption import AssumptionCheck, Partition, model_assumption
 from phdesign.symbolic.certificate import Certificate, certify
 from phdesign.symbolic.expressions import Trace
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import ErrorSystem, ObserverDesign
-from phdesign.symbolic.propositions import VARIANTS, Variant
+from phdesign.symbolic.ports import trace_list
+from phdesign.symbolic.propositions import (
+    PROPOSITIONS,
+    VERDICTS,
+    Case,
+    Variant,
+    strength,
+    variant_cases,
+    verdict_of,
+)
 
-__all__ = ["Classification", "VariantResult", "classify", "verdict_of"]
+__all__ = ["VERDICTS", "Classification", "VariantResult", "classify", "verdict_of"]
 
-VERDICTS = ("exponential", "asymptotic", "inconclusive")
+#: Width of the κ* column of the table; longer constants move to a note below the row.
+KAPPA_WIDTH = 12
 
 
 @dataclass(frozen=True)
@@ -76,7 +104,7 @@ class VariantResult:
     free : tuple of Trace
         Selected traces the witness leaves non-zero.
     rhs : str
-        The right-hand side in words.
+        The right-hand side in words, in the model's components (``ẽ2'(1)``).
     reason : str
         One sentence: why it holds, why it fails, or why it does not apply.
     path : str or None
@@ -85,6 +113,8 @@ class VariantResult:
         Range of gains the symbolic answer covers.
     partition : Partition or None
         The partition used (3.4 only).
+    certificate : Certificate or None
+        The certificate behind the answer (``None`` when not applicable).
     """
 
     proposition: str
@@ -104,12 +134,24 @@ class VariantResult:
     certificate: Certificate | None = None
 
     @property
+    def name(self) -> str:
+        """``"3.4.3"``-style name."""
+        return f"{self.proposition}.{self.variant}"
+
+    @property
     def convergence(self) -> str:
         """``"asymptotic"`` or ``"exponential"``."""
-        return "asymptotic" if self.proposition == "3.1" else "exponential"
+        return PROPOSITIONS[self.proposition].convergence
+
+    @property
+    def kappa_text(self) -> str:
+        r""":math:`\kappa^*` as every printout shows it (six digits, or the expression)."""
+        if not self.applicable or not self.holds:
+            return "—"
+        return kappa_text(self.kappa, self.kappa_float, self.unbounded)
 
     def kappa_json(self) -> float | str | None:
-        r""":math:`\kappa^*` for the JSON ``kappa`` key (DESIGN.md).
+        r""":math:`\kappa^*` for the JSON ``kappa`` key.
 
         ``None`` only when the variant is not applicable or :math:`\kappa^*` is unbounded
         (or has no closed form for symbolic gains); ``0.0`` for a failing variant (its
@@ -124,10 +166,35 @@ class VariantResult:
             return self.kappa_float
         return None if self.kappa is None else str(self.kappa)
 
+    def to_dict(self, interval: Sequence[Any] = ("a", "b")) -> dict[str, Any]:
+        """JSON form of one variant (``interval`` names the endpoints of the traces)."""
+        out: dict[str, Any] = {
+            "proposition": self.proposition,
+            "variant": self.variant,
+            "applicable": self.applicable,
+            "holds": self.holds,
+            "kappa": self.kappa_json(),
+            "kappa_exact": None if self.kappa is None else str(self.kappa),
+            "unbounded": self.unbounded,
+            "rhs": self.rhs,
+            "reason": self.reason,
+            "path": self.path,
+        }
+        if self.conditions is not None:
+            out["conditions"] = self.conditions
+        if self.partition is not None:
+            out["partition"] = {"x1": list(self.partition.x1), "x2": list(self.partition.x2)}
+        if self.witness is not None:
+            out["witness"] = {t.label(interval, tilde=True): str(x) for t, x in self.witness}
+            out["free"] = [t.label(interval, tilde=True) for t in self.free]
+        return out
 
-@dataclass(frozen=True)
+
+@dataclass(frozen=True, repr=False)
 class Classification:
     """The classification of one observer design.
+
+    ``str()`` is the table of ``phdesign classify``; :meth:`to_dict` its JSON.
 
     Attributes
     ----------
@@ -153,7 +220,8 @@ class Classification:
         for r in self.results:
             if r.proposition == proposition and r.variant == variant:
                 return r
-        raise KeyError(f"no variant {proposition}.{variant}")
+        known = ", ".join(r.name for r in self.results)
+        raise ObserverError(f"no variant {proposition}.{variant}; expected one of {known}")
 
     @property
     def best(self) -> VariantResult | None:
@@ -163,8 +231,13 @@ class Classification:
             return None
         return max(holding, key=_strength)
 
-    def to_json_dict(self) -> dict[str, Any]:
-        """Return the JSON of DESIGN.md (plus keys such as ``kappa_exact``, ``witness``)."""
+    @property
+    def applicable(self) -> tuple[VariantResult, ...]:
+        """The variants that apply to this model (the rows of the table)."""
+        return tuple(r for r in self.results if r.applicable)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Return the JSON of ``phdesign classify --json`` (every key is documented there)."""
         partitions = self.assumption.partitions if self.assumption else ()
         best = self.best
         return {
@@ -175,11 +248,104 @@ class Classification:
             "gain": _rows(self.L),
             "gain_exact": [[str(x) for x in row] for row in self.L.tolist()],
             "partitioned": bool(partitions),
-            "partitions": [p.to_json_dict() for p in partitions],
-            "results": [_result_json(r, self.model.interval) for r in self.results],
+            "partitions": [p.to_dict() for p in partitions],
+            "results": [r.to_dict(self.model.interval) for r in self.results],
             "verdict": self.verdict,
-            "best": None if best is None else f"{best.proposition}.{best.variant}",
+            "best": None if best is None else best.name,
         }
+
+    # ------------------------------------------------------------------ display
+    def _header(self) -> list[str]:
+        model = self.model
+        lines = [
+            f"model {model.name}: N = {model.order}, n = {model.size}",
+            f"sensors: {sensors_text(self.C_m)}",
+            f"gain L = {matrix_text(self.L)}",
+        ]
+        if model.feedback is not None:  # the plant's own dampers: part of the error boundary
+            closed = ", ".join(f"u{i}" for i in model.feedback.inputs)
+            lines.append(
+                f"plant feedback: {closed} = -K y (K = {matrix_text(model.feedback.gain)}); "
+                "sensors index the remaining outputs"
+            )
+        if self.assumption is not None:
+            if self.assumption.holds:
+                parts = "; ".join(p.label(model.state_names) for p in self.assumption.partitions)
+                lines.append(f"Assumption 3.1 holds: {parts}")
+            else:
+                lines.append(f"Assumption 3.1 fails: {self.assumption.reason}")
+        return lines
+
+    def _verdict_line(self) -> str:
+        best = self.best
+        tail = ""
+        if best is not None:
+            tail = f" (best: Proposition {best.proposition} variant {best.variant})"
+        return f"verdict: {self.verdict}{tail}"
+
+    def __str__(self) -> str:
+        names = self.model.state_names
+        lines = [*self._header(), ""]
+        header = f"{'prop':<5} {'var':<3} {'holds':<6} {'κ*':<{KAPPA_WIDTH}} right-hand side"
+        lines += [header, "-" * len(header)]
+        indent = " " * (17 + KAPPA_WIDTH)
+        for r in self.applicable:
+            kappa = r.kappa_text
+            notes = []
+            if len(kappa) > KAPPA_WIDTH:
+                notes.append(f"κ* = {kappa}")
+                kappa = "see below"
+            lines.append(
+                f"{r.proposition:<5} {r.variant:<3} {'yes' if r.holds else 'no':<6} "
+                f"{kappa:<{KAPPA_WIDTH}} {r.rhs}"
+            )
+            if not r.holds:
+                notes.append(r.reason)
+            elif r.kappa is not None and r.kappa_float is not None:
+                exact = number_text(r.kappa)
+                if exact != kappa and "/" not in kappa and exact != f"{r.kappa_float:.6g}":
+                    notes.append(f"κ* = {exact} exactly")
+            if r.holds and r.conditions:
+                notes.append(r.conditions)
+            if r.partition is not None:
+                notes.append(f"partition {r.partition.label(names)}")
+            if notes:
+                lines.append(f"{indent}↳ {'; '.join(notes)}")
+        lines += [f"not applicable: {text}" for text in self._not_applicable()]
+        lines += ["", self._verdict_line()]
+        return "\n".join(lines)
+
+    def _not_applicable(self) -> list[str]:
+        """Return the variants that do not apply, grouped by proposition and reason."""
+        groups: dict[tuple[str, str], list[int]] = {}
+        for r in self.results:
+            if not r.applicable:
+                groups.setdefault((r.proposition, r.reason), []).append(r.variant)
+        return [f"Proposition {prop} ({reason})" for prop, reason in groups]
+
+    def __repr__(self) -> str:
+        best = self.best
+        text = (
+            f"Classification(model={self.model.name!r}, "
+            f"sensors={shorten(sensors_text(self.C_m), 60)!r}, "
+            f"L={shorten(matrix_text(self.L), 60)!r}, verdict={self.verdict!r}, "
+            f"best={None if best is None else best.name!r}, "
+            f"kappa={shorten(best.kappa_text, 40) if best is not None else None})"
+        )
+        return shorten(text, REPR_LIMIT)
+
+    def _repr_html_(self) -> str:
+        rows = [
+            [r.name, "yes" if r.holds else "no", r.kappa_text, r.rhs, "" if r.holds else r.reason]
+            for r in self.applicable
+        ]
+        footer = "; ".join([*self._not_applicable(), self._verdict_line()])
+        return html_table(
+            ["variant", "holds", "κ*", "right-hand side", "reason"],
+            rows,
+            caption=" · ".join(self._header()),
+            footer="not applicable: " + footer if self._not_applicable() else footer,
+        )
 
 
 def _number(x: sympy.Expr) -> Any:
@@ -195,52 +361,11 @@ def _rows(M: sympy.MatrixBase) -> list[list[Any]]:
     return [[_number(sympy.sympify(x)) for x in row] for row in M.tolist()]
 
 
-def _result_json(r: VariantResult, interval: Sequence[Any]) -> dict[str, Any]:
-    out: dict[str, Any] = {
-        "proposition": r.proposition,
-        "variant": r.variant,
-        "applicable": r.applicable,
-        "holds": r.holds,
-        "kappa": r.kappa_json(),
-        "kappa_exact": None if r.kappa is None else str(r.kappa),
-        "unbounded": r.unbounded,
-        "rhs": r.rhs,
-        "reason": r.reason,
-        "path": r.path,
-    }
-    if r.conditions is not None:
-        out["conditions"] = r.conditions
-    if r.partition is not None:
-        out["partition"] = {"x1": list(r.partition.x1), "x2": list(r.partition.x2)}
-    if r.witness is not None:
-        out["witness"] = {t.label(interval, tilde=True): str(x) for t, x in r.witness}
-        out["free"] = [t.label(interval, tilde=True) for t in r.free]
-    return out
-
-
 def _strength(r: VariantResult) -> tuple[int, float]:
-    kind = 1 if r.convergence == "exponential" else 0
-    if r.unbounded:
-        return kind, float("inf")
-    return kind, r.kappa_float if r.kappa_float is not None else 0.0
+    return strength(r.convergence, r.kappa_float, r.unbounded)
 
 
-def verdict_of(results: Sequence[VariantResult]) -> str:
-    """Exponential if a 3.2/3.3/3.4 variant holds, asymptotic if only 3.1, else inconclusive."""
-    if any(r.holds and r.convergence == "exponential" for r in results):
-        return "exponential"
-    if any(r.holds for r in results):
-        return "asymptotic"
-    return "inconclusive"
-
-
-def _trace_of_index(index: int, order: int, size: int) -> Trace:
-    side = "b" if index < order * size else "a"
-    rest = index % (order * size)
-    return Trace(rest % size + 1, rest // size, side)  # type: ignore[arg-type]
-
-
-def _not_applicable(variant: Variant, order: int, why: str) -> VariantResult:
+def _not_applicable(variant: Variant, interval: Sequence[Any], why: str) -> VariantResult:
     return VariantResult(
         variant.proposition,
         variant.variant,
@@ -251,43 +376,40 @@ def _not_applicable(variant: Variant, order: int, why: str) -> VariantResult:
         False,
         None,
         (),
-        variant.describe(),
+        variant.describe(interval=interval, tilde=True),
         why,
     )
 
 
 def _from_certificate(
-    variant: Variant,
-    cert: Certificate,
-    es: ErrorSystem,
-    interval: Sequence[Any],
-    partition: Partition | None,
+    case: Case, cert: Certificate, es: ErrorSystem, interval: Sequence[Any]
 ) -> VariantResult:
-    order, size = es.order, es.size
+    traces = trace_list(es.order, es.size)
     witness = None
     free: tuple[Trace, ...] = ()
+    symbolic = bool(es.L.free_symbols)
+    conditions = cert.conditions
     if cert.holds:
         if cert.unbounded:
             reason = "holds for every κ > 0: the right-hand side vanishes on the error traces"
         else:
-            value = cert.kappa if cert.kappa is not None else cert.kappa_float
-            reason = f"holds with κ* = {value}"
+            reason = f"holds with κ* = {kappa_text(cert.kappa, cert.kappa_float)}"
             if cert.conditions:
                 reason += f" ({cert.conditions})"
     else:
-        assert cert.witness is not None  # a failing certificate always has one
-        witness = tuple(
-            (_trace_of_index(i, order, size), x) for i, x in enumerate(cert.witness) if x != 0
-        )
-        free = tuple(_trace_of_index(i, order, size) for i in cert.free)
+        if cert.witness is None:  # pragma: no cover - a failing certificate always has one
+            raise ObserverError("a failing certificate must carry its witness")
+        witness = tuple((traces[i], x) for i, x in enumerate(cert.witness) if x != 0)
+        free = tuple(traces[i] for i in cert.free)
         labels = ", ".join(t.label(interval, tilde=True) for t in free)
         verb = "is" if len(free) == 1 else "are"
         reason = f"{labels} {verb} left free by these sensors"
-        if es.L.free_symbols:
+        if symbolic:
             reason += "; fails for all positive gains"
+            conditions = conditions or "fails for all positive gains"
     return VariantResult(
-        variant.proposition,
-        variant.variant,
+        case.variant.proposition,
+        case.variant.variant,
         True,
         cert.holds,
         cert.kappa,
@@ -295,33 +417,29 @@ def _from_certificate(
         cert.unbounded,
         witness,
         free,
-        variant.describe(),
+        case.variant.describe(case.blocks, interval, tilde=True),
         reason,
         cert.path,
-        cert.conditions
-        if cert.conditions
-        else ("fails for all positive gains" if es.L.free_symbols and not cert.holds else None),
-        partition,
+        conditions,
+        case.partition,
         cert,
     )
 
 
-def classify(
-    model: BCPHS,
-    C_m: sympy.MatrixBase,
-    L: sympy.MatrixBase,
-    method: str = "auto",
-) -> Classification:
+def classify(model: BCPHS, C_m: Any, L: Any, method: str = "auto") -> Classification:
     r"""Classify the observer with sensors ``C_m`` and gain ``L`` for ``model``.
 
     Parameters
     ----------
     model : BCPHS
         The plant (parameters at their defaults).
-    C_m : sympy matrix
-        ``q x Nn`` sensor matrix (:func:`~phdesign.symbolic.observer.sensor_matrix`).
-    L : sympy matrix
-        ``q x q`` gain with :math:`L + L^\top > 0`, or diagonal positive symbols.
+    C_m : matrix
+        ``q x Nn`` sensor matrix, read by
+        :func:`~phdesign.symbolic.observer.measurement_matrix` (nested lists, numpy or
+        sympy; :func:`~phdesign.symbolic.observer.sensor_matrix` picks outputs by index).
+    L : number, sequence, matrix or "symbolic"
+        The gain, read by :func:`~phdesign.symbolic.observer.gain_matrix`:
+        :math:`L + L^\top > 0`, or diagonal positive symbols.
     method : {"auto", "exact", "float"}
         How :math:`\kappa^*` is computed (the decision is always exact).
 
@@ -331,45 +449,27 @@ def classify(
 
     Raises
     ------
+    ArgumentError
+        ``model`` is not a model.
     ObserverError
-        Bad sensors or gain (shape, rank, NaN, :math:`L + L^\top` not positive definite).
+        Bad sensors or gain (kind, shape, rank, NaN, :math:`L + L^\top` not positive
+        definite), or an unknown ``method``.
     """
-    if method not in ("auto", "exact", "float"):
-        raise ValueError(f"method must be 'auto', 'exact' or 'float'; found {method!r}")
+    choice(method, "method", ("auto", "exact", "float"), ObserverError)
     design = ObserverDesign(model, C_m, L)
     es = design.error_system()
-    order, size = model.order, model.size
-    assumption = None
-    if order == 2:
-        assumption = check_assumption(model.P[1], model.P[2], model.H, model.parameter_defaults)
+    interval = model.interval
+    assumption = model_assumption(model)
     results: list[VariantResult] = []
-    for variant in VARIANTS:
-        if not variant.applicable_order(order):
-            results.append(
-                _not_applicable(variant, order, f"stated for N = {_orders(variant)}; N = {order}")
-            )
+    for entry in variant_cases(model.order, model.size, assumption):
+        if not entry.cases:
+            results.append(_not_applicable(entry.variant, interval, str(entry.reason)))
             continue
-        if variant.needs_partition:
-            assert assumption is not None  # order == 2 here
-            if not assumption.holds:
-                results.append(
-                    _not_applicable(variant, order, f"Assumption 3.1 fails: {assumption.reason}")
-                )
-                continue
-            candidates = []
-            for partition in assumption.partitions:
-                indices = variant.indices(order, size, (partition.x1, partition.x2))
-                cert = certify(es, indices, method)
-                candidates.append(_from_certificate(variant, cert, es, model.interval, partition))
-            holding = [c for c in candidates if c.holds]
-            results.append(max(holding, key=_strength) if holding else candidates[0])
-            continue
-        cert = certify(es, variant.indices(order, size), method)
-        results.append(_from_certificate(variant, cert, es, model.interval, None))
-    return Classification(
-        model, design.C_m, design.L, assumption, tuple(results), verdict_of(results)
-    )
-
-
-def _orders(variant: Variant) -> str:
-    return {"3.1": "any", "3.2": "1", "3.3": "2", "3.4": "2"}[variant.proposition]
+        tried = [
+            _from_certificate(case, certify(es, case.selected, method), es, interval)
+            for case in entry.cases
+        ]
+        holding = [c for c in tried if c.holds]
+        results.append(max(holding, key=_strength) if holding else tried[0])
+    verdict = verdict_of(r.convergence for r in results if r.holds)
+    return Classification(model, design.C_m, design.L, assumption, tuple(results), verdict)

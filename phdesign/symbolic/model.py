@@ -33,12 +33,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
 
 import sympy
 
 from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
 from phdesign.symbolic.conjugate import conjugate_outputs
+from phdesign.symbolic.display import ModelDisplay
 from phdesign.symbolic.expressions import (
     Z,
     canonical,
@@ -61,6 +63,9 @@ from phdesign.symbolic.feedback import (
 from phdesign.symbolic.signs import check_definite
 from phdesign.symbolic.units import check_units
 
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from phdesign.symbolic.ports import Ports
+
 __all__ = ["BCPHS", "Displacement", "Feedback", "Z", "parse_matrix"]
 
 
@@ -78,8 +83,8 @@ class Displacement:
     integrations: int
 
 
-@dataclass(frozen=True)
-class BCPHS:
+@dataclass(frozen=True, repr=False)
+class BCPHS(ModelDisplay):
     r"""A validated symbolic BC-PHS (see the module docstring for the equations).
 
     Build one with :meth:`define` (from strings and numbers) or from a model file
@@ -257,6 +262,13 @@ class BCPHS:
         )
 
     # ------------------------------------------------------------------ views
+    @cached_property
+    def ports(self) -> Ports:
+        """The boundary port structure (:func:`~phdesign.symbolic.ports.derive_ports`), cached."""
+        from phdesign.symbolic.ports import derive_ports
+
+        return derive_ports(self)
+
     @property
     def n_ports(self) -> int:
         """Number of external inputs (= outputs): ``N n`` less the closed ones."""
@@ -409,6 +421,9 @@ def _validate(model: BCPHS) -> list[str]:
         check_shape(f"P{k}", P_k, (n, n))
     if len(model.state_names) != n:
         raise ModelError(f"state_names must hold {n} labels; found {len(model.state_names)}")
+    for label in model.state_names:
+        if not isinstance(label, str) or not label.strip():
+            raise ModelError(f"state_names must be non-empty text labels; found {label!r}")
 
     symbols = {s for s, _ in model.parameters}
     for s, value in model.parameters:
@@ -458,9 +473,7 @@ def _validate(model: BCPHS) -> list[str]:
         object.__setattr__(model, "outputs", outputs)
         checks.append("outputs: derived, the least-norm power conjugates of the inputs")
     _check_ports(model, symbols, ("outputs",))
-    from phdesign.symbolic.ports import derive_ports  # ports depend on a built model
-
-    derive_ports(model)
+    model.ports  # noqa: B018 - derives the ports (checking the identities) and caches them
     checks.append("port identities: exact")
     if model.feedback is not None:
         checks += check_feedback(model, symbols, defaults)

@@ -36,17 +36,24 @@ picks among them, and the error boundary condition over all :math:`Nn` open port
 E_r`, whose symmetric part (the plant's dampers and the observer's injection) is the
 left-hand side of every proposition.
 
+Sensors and gains are given as plain Python: :func:`sensor_matrix` picks outputs by
+index, :func:`measurement_matrix` takes :math:`C_m` in full and :func:`gain_matrix` takes
+:math:`L` as a number, a diagonal, a matrix or ``"symbolic"``.  These three functions are
+the one place where sensors and gains are validated (shape, finiteness, full row rank of
+:math:`C_m`, :math:`L + L^\top \succ 0`), for the library and for every command of the
+command line alike; their messages name the argument (``sensors``, ``C_m``, ``gain``).
+
 Examples
 --------
 >>> sensor_matrix([3, 4], n_outputs=4)
 Matrix([
 [0, 0, 1, 0],
 [0, 0, 0, 1]])
->>> parse_gain("0.1, 1", q=2)
+>>> gain_matrix([0.1, 1], q=2)
 Matrix([
 [1/10, 0],
 [   0, 1]])
->>> parse_gain("symbolic", q=2)
+>>> gain_matrix("symbolic", q=2)
 Matrix([
 [l1,  0],
 [ 0, l2]])
@@ -54,10 +61,11 @@ Matrix([
 
 from __future__ import annotations
 
-import json
-from collections.abc import Sequence
+import operator
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import sympy
 from sympy.polys.matrices import DomainMatrix
@@ -71,229 +79,210 @@ from phdesign.symbolic.model import BCPHS
 __all__ = [
     "ErrorSystem",
     "ObserverDesign",
-    "diagonal_values",
     "error_system",
+    "gain_matrix",
     "gain_symbols",
-    "parse_cm",
-    "parse_gain",
-    "parse_sensors",
+    "measurement_matrix",
+    "port_inverse",
     "port_matrices",
     "sensor_matrix",
-    "vanishes",
 ]
 
 
 # --------------------------------------------------------------------------- sensors
-def sensor_matrix(indices: Sequence[int], n_outputs: int) -> sympy.ImmutableMatrix:
-    """Return :math:`C_m` whose rows are the unit rows picking outputs ``indices`` (1-based).
+def sensor_matrix(sensors: Iterable[int] | int, n_outputs: int) -> sympy.ImmutableMatrix:
+    """Return :math:`C_m` whose rows are the unit rows picking outputs ``sensors`` (1-based).
+
+    Parameters
+    ----------
+    sensors : int or iterable of int
+        The measured outputs, 1-based (``[3, 4]`` measures :math:`y_3` and :math:`y_4`).
+    n_outputs : int
+        The number :math:`Nn` of outputs of the model.
 
     Raises
     ------
     ObserverError
-        If an index is out of ``1..n_outputs``, repeated, or the list is empty.
+        If an index is out of ``1..n_outputs``, repeated, not an integer, or there is none.
     """
-    picked = list(indices)
+    _check_count(n_outputs, "n_outputs")
+    if isinstance(sensors, str | bytes):
+        raise ObserverError(
+            f"sensors: expected a list of output indices such as [3, 4]; found the text "
+            f"{sensors!r}"
+        )
+    if isinstance(sensors, int) and not isinstance(sensors, bool):
+        sensors = [sensors]
+    if not isinstance(sensors, Iterable):
+        raise ObserverError(
+            f"sensors: expected a list of output indices such as [3, 4]; found "
+            f"{type(sensors).__name__} {sensors!r}"
+        )
+    picked: list[int] = []
+    for index in sensors:
+        try:
+            if isinstance(index, bool):
+                raise TypeError
+            value = operator.index(index)
+        except TypeError:
+            raise ObserverError(
+                f"sensors: expected integer output indices; found {index!r}"
+            ) from None
+        if not 1 <= value <= n_outputs:
+            raise ObserverError(
+                f"sensors: output index {value} is out of range; expected 1..{n_outputs}"
+            )
+        if value in picked:
+            raise ObserverError(
+                f"sensors: output index {value} is repeated; expected distinct indices"
+            )
+        picked.append(value)
     if not picked:
         raise ObserverError("sensors: expected at least one output index; found none")
-    seen: set[int] = set()
-    for index in picked:
-        if isinstance(index, bool) or not isinstance(index, int):
-            raise ObserverError(f"sensors: expected integer output indices; found {index!r}")
-        if not 1 <= index <= n_outputs:
-            raise ObserverError(
-                f"sensors: output index {index} is out of range; expected 1..{n_outputs}"
-            )
-        if index in seen:
-            raise ObserverError(
-                f"sensors: output index {index} is repeated; expected distinct indices"
-            )
-        seen.add(index)
     return sympy.ImmutableMatrix(
         len(picked), n_outputs, lambda r, c: 1 if c == picked[r] - 1 else 0
     )
 
 
-def parse_sensors(text: str, n_outputs: int) -> sympy.ImmutableMatrix:
-    """Parse ``"3,4"`` into :math:`C_m` (see :func:`sensor_matrix`)."""
-    parts = [p.strip() for p in str(text).split(",")]
-    indices = []
-    for part in parts:
-        try:
-            indices.append(int(part))
-        except ValueError:
-            raise ObserverError(
-                f"--sensors: expected comma-separated output indices like 3,4; "
-                f"found {part!r} in {text!r}"
-            ) from None
-    return sensor_matrix(indices, n_outputs)
+def measurement_matrix(C_m: Any, n_outputs: int) -> sympy.ImmutableMatrix:
+    """Return :math:`C_m` given in full, exact and checked (``q x n_outputs``, full row rank).
 
-
-def _numbers_from_json(text: str, what: str) -> object:
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError as error:
-        raise ObserverError(
-            f"{what}: expected a JSON list of rows like [[0, 1], [1, 0]]; found {text!r} "
-            f"({error.msg} at character {error.pos})"
-        ) from None
-
-
-def _exact_matrix(rows: object, what: str) -> sympy.ImmutableMatrix:
-    if not isinstance(rows, list) or not rows or not all(isinstance(r, list) and r for r in rows):
-        raise ObserverError(f"{what}: expected a non-empty list of non-empty rows; found {rows!r}")
-    width = len(rows[0])  # type: ignore[arg-type]
-    for i, row in enumerate(rows):  # type: ignore[arg-type]
-        if len(row) != width:
-            raise ObserverError(
-                f"{what}: row {i + 1} has {len(row)} entries; expected {width} like row 1"
-            )
-    try:
-        entries = [
-            [exact_number(x, f"{what}[{i + 1}][{j + 1}]") for j, x in enumerate(row)]
-            for i, row in enumerate(rows)  # type: ignore[arg-type]
-        ]
-    except ExpressionError as error:
-        raise ObserverError(str(error)) from None
-    return sympy.ImmutableMatrix(entries)
-
-
-def parse_cm(text: str, n_outputs: int) -> sympy.ImmutableMatrix:
-    """Parse ``"[[0,0,1,0]]"`` into :math:`C_m` (``q x n_outputs``), exactly."""
-    C_m = _exact_matrix(_numbers_from_json(text, "--cm"), "--cm")
-    if C_m.shape[1] != n_outputs:
-        raise ObserverError(
-            f"--cm: Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) "
-            f"but found {C_m.shape}"
-        )
-    return C_m
-
-
-def diagonal_values(entries: Sequence[object], count: int, meaning: str) -> list[sympy.Expr]:
-    """Read diagonal gain entries exactly; a single entry is used ``count`` times.
+    Parameters
+    ----------
+    C_m : matrix
+        Rows of numbers (nested lists), a numpy array or a sympy matrix; floats are read
+        exactly through their shortest decimal form (``0.5`` is :math:`1/2`).
+    n_outputs : int
+        The number :math:`Nn` of outputs of the model.
 
     Raises
     ------
     ObserverError
-        If an entry is not a finite number, or there are neither 1 nor ``count`` entries.
+        Wrong kind or shape, an entry that is not a finite number, or dependent rows.
+
+    Examples
+    --------
+    >>> measurement_matrix([[0, 0, 1, 0.5]], 4)
+    Matrix([[0, 0, 1, 1/2]])
     """
-    for i, part in enumerate(entries):
-        if str(part).lower().lstrip("+-") in ("nan", "inf", "infinity"):
-            raise ObserverError(
-                f"--gain: entry {i + 1} must be a finite positive number; found {part!r}"
-            )
-    try:
-        values = [exact_number(p, f"--gain entry {p!r}") for p in entries]
-    except ExpressionError as error:
-        raise ObserverError(f"--gain: {error}") from None
-    if len(values) == 1:
-        values = values * count
-    if len(values) != count:
+    _check_count(n_outputs, "n_outputs")
+    rows = _rows(C_m, "C_m")
+    if len(rows) > n_outputs:
         raise ObserverError(
-            f"--gain: expected {count} diagonal values ({meaning}) or a single one; "
-            f"found {len(values)}"
+            f"Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) with "
+            f"1 <= q <= {n_outputs} but found ({len(rows)}, {len(rows[0])})"
         )
-    return values
+    if len(rows[0]) != n_outputs:
+        raise ObserverError(
+            f"Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) but found "
+            f"({len(rows)}, {len(rows[0])})"
+        )
+    matrix = _exact(rows, "C_m")
+    if matrix.free_symbols:
+        raise ObserverError(
+            f"C_m must be numeric; found symbols {sorted(map(str, matrix.free_symbols))}"
+        )
+    rank = matrix.rank()
+    if rank != matrix.rows:
+        raise ObserverError(
+            f"C_m must have full row rank (independent measurements); expected rank "
+            f"{matrix.rows} but found {rank}"
+        )
+    return matrix
 
 
+# --------------------------------------------------------------------------- gains
 @lru_cache(maxsize=64)
 def gain_symbols(q: int) -> tuple[sympy.Symbol, ...]:
     """Return the positive symbols ``l1 .. lq`` used for symbolic gains."""
     return tuple(sympy.Symbol(f"l{i + 1}", positive=True) for i in range(q))
 
 
-def parse_gain(text: str, q: int) -> sympy.ImmutableMatrix:
-    r"""Parse a gain: ``"0.1,1"`` (diagonal), ``"[[..]]"`` (full) or ``"symbolic"``.
+def gain_matrix(gain: Any, q: int, per: str = "sensor") -> sympy.ImmutableMatrix:
+    r"""Return the observer gain :math:`L` (``q x q``), exact and checked.
 
-    A single diagonal value is used for every sensor.  Numbers are read exactly
-    (``0.1`` is :math:`1/10`).  ``symbolic`` gives :math:`L = \mathrm{diag}(l_1..l_q)`
-    with positive symbols.
+    Parameters
+    ----------
+    gain : number, sequence of numbers, matrix or "symbolic"
+        A number :math:`g` (:math:`L = gI`), one number per sensor (the diagonal), the
+        matrix in full (nested lists, numpy array, sympy matrix), or ``"symbolic"``:
+        :math:`L = \mathrm{diag}(l_1, \dots, l_q)` with positive symbols.  Numbers may be
+        ints, floats (read exactly: ``0.1`` is :math:`1/10`), sympy numbers or text such
+        as ``"1/3"``.
+    q : int
+        The number of sensors.
+    per : str
+        What one diagonal entry belongs to, for messages (``"sensor"`` or ``"output"``).
+
+    Raises
+    ------
+    ObserverError
+        Wrong kind, shape or count, a non-finite entry, or :math:`L + L^\top` not positive
+        definite (symbolic gains must be diagonal and positive).
     """
-    text = str(text).strip()
-    if text == "symbolic":
-        return _check_gain(sympy.diag(*gain_symbols(q)), q)
-    if text.startswith("["):
-        L = _exact_matrix(_numbers_from_json(text, "--gain"), "--gain")
-        if L.shape != (q, q):
+    _check_count(q, "q (the number of sensors)")
+    if isinstance(gain, str):
+        text = gain.strip()
+        if text == "symbolic":
+            return _check_gain(sympy.diag(*gain_symbols(q)), q)
+        if "," in text or text.startswith("["):
             raise ObserverError(
-                f"--gain: Incompatible dimensions of L matrix; expected {(q, q)} "
-                f"(one row and column per sensor) but found {L.shape}"
+                f"gain: expected a number, a list of numbers, a matrix or 'symbolic'; found "
+                f"the text {gain!r} (write gain=[0.1, 1] for a diagonal)"
             )
-        return _check_gain(L, q)
-    values = diagonal_values([p.strip() for p in text.split(",")], q, "one per sensor")
-    return _check_gain(sympy.diag(*values), q)
-
-
-# --------------------------------------------------------------------------- checks
-def _check_cm(C_m: sympy.MatrixBase, n_outputs: int) -> sympy.ImmutableMatrix:
-    C_m = sympy.ImmutableMatrix(C_m)
-    if C_m.rows < 1 or C_m.rows > n_outputs:
+        gain = [text]
+    if _is_scalar(gain):
+        gain = [gain]
+    if isinstance(gain, sympy.MatrixBase) or getattr(gain, "ndim", 1) == 2:
+        rows = _rows(gain, "gain")
+    elif isinstance(gain, Iterable) and not isinstance(gain, Mapping | set | frozenset):
+        entries = list(gain.tolist() if hasattr(gain, "tolist") else gain)
+        if entries and all(_is_scalar(x) for x in entries):
+            return _check_gain(sympy.diag(*_diagonal(entries, q, per)), q)
+        rows = _rows(entries, "gain")
+    else:
         raise ObserverError(
-            f"Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) with "
-            f"1 <= q <= {n_outputs} but found {C_m.shape}"
+            "gain: expected a number, a list of numbers, a matrix or 'symbolic'; found "
+            f"{type(gain).__name__} {gain!r}"
         )
-    try:
-        check_shape("C_m", C_m, (C_m.rows, n_outputs))
-    except ValueError as error:
-        raise ObserverError(str(error)) from None
-    C_m = _exactify_entries(C_m, "C_m")
-    if C_m.free_symbols:
+    L = _exact(rows, "gain")
+    if L.shape != (q, q):
         raise ObserverError(
-            f"C_m must be numeric; found symbols {sorted(map(str, C_m.free_symbols))}"
+            f"gain: Incompatible dimensions of L matrix; expected {(q, q)} "
+            f"(one row and column per {per}) but found {L.shape}"
         )
-    rank = C_m.rank()
-    if rank != C_m.rows:
+    return _check_gain(L, q)
+
+
+def _diagonal(entries: list[Any], count: int, per: str) -> list[sympy.Expr]:
+    """Read diagonal gain entries exactly; a single entry is used ``count`` times."""
+    for i, entry in enumerate(entries):
+        if str(entry).strip().lower().lstrip("+-") in ("nan", "inf", "infinity"):
+            raise ObserverError(
+                f"gain: entry {i + 1} must be a finite positive number; found {entry!r}"
+            )
+    values = [_number(x, f"gain entry {x!r}") for x in entries]
+    if len(values) == 1:
+        values = values * count
+    if len(values) != count:
         raise ObserverError(
-            f"C_m must have full row rank (independent measurements); expected rank "
-            f"{C_m.rows} but found {rank}"
+            f"gain: expected {count} diagonal values (one per {per}) or a single one; "
+            f"found {len(values)}"
         )
-    return C_m
-
-
-def _exactify_entries(M: sympy.MatrixBase, what: str) -> sympy.ImmutableMatrix:
-    entries = []
-    for i in range(M.rows):
-        row = []
-        for j in range(M.cols):
-            x = M[i, j]
-            if isinstance(x, sympy.Basic) and x.has(sympy.nan, sympy.zoo, sympy.oo, -sympy.oo):
-                raise ObserverError(f"{what}[{i + 1}][{j + 1}] must be a finite number; found {x}")
-            if isinstance(x, sympy.Basic) and x.free_symbols:
-                row.append(x)
-                continue
-            try:
-                row.append(
-                    exact_number(
-                        x if isinstance(x, sympy.Basic) else _py(x), f"{what}[{i + 1}][{j + 1}]"
-                    )
-                )
-            except ExpressionError as error:
-                raise ObserverError(str(error)) from None
-        entries.append(row)
-    return sympy.ImmutableMatrix(entries)
-
-
-def _py(x: object) -> object:
-    # numpy scalars -> python numbers, without importing numpy
-    item = getattr(x, "item", None)
-    return item() if callable(item) else x
+    return values
 
 
 def _check_gain(L: sympy.MatrixBase, q: int) -> sympy.ImmutableMatrix:
     L = sympy.ImmutableMatrix(L)
-    try:
-        check_shape("L", L, (q, q))
-    except ValueError as error:
-        raise ObserverError(f"{error} (one row and column per sensor)") from None
-    L = _exactify_entries(L, "L")
+    check_shape("L", L, (q, q), error=ObserverError)
     sym = (L + L.T) / 2
     if L.free_symbols:
         # Symbolic gains: only a diagonal of positive expressions is decidable for all values.
         off = [sym[i, j] for i in range(q) for j in range(q) if i != j and sym[i, j] != 0]
         if off or not all(sym[i, i].is_positive for i in range(q)):
             raise ObserverError(
-                "symbolic L must be diagonal with positive entries (e.g. --gain symbolic) "
-                "so that L + Lᵀ > 0 holds for every value; found "
-                f"{L.tolist()}"
+                "symbolic L must be diagonal with positive entries (e.g. gain='symbolic') "
+                f"so that L + Lᵀ > 0 holds for every value; found {L.tolist()}"
             )
         return L
     # Exact Sylvester test on leading principal minors (q is small).
@@ -307,23 +296,110 @@ def _check_gain(L: sympy.MatrixBase, q: int) -> sympy.ImmutableMatrix:
     return L
 
 
+# --------------------------------------------------------------------------- entries
+def _check_count(value: object, what: str) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ObserverError(f"{what} must be a positive integer; found {value!r}")
+
+
+def _is_scalar(x: object) -> bool:
+    if isinstance(x, sympy.MatrixBase):
+        return False
+    if isinstance(x, str | int | float | sympy.Expr):
+        return True
+    return getattr(x, "ndim", None) == 0  # numpy scalars and 0-d arrays
+
+
+def _rows(value: Any, what: str) -> list[list[Any]]:
+    """Return a matrix given as nested lists, a numpy array or a sympy matrix as rows."""
+    if isinstance(value, str | bytes) or _is_scalar(value):
+        raise ObserverError(
+            f"{what}: expected a matrix (rows of numbers, a numpy array or a sympy Matrix); "
+            f"found {type(value).__name__} {value!r}"
+        )
+    if isinstance(value, sympy.MatrixBase) or hasattr(value, "tolist"):
+        value = value.tolist()
+    if isinstance(value, Mapping) or not isinstance(value, Iterable):
+        raise ObserverError(
+            f"{what}: expected a matrix (rows of numbers); found {type(value).__name__}"
+        )
+    rows = [list(r) if isinstance(r, Iterable) and not isinstance(r, str) else r for r in value]
+    if not rows or not all(isinstance(r, list) and r for r in rows):
+        raise ObserverError(f"{what}: expected a non-empty list of non-empty rows; found {rows!r}")
+    width = len(rows[0])
+    for i, row in enumerate(rows):
+        if len(row) != width:
+            raise ObserverError(
+                f"{what}: row {i + 1} has {len(row)} entries; expected {width} like row 1"
+            )
+    return rows
+
+
+def _exact(rows: list[list[Any]], what: str) -> sympy.ImmutableMatrix:
+    name = "L" if what == "gain" else what
+    return sympy.ImmutableMatrix(
+        [
+            [_number(x, f"{name}[{i + 1}][{j + 1}]") for j, x in enumerate(row)]
+            for i, row in enumerate(rows)
+        ]
+    )
+
+
+def _number(x: object, what: str) -> sympy.Expr:
+    """Return ``x`` as an exact number (symbols kept), or raise ObserverError."""
+    if isinstance(x, sympy.Basic) and x.has(sympy.nan, sympy.zoo, sympy.oo, -sympy.oo):
+        raise ObserverError(f"{what} must be a finite number; found {x}")
+    if isinstance(x, sympy.Expr) and x.free_symbols:
+        return x
+    item = getattr(x, "item", None)  # numpy scalars -> python numbers, without numpy
+    try:
+        return exact_number(item() if callable(item) else x, what)
+    except ExpressionError as error:
+        raise ObserverError(str(error)) from None
+
+
 # --------------------------------------------------------------------------- design
-@lru_cache(maxsize=64)
 def port_matrices(model: BCPHS) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix]:
     r"""Return :math:`(U, Y)` of ``model`` with the parameter defaults substituted.
 
     The classification lives in trace coordinates: only :math:`U` and :math:`Y`
     enter it (not :math:`\mathcal H`, and :math:`P_k` only through Assumption 3.1).
     """
-    from phdesign.symbolic.ports import derive_ports
-
-    ports = derive_ports(model)
+    ports = model.ports
     defaults = model.parameter_defaults
     U, Y = (sympy.ImmutableMatrix(M.xreplace(defaults)) for M in (ports.U, ports.Y))
     return U, Y
 
 
-@lru_cache(maxsize=64)
+def port_inverse(model: BCPHS) -> sympy.ImmutableMatrix:
+    r"""Return :math:`T^{-1}` for :math:`T = (U; Y)` at the parameter defaults (exact).
+
+    Column :math:`j` of :math:`T^{-1}` is the trace vector :math:`v` whose inputs and
+    outputs are all zero but the :math:`j`-th of :math:`(u; y)`; the port identities make
+    :math:`T` invertible, so the traces of the error system are :math:`v = T^{-1}(\tilde u;
+    \tilde y)`.
+
+    Raises
+    ------
+    ObserverError
+        If :math:`T` is singular (the outputs are not the power conjugates of the inputs).
+
+    Examples
+    --------
+    >>> from phdesign.models import load_builtin
+    >>> port_inverse(load_builtin("wave"))  # v = (e1(1), e2(1), e1(0), e2(0))
+    Matrix([
+    [0, 0,  0, 1],
+    [0, 1,  0, 0],
+    [1, 0,  0, 0],
+    [0, 0, -1, 0]])
+    """
+    from phdesign.arguments import require_model
+
+    require_model(model)
+    return _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(*port_matrices(model))))
+
+
 def _inverse(T: sympy.ImmutableMatrix) -> sympy.ImmutableMatrix:
     dm = DomainMatrix.from_Matrix(T).to_field()
     try:
@@ -398,8 +474,8 @@ def error_system(
     size: int,
     U: sympy.MatrixBase,
     Y: sympy.MatrixBase,
-    C_m: sympy.MatrixBase,
-    L: sympy.MatrixBase,
+    C_m: Any,
+    L: Any,
     feedback: tuple[tuple[int, ...], sympy.ImmutableMatrix] | None = None,
 ) -> ErrorSystem:
     r"""Build the error boundary condition and the admissible traces.
@@ -410,8 +486,9 @@ def error_system(
         :math:`N` and :math:`n`.
     U, Y : sympy matrix
         The open plant's ports over the traces (``Nn x 2Nn``).
-    C_m, L : sympy matrix
-        Sensors over the external outputs and their gain.
+    C_m, L
+        Sensors over the external outputs and their gain, read by
+        :func:`measurement_matrix` and :func:`gain_matrix`.
     feedback : (closed 0-based indices, K), optional
         The plant's own boundary feedback (:func:`~phdesign.symbolic.feedback.plant_feedback`).
 
@@ -421,8 +498,8 @@ def error_system(
         If ``C_m`` or ``L`` is malformed, or :math:`\dim \mathcal K \ne Nn`.
     """
     nn = order * size
-    C_m = _check_cm(C_m, nn - (0 if feedback is None else len(feedback[0])))
-    L = _check_gain(L, C_m.rows)
+    C_m = measurement_matrix(C_m, nn - (0 if feedback is None else len(feedback[0])))
+    L = gain_matrix(L, C_m.rows)
     U = sympy.ImmutableMatrix(U)
     Y = sympy.ImmutableMatrix(Y)
     T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
@@ -446,14 +523,18 @@ def error_system(
 class ObserverDesign:
     r"""A sensor set and gain for a model: the observer of the module docstring.
 
+    The symbolic core of :class:`phdesign.Observer`: exact, validated :math:`C_m` and
+    :math:`L` and the error system they define.
+
     Parameters
     ----------
     model : BCPHS
         The plant (with its own boundary feedback, if any).
-    C_m : sympy matrix
-        ``q x n_ports`` over the model's external outputs, full row rank.
-    L : sympy matrix
-        ``q x q`` with :math:`L + L^\top > 0` (checked), or diagonal positive symbols.
+    C_m : matrix
+        ``q x n_ports`` over the model's external outputs, full row rank (read by
+        :func:`measurement_matrix`).
+    L : number, sequence, matrix or "symbolic"
+        Read by :func:`gain_matrix`: :math:`L + L^\top > 0`, or diagonal positive symbols.
     """
 
     model: BCPHS
@@ -461,13 +542,11 @@ class ObserverDesign:
     L: sympy.ImmutableMatrix
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "C_m", _check_cm(self.C_m, self.model.n_ports))
-        object.__setattr__(self, "L", _check_gain(self.L, self.C_m.rows))
+        from phdesign.arguments import require_model
 
-    @property
-    def error_boundary_matrix(self) -> sympy.ImmutableMatrix:
-        r""":math:`U + C_m^\top L C_m Y` (``Nn x 2Nn``)."""
-        return self.error_system().boundary_matrix
+        require_model(self.model)
+        object.__setattr__(self, "C_m", measurement_matrix(self.C_m, self.model.n_ports))
+        object.__setattr__(self, "L", gain_matrix(self.L, self.C_m.rows))
 
     def error_system(self) -> ErrorSystem:
         """Return the :class:`ErrorSystem` of this design."""

@@ -11,7 +11,8 @@ for :math:`k \ge 1`,
     \qquad Q_{ij} = (-1)^{i-1} P_{i+j-1} \ (i + j - 1 \le N), \ 0 \text{ otherwise},
 
 (block indices :math:`i, j = 1..N`). The paper prints :math:`(-1)^{j-1}`, which has the
-wrong sign for every even :math:`k` (DESIGN.md). Proof sketch: moving :math:`j-1`
+wrong sign for every even :math:`k` (see the conventions in the documentation).
+Proof sketch: moving :math:`j-1`
 derivatives of :math:`\partial_z^k e` onto :math:`e^\top` leaves boundary terms
 :math:`(-1)^{i-1} (\partial^{i-1} e)^\top P_k \partial^{k-i} e`, :math:`i = 1..k`, whose
 symmetrization is the :math:`(i, k+1-i)` block of :math:`Q`, and the remaining integral
@@ -45,13 +46,15 @@ Matrix([
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Protocol
 
 import sympy
 
+from phdesign.arguments import require_model
 from phdesign.errors import PortError
+from phdesign.symbolic.display import PortsDisplay
 from phdesign.symbolic.expressions import (
     Trace,
     canonical,
@@ -96,7 +99,7 @@ __all__ = [
     "trace_vector",
 ]
 
-#: Keys of :attr:`Ports.identities`, in the order of DESIGN.md's JSON contract.
+#: Keys of :attr:`Ports.identities`, in the order of the JSON contract of ``phdesign ports``.
 IDENTITY_NAMES = ("WB_Sigma_WBt", "WC_Sigma_WCt", "WC_Sigma_WBt_minus_I")
 
 
@@ -129,7 +132,7 @@ def trace_vector(order: int, size: int) -> tuple[sympy.Symbol, ...]:
 
 
 def q_matrix(P: Sequence[sympy.MatrixBase], order: int) -> sympy.ImmutableMatrix:
-    """Return :math:`Q` with blocks :math:`Q_{ij} = (-1)^{i-1} P_{i+j-1}` (DESIGN.md sign).
+    """Return :math:`Q` with blocks :math:`Q_{ij} = (-1)^{i-1} P_{i+j-1}` (the corrected sign).
 
     Parameters
     ----------
@@ -182,8 +185,8 @@ def coefficient_matrix(
     return sympy.ImmutableMatrix(rows)
 
 
-@dataclass(frozen=True)
-class Ports:
+@dataclass(frozen=True, repr=False)
+class Ports(PortsDisplay):
     """The boundary port structure of a model (all matrices exact).
 
     Attributes
@@ -203,6 +206,8 @@ class Ports:
     identities : dict
         Largest absolute entry of each identity's residual (zero for a valid model),
         keyed by :data:`IDENTITY_NAMES`.
+    model : BCPHS or None
+        The model the ports belong to (for printing: names and endpoints).
     """
 
     trace_vector: tuple[sympy.Symbol, ...]
@@ -214,6 +219,7 @@ class Ports:
     W_C: sympy.ImmutableMatrix
     Sigma: sympy.ImmutableMatrix
     identities: dict[str, sympy.Expr]
+    model: PortedSystem | None = field(default=None, compare=False)
 
     def boundary_variables(self) -> sympy.ImmutableMatrix:
         r"""Return :math:`(f_\partial; e_\partial)` as expressions in the traces."""
@@ -226,16 +232,18 @@ def sigma_matrix(dimension: int) -> sympy.ImmutableMatrix:
     return sympy.ImmutableMatrix(sympy.BlockMatrix([[zero, eye], [eye, zero]]).as_explicit())
 
 
-@lru_cache(maxsize=256)
 def derive_ports(model: PortedSystem) -> Ports:
-    """Derive and check the port structure of ``model``.
+    """Derive and check the port structure of ``model`` (a model caches it as ``model.ports``).
 
     Raises
     ------
+    ArgumentError
+        If ``model`` is not a model.
     PortError
         If the inputs or the outputs are linearly dependent, or an identity fails;
         the message names the identity and its largest residual.
     """
+    require_model(model)
     N, n = model.order, model.size
     Q = q_matrix(model.P, N)
     eye = sympy.eye(N * n)
@@ -291,6 +299,7 @@ def derive_ports(model: PortedSystem) -> Ports:
         W_C=sympy.ImmutableMatrix(W_C),
         Sigma=Sigma,
         identities=identities,
+        model=model,
     )
 
 

@@ -18,6 +18,10 @@ searches (numpy would cost more to import than the work), batched LAPACK
 exact zero pattern, never from a tolerance.
 
 A set is *minimal* for a verdict when it has that verdict and no proper subset has.
+The variants tried and the verdict rule are those of the classifier
+(:func:`~phdesign.symbolic.propositions.variant_cases`,
+:func:`~phdesign.symbolic.propositions.verdict_of`), so the search and
+:func:`~phdesign.symbolic.classify.classify` agree subset by subset.
 
 A plant with its own boundary feedback (``[feedback]``) is searched over its external
 outputs.  The closed ports are dissipated by the plant's dampers whatever the sensors,
@@ -37,6 +41,9 @@ Examples
 ((2,), (4,))
 >>> found.subset([4]).best, found.subset([4]).kappa
 ('3.4.4', 0.5)
+>>> found  # doctest: +NORMALIZE_WHITESPACE
+SensorSearch(model='euler-bernoulli', sets=15, gains='diag(1, 1, 1, 1)',
+             minimal_exponential=[[2], [4]])
 """
 
 from __future__ import annotations
@@ -44,17 +51,26 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Any
 
 import sympy
 
+from phdesign._display import (
+    REPR_LIMIT,
+    html_table,
+    kappa_text,
+    matrix_text,
+    number_text,
+    shorten,
+)
+from phdesign.arguments import require_model
 from phdesign.errors import ObserverError
-from phdesign.symbolic.assumption import Partition, check_assumption
+from phdesign.symbolic.assumption import Partition, model_assumption
+from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.feedback import external_indices, plant_feedback
 from phdesign.symbolic.model import BCPHS
-from phdesign.symbolic.observer import _inverse, diagonal_values, port_matrices, vanishes
-from phdesign.symbolic.propositions import VARIANTS, Variant
+from phdesign.symbolic.observer import gain_matrix, port_inverse
+from phdesign.symbolic.propositions import VERDICTS, Case, strength, variant_cases, verdict_of
 
 __all__ = ["Candidate", "SensorSearch", "SubsetResult", "candidates", "search_sensors"]
 
@@ -64,14 +80,12 @@ PROGRESS_THRESHOLD = 512
 
 @dataclass(frozen=True)
 class Candidate:
-    r"""One (variant, partition) pair with the unique minimal sensor set that makes it hold.
+    r"""One case (variant, partition) with the unique minimal sensor set that makes it hold.
 
     Attributes
     ----------
-    variant : Variant
-    partition : Partition or None
-    selected : tuple of int
-        Indices in :math:`v` of the traces the right-hand side selects.
+    case : Case
+        The variant, its partition and the traces it selects.
     required : tuple of int
         1-based outputs that must be measured (:math:`B_{\text{variant}}`).
     attainable : bool
@@ -79,16 +93,24 @@ class Candidate:
         leaves undamped breaks it).
     """
 
-    variant: Variant
-    partition: Partition | None
-    selected: tuple[int, ...]
+    case: Case
     required: tuple[int, ...]
     attainable: bool = True
 
     @property
     def name(self) -> str:
         """``"3.4.3"``-style name."""
-        return f"{self.variant.proposition}.{self.variant.variant}"
+        return self.case.variant.name
+
+    @property
+    def partition(self) -> Partition | None:
+        """The partition of Assumption 3.1 the case uses (3.4 only)."""
+        return self.case.partition
+
+    @property
+    def convergence(self) -> str:
+        """``"asymptotic"`` or ``"exponential"``."""
+        return self.case.variant.convergence
 
 
 @dataclass(frozen=True)
@@ -119,7 +141,7 @@ class SubsetResult:
     holding: tuple[str, ...]
     partition: tuple[tuple[int, ...], tuple[int, ...]] | None = None
 
-    def to_json_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """JSON form of one subset."""
         out: dict[str, Any] = {
             "sensors": list(self.sensors),
@@ -134,9 +156,9 @@ class SubsetResult:
         return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SensorSearch:
-    """Result of :func:`search_sensors`.
+    """Result of :func:`search_sensors`; ``str()`` is the table of ``classify --all-sensors``.
 
     Attributes
     ----------
@@ -160,15 +182,22 @@ class SensorSearch:
     subsets: tuple[SubsetResult, ...]
     minimal: dict[str, tuple[tuple[int, ...], ...]]
 
+    @property
+    def symbolic(self) -> bool:
+        """Whether the gains are symbolic (the constants are then not computed)."""
+        return all(g == "symbolic" for g in self.gains)
+
     def subset(self, sensors: Sequence[int]) -> SubsetResult:
         """Return the result of one sensor set."""
         key = tuple(sorted(sensors))
         for s in self.subsets:
             if s.sensors == key:
                 return s
-        raise KeyError(f"no subset {key}")
+        raise ObserverError(
+            f"no sensor set {list(key)}; expected distinct outputs in 1..{self.order * self.size}"
+        )
 
-    def to_json_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """JSON: every subset with its verdict, and the minimal sets per verdict."""
         return {
             "model": self.model,
@@ -176,11 +205,69 @@ class SensorSearch:
             "size": self.size,
             "gain": list(self.gains),
             "decision_path": "exact (combinatorial, gain-independent)",
-            "kappa_path": "float",
+            "kappa_path": None if self.symbolic else "float",
             "required": {c.name + _partition_suffix(c): list(c.required) for c in self.candidates},
-            "subsets": [s.to_json_dict() for s in self.subsets],
+            "subsets": [s.to_dict() for s in self.subsets],
             "minimal": {k: [list(s) for s in v] for k, v in self.minimal.items()},
         }
+
+    # ------------------------------------------------------------------ display
+    def _gain_text(self) -> str:
+        if self.symbolic:
+            return f"diag({', '.join(f'l{j + 1}' for j in range(len(self.gains)))})"
+        return f"diag({', '.join(self.gains)})"
+
+    def _kappa(self, s: SubsetResult) -> str:
+        if s.best is None:
+            return "—"
+        if self.symbolic:
+            return "depends on L"
+        return kappa_text(None, s.kappa, s.unbounded)
+
+    def _minimal_lines(self) -> list[str]:
+        lines = []
+        for verdict, sets in self.minimal.items():
+            shown = ", ".join("{" + ",".join(map(str, s)) + "}" for s in sets) or "none"
+            lines.append(f"minimal {verdict} sets: {shown}")
+        return lines
+
+    def __str__(self) -> str:
+        lines = [
+            f"model {self.model}: N = {self.order}, n = {self.size}, "
+            f"{len(self.subsets)} sensor sets, gains L = {self._gain_text()} "
+            "restricted to each set",
+        ]
+        if self.symbolic:
+            lines.append(
+                "κ* is not computed for symbolic gains (the verdicts do not depend on them); "
+                "classify one set with symbolic gains for κ* as an expression"
+            )
+        lines += ["", f"{'sensors':<24} {'verdict':<13} {'best':<7} κ*"]
+        for s in self.subsets:
+            sensors = ",".join(map(str, s.sensors))
+            lines.append(f"{sensors:<24} {s.verdict:<13} {s.best or '—':<7} {self._kappa(s)}")
+        return "\n".join([*lines, "", *self._minimal_lines()])
+
+    def __repr__(self) -> str:
+        minimal = [list(s) for s in self.minimal.get("exponential", ())]
+        text = (
+            f"SensorSearch(model={self.model!r}, sets={len(self.subsets)}, "
+            f"gains={shorten(self._gain_text(), 80)!r}, "
+            f"minimal_exponential={shorten(str(minimal), 120)})"
+        )
+        return shorten(text, REPR_LIMIT)
+
+    def _repr_html_(self) -> str:
+        rows = [
+            [",".join(map(str, s.sensors)), s.verdict, s.best or "—", self._kappa(s)]
+            for s in self.subsets
+        ]
+        return html_table(
+            ["sensors", "verdict", "best", "κ*"],
+            rows,
+            caption=f"{self.model}: every sensor set, gains L = {self._gain_text()}",
+            footer="; ".join(self._minimal_lines()),
+        )
 
 
 def _partition_suffix(c: Candidate) -> str:
@@ -189,36 +276,21 @@ def _partition_suffix(c: Candidate) -> str:
     return f" x1={list(c.partition.x1)}"
 
 
-@lru_cache(maxsize=32)
 def candidates(model: BCPHS) -> tuple[Candidate, ...]:
     """Return every applicable (variant, partition) of ``model`` with its minimal sensor set."""
-    order, size = model.order, model.size
-    nn = order * size
-    U, Y = port_matrices(model)
-    T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
+    require_model(model)
+    nn = model.order * model.size
+    T_inv = port_inverse(model)
     external = external_indices(nn, model.feedback)
     support = [{i for i in range(2 * nn) if not vanishes(T_inv[i, nn + j])} for j in external]
     undamped = _undamped_directions(model, T_inv)
-    partitions: tuple[Partition | None, ...] = (None,)
     found: list[Candidate] = []
-    assumption = None
-    if order == 2:
-        assumption = check_assumption(model.P[1], model.P[2], model.H, model.parameter_defaults)
-    for variant in VARIANTS:
-        if not variant.applicable_order(order):
-            continue
-        if variant.needs_partition:
-            if assumption is None or not assumption.holds:
-                continue
-            partitions = assumption.partitions
-        else:
-            partitions = (None,)
-        for partition in partitions:
-            blocks = None if partition is None else (partition.x1, partition.x2)
-            selected = variant.indices(order, size, blocks)
-            required = tuple(j + 1 for j in range(len(external)) if support[j] & set(selected))
-            attainable = not any(set(selected) & s for s in undamped)
-            found.append(Candidate(variant, partition, selected, required, attainable))
+    for entry in variant_cases(model.order, model.size, model_assumption(model)):
+        for case in entry.cases:
+            selected = set(case.selected)
+            required = tuple(j + 1 for j in range(len(external)) if support[j] & selected)
+            attainable = not any(selected & s for s in undamped)
+            found.append(Candidate(case, required, attainable))
     return tuple(found)
 
 
@@ -246,27 +318,15 @@ def _undamped_directions(model: BCPHS, T_inv: sympy.MatrixBase) -> list[set[int]
 
 def _gain_vector(gain: Any, nn: int) -> tuple[sympy.Expr, ...] | None:
     """Diagonal gain per output; ``None`` for symbolic gains (constants not computed)."""
-    if gain is None:
-        return (sympy.Integer(1),) * nn
-    if isinstance(gain, str):
-        text = gain.strip()
-        if text == "symbolic":
-            return None
-        if text.startswith("["):
-            raise ObserverError(
-                "--all-sensors takes diagonal gains ('0.5' or one value per output); "
-                f"found a full matrix {text!r}"
-            )
-        gain = [p.strip() for p in text.split(",")]
-    values = list(gain) if isinstance(gain, Sequence) else [gain]
-    exact = diagonal_values(values, nn, "one per output")
-    for i, value in enumerate(exact):
-        if not value.is_positive:
-            raise ObserverError(
-                f"--gain: diagonal gain of output {i + 1} must be > 0 so that L + Lᵀ > 0; "
-                f"found {value}"
-            )
-    return tuple(exact)
+    if isinstance(gain, str) and gain.strip() == "symbolic":
+        return None
+    L = gain_matrix(1 if gain is None else gain, nn, per="output")
+    if any(L[i, j] != 0 for i in range(nn) for j in range(nn) if i != j):
+        raise ObserverError(
+            "gain: the sensor search takes diagonal gains (one number, or one per output); "
+            f"found the full matrix {matrix_text(L)}"
+        )
+    return tuple(L[j, j] for j in range(nn))
 
 
 def search_sensors(
@@ -280,10 +340,11 @@ def search_sensors(
     ----------
     model : BCPHS
         The plant.
-    gain : None, str or sequence of numbers
-        Diagonal gains: ``None`` (identity), one value for every output, or one per
-        output (``"0.5,1,1,2"``); ``"symbolic"`` skips the constants (the verdicts do
-        not depend on the gain).
+    gain : None, number, sequence of numbers, diagonal matrix or "symbolic"
+        Diagonal gains: ``None`` (identity), one number for every output, or one per
+        output (``[0.5, 1, 1, 2]``, a numpy array); a subset uses the entries of the
+        outputs it measures.  ``"symbolic"`` skips the constants (the verdicts do not
+        depend on the gain).
     progress : callable(done, total), optional
         Called as the subsets are processed, when there are more than
         :data:`PROGRESS_THRESHOLD` of them.
@@ -292,13 +353,15 @@ def search_sensors(
     -------
     SensorSearch
     """
+    require_model(model)
+    if progress is not None and not callable(progress):
+        raise ObserverError(f"progress must be callable(done, total); found {progress!r}")
     order, size = model.order, model.size
     nn = model.n_ports
     gains = _gain_vector(gain, nn)
     cands = candidates(model)
     total = 2**nn - 1
     required = [sum(1 << (j - 1) for j in c.required) for c in cands]
-    exponential = [c.variant.convergence == "exponential" for c in cands]
     # decision: exact and combinatorial (module docstring)
     holds = [
         [required[c] & ~mask == 0 and cands[c].attainable for c in range(len(cands))]
@@ -311,45 +374,42 @@ def search_sensors(
         ]
         kappas = _kappas if model.feedback is None else _kappas_with_plant_feedback
         kappa = kappas(model, gains, cands, jobs, progress, total)
-    names = ("exponential", "asymptotic", "inconclusive")
-    verdict_code = [2] * (total + 1)
+    verdict_code = [VERDICTS.index("inconclusive")] * (total + 1)
     results = []
     for mask in sorted(range(1, total + 1), key=lambda m: (bin(m).count("1"), _members(m))):
         holding = [c for c in range(len(cands)) if holds[mask][c]]
-        if any(exponential[c] for c in holding):
-            verdict_code[mask] = 0
-        elif holding:
-            verdict_code[mask] = 1
+        verdict = verdict_of(cands[c].convergence for c in holding)
+        verdict_code[mask] = VERDICTS.index(verdict)
         best = None
         if holding:
 
-            def strength(c: int, mask: int = mask) -> tuple[int, float]:
-                if (mask, c) not in kappa:
-                    return int(exponential[c]), -1.0  # symbolic gains: no constant
-                value = kappa[mask, c]
-                return int(exponential[c]), float("inf") if value is None else value
+            def key(c: int, mask: int = mask) -> tuple[int, float]:
+                value = kappa.get((mask, c))
+                unbounded = (mask, c) in kappa and value is None
+                return strength(cands[c].convergence, value, unbounded)
 
-            best = max(holding, key=strength)
+            best = max(holding, key=key)
         value = None if best is None else kappa.get((mask, best))
+        partition = None if best is None else cands[best].partition
         results.append(
             SubsetResult(
                 sensors=_members(mask),
-                verdict=names[verdict_code[mask]],
+                verdict=verdict,
                 best=None if best is None else cands[best].name,
                 kappa=value,
                 unbounded=best is not None and (mask, best) in kappa and value is None,
                 holding=tuple(dict.fromkeys(cands[c].name for c in holding)),
-                partition=None
-                if best is None or cands[best].partition is None
-                else (cands[best].partition.x1, cands[best].partition.x2),  # type: ignore[union-attr]
+                partition=None if partition is None else (partition.x1, partition.x2),
             )
         )
-    minimal = _minimal_sets(verdict_code, names, nn)
+    minimal = _minimal_sets(verdict_code, VERDICTS, nn)
     return SensorSearch(
         model=model.name,
         order=order,
         size=size,
-        gains=tuple("symbolic" for _ in range(nn)) if gains is None else tuple(map(str, gains)),
+        gains=tuple("symbolic" for _ in range(nn))
+        if gains is None
+        else tuple(number_text(g) for g in gains),
         candidates=cands,
         subsets=tuple(results),
         minimal=minimal,
@@ -376,8 +436,7 @@ def _kappas(
     its exact zero pattern decides "unbounded" (RHS vanishes on K) without a tolerance.
     """
     nn = model.order * model.size
-    U, Y = port_matrices(model)
-    T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
+    T_inv = port_inverse(model)
     exact_columns = [
         [-gains[j] * T_inv[i, j] + T_inv[i, nn + j] for j in range(nn)] for i in range(2 * nn)
     ]
@@ -387,7 +446,7 @@ def _kappas(
     out: dict[tuple[int, int], float | None] = {}
     todo: list[tuple[int, int, list[int], list[int]]] = []
     for mask, c in jobs:
-        rows = list(cands[c].selected)
+        rows = list(cands[c].case.selected)
         pick = [j for j in range(nn) if mask >> j & 1]
         if not any(nonzero[i][j] for i in rows for j in pick):
             out[mask, c] = None
@@ -409,7 +468,7 @@ def _kappas(
         by_shape.setdefault((job[1], len(job[3])), []).append(job)
     done = 0
     for (c, _q), group in sorted(by_shape.items(), key=lambda item: item[0][1]):
-        selected = np.array(cands[c].selected)
+        selected = np.array(cands[c].case.selected)
         picks = np.array([job[3] for job in group])
         M = cols[selected][:, picks].transpose(1, 0, 2)  # (subsets, |S|, q)
         top = np.linalg.eigvalsh(np.einsum("kia,kib->kab", M, M))[:, -1]
@@ -431,7 +490,7 @@ def _kappas_with_plant_feedback(
 ) -> dict[tuple[int, int], float | None]:
     """κ* per (subset mask, candidate) through each subset's error system (module docstring)."""
     from phdesign.symbolic.certificate import certify
-    from phdesign.symbolic.observer import error_system, sensor_matrix
+    from phdesign.symbolic.observer import error_system, port_matrices, sensor_matrix
 
     U, Y = port_matrices(model)
     feedback = plant_feedback(model)
@@ -443,7 +502,7 @@ def _kappas_with_plant_feedback(
             L = sympy.diag(*[gains[j - 1] for j in pick])
             C_m = sensor_matrix(pick, model.n_ports)
             systems[mask] = error_system(model.order, model.size, U, Y, C_m, L, feedback)
-        cert = certify(systems[mask], cands[c].selected, "float")
+        cert = certify(systems[mask], cands[c].case.selected, "float")
         out[mask, c] = None if cert.unbounded else cert.kappa_float
         if progress is not None and total > PROGRESS_THRESHOLD:
             progress(round(total * done / len(jobs)), total)

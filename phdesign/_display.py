@@ -1,0 +1,141 @@
+r"""How results show themselves: numbers, matrices, sensors and small HTML tables.
+
+One formatter per kind of value, shared by every result object (its ``__str__``, which is
+the text the command line prints, its ``__repr__`` and its ``_repr_html_``), so that the
+same number reads the same everywhere: a constant :math:`\\kappa^*` is printed with six
+significant digits wherever it appears, an exact gain entry as the decimal the user wrote
+(``0.1``, not ``1/10``) when it has one.  Standard library only: sympy values are read
+through their attributes, never imported here.
+
+Examples
+--------
+>>> from fractions import Fraction
+>>> number_text(Fraction(1, 10)), number_text(Fraction(1, 3)), number_text(0.4000000000000001)
+('0.1', '1/3', '0.4')
+>>> html_table(["a", "b"], [[1, "<x>"]])
+'<table><thead><tr><th>a</th><th>b</th></tr></thead><tbody><tr><td>1</td><td>&lt;x&gt;</td></tr></tbody></table>'
+"""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+__all__ = [
+    "REPR_LIMIT",
+    "html_table",
+    "kappa_text",
+    "matrix_text",
+    "number_text",
+    "sensors_text",
+    "shorten",
+]
+
+#: Longest ``repr`` of a result object.
+REPR_LIMIT = 300
+
+
+def _fraction(x: Any) -> tuple[int, int] | None:
+    """``(numerator, denominator)`` of an exact rational (int, Fraction, sympy Rational)."""
+    if isinstance(x, bool):
+        return None
+    if isinstance(x, int):
+        return x, 1
+    p, q = getattr(x, "numerator", None), getattr(x, "denominator", None)
+    if getattr(x, "is_Rational", False):
+        p, q = x.p, x.q
+    if isinstance(p, int) and isinstance(q, int) and not isinstance(x, float):
+        return p, q
+    return None
+
+
+def number_text(x: Any) -> str:
+    """Return a number as a person writes it.
+
+    Integers as integers; exact rationals as their decimal when it terminates within 20
+    digits (``1/10`` is ``0.1``, a float read exactly shows as written), else as a
+    fraction; floats with six significant digits;
+    anything else (an expression of symbolic gains) as sympy prints it.
+    """
+    exact = _fraction(x)
+    if exact is not None:
+        p, q = exact
+        if q == 1:
+            return str(p)
+        rest = q
+        for prime in (2, 5):
+            while rest % prime == 0:
+                rest //= prime
+        if rest == 1:
+            digits = 0
+            while (p * 10**digits) % q:
+                digits += 1
+            if digits <= 20:
+                sign = "-" if p < 0 else ""
+                whole, frac = divmod(abs(p) * 10**digits // q, 10**digits)
+                return f"{sign}{whole}.{str(frac).rjust(digits, '0')}"
+        return f"{p}/{q}"
+    if isinstance(x, float) or getattr(x, "is_Float", False):
+        return f"{float(x):.6g}"
+    return str(x)
+
+
+def kappa_text(exact: Any, value: float | None, unbounded: bool = False) -> str:
+    r"""Return :math:`\kappa^*` as text: ``unbounded``, six digits, or the expression."""
+    if unbounded:
+        return "unbounded"
+    if value is not None:
+        return f"{value:.6g}"
+    if exact is None:
+        return "—"
+    return number_text(exact)
+
+
+def matrix_text(M: Any) -> str:
+    """Return a small matrix as text: ``diag(0.1, 1)`` when diagonal, else its rows."""
+    rows = [list(r) for r in (M.tolist() if hasattr(M, "tolist") else M)]
+    square = all(len(r) == len(rows) for r in rows)
+    if square and all(
+        rows[i][j] == 0 for i in range(len(rows)) for j in range(len(rows)) if i != j
+    ):
+        return f"diag({', '.join(number_text(rows[i][i]) for i in range(len(rows)))})"
+    return "[" + ", ".join("[" + ", ".join(number_text(x) for x in r) + "]" for r in rows) + "]"
+
+
+def sensors_text(C_m: Any) -> str:
+    """Return the measurements ``C_m y`` as text: ``y3, y4``, or ``0.5·y3 + y4``."""
+    parts = []
+    for row in C_m.tolist() if hasattr(C_m, "tolist") else C_m:
+        terms = []
+        for j, c in enumerate(row):
+            if c == 0:
+                continue
+            name = f"y{j + 1}"
+            terms.append(name if c == 1 else f"-{name}" if c == -1 else f"{number_text(c)}·{name}")
+        parts.append(" + ".join(terms).replace("+ -", "- "))
+    return ", ".join(parts)
+
+
+def shorten(text: str, limit: int) -> str:
+    """Cut ``text`` to ``limit`` characters, marking the cut with an ellipsis."""
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def html_table(
+    headers: Sequence[str],
+    rows: Iterable[Sequence[Any]],
+    caption: str | None = None,
+    footer: str | None = None,
+) -> str:
+    """Return a small HTML table (escaped), for the ``_repr_html_`` of result objects."""
+    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows
+    )
+    out = f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    if caption:
+        out = f"<p><b>{html.escape(caption)}</b></p>" + out
+    if footer:
+        out += f"<p>{html.escape(footer)}</p>"
+    return out

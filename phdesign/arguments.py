@@ -1,0 +1,104 @@
+"""Checkers for the arguments of phdesign's public functions (standard library only).
+
+Every public function checks what it is given before any work and raises phdesign's
+errors (:mod:`phdesign.errors`) naming the argument, with what was expected against what
+was found: a wrong kind of argument is an :class:`~phdesign.errors.ArgumentError` (a
+:class:`TypeError`), a bad value one of the domain errors (a :class:`ValueError`).  The
+checkers import nothing heavy, so any layer may use them.
+
+Examples
+--------
+>>> positive_int(3, "count")
+3
+>>> positive_int(2.5, "samples")
+Traceback (most recent call last):
+...
+phdesign.errors.NumericError: samples must be a positive integer; found 2.5
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from collections.abc import Sequence
+
+from phdesign.errors import ArgumentError, NumericError, PhdesignError
+
+__all__ = [
+    "choice",
+    "positive_int",
+    "positive_number",
+    "require_model",
+    "require_numeric_model",
+]
+
+
+def _found(value: object) -> str:
+    text = repr(value)
+    if len(text) > 60:
+        text = text[:57] + "..."
+    return f"{type(value).__name__} {text}"
+
+
+def require_model(value: object, name: str = "model") -> None:
+    """Raise :class:`ArgumentError` unless ``value`` is a :class:`~phdesign.BCPHS`."""
+    from phdesign.symbolic.model import BCPHS
+
+    if not isinstance(value, BCPHS):
+        hint = ""
+        if isinstance(value, str):
+            hint = f" (phdesign.load({value!r}) reads a built-in model or a TOML file)"
+        raise ArgumentError(f"{name}: expected a BCPHS model{hint}; found {_found(value)}")
+
+
+def require_numeric_model(value: object, name: str = "nm") -> None:
+    """Raise :class:`ArgumentError` unless ``value`` is a numeric model (the bridge's output)."""
+    from phdesign.numeric.bridge import NumericModel
+
+    if not isinstance(value, NumericModel):
+        hint = ""
+        if isinstance(value, str) or type(value).__name__ == "BCPHS":
+            hint = " (phdesign.numeric.bridge.to_numeric(model) makes one from a model)"
+        raise ArgumentError(f"{name}: expected a NumericModel{hint}; found {_found(value)}")
+
+
+def positive_int(
+    value: object, name: str, error: type[PhdesignError] = NumericError, minimum: int = 1
+) -> int:
+    """Return ``value`` as an int if it is an integer ``>= minimum``, else raise ``error``."""
+    if isinstance(value, bool | float | complex | str):
+        number = None
+    else:
+        try:
+            number = operator.index(value)  # type: ignore[arg-type]
+        except TypeError:
+            number = None
+    if number is None or number < minimum:
+        what = "a positive integer" if minimum == 1 else f"an integer >= {minimum}"
+        raise error(f"{name} must be {what}; found {value!r}")
+    return number
+
+
+def positive_number(value: object, name: str, error: type[PhdesignError] = NumericError) -> float:
+    """Return ``value`` as a float if it is a finite number > 0, else raise ``error``."""
+    number: float | None
+    if isinstance(value, bool | str | complex):
+        number = None
+    else:
+        try:
+            number = float(value)  # type: ignore[arg-type]
+        except (TypeError, ValueError, OverflowError):
+            number = None
+    if number is None or not math.isfinite(number) or number <= 0:
+        raise error(f"{name} must be a finite positive number; found {value!r}")
+    return number
+
+
+def choice(
+    value: object, name: str, options: Sequence[str], error: type[PhdesignError] = NumericError
+) -> str:
+    """Return ``value`` if it is one of ``options``, else raise ``error`` listing them."""
+    if not isinstance(value, str) or value not in options:
+        listed = ", ".join(repr(o) for o in options)
+        raise error(f"{name} must be one of {listed}; found {value!r}")
+    return value

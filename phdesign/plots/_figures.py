@@ -1,0 +1,170 @@
+"""Figures, axes, labels and legends shared by the plots (matplotlib imported lazily).
+
+New figures are plain :class:`~matplotlib.figure.Figure` objects on an Agg canvas, never
+pyplot's: no display, no global state, safe in scripts, servers and tests.  In a Jupyter
+kernel a figure is shown when it is the value of a cell (or passed to ``display``), once:
+pyplot does not manage it, so the inline backend does not show it a second time at the
+end of the cell (this module registers the PNG formatter for figures when the kernel has
+none).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from phdesign.errors import NumericError
+from phdesign.symbolic.units import with_unit
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+RE_LABEL = "Re λ [1/s]"
+IM_LABEL = "Im λ [rad/s]"
+ABSCISSA_LABEL = "spectral abscissa α [1/s]"
+
+#: The paper's colours: plant solid blue, observer dashed orange, error solid red.
+PLANT_COLOR, OBSERVER_COLOR, ERROR_COLOR = "tab:blue", "tab:orange", "tab:red"
+#: Design colours of the paper's Fig. 5 (yellow, orange, violet), then matplotlib's cycle.
+DESIGN_COLORS = ("goldenrod", "tab:orange", "tab:purple", "tab:green", "tab:brown", "tab:cyan")
+
+#: Units assumed for a result that states none (built by hand; the built-in models are SI).
+#: A model's own ``[units]`` section, carried by ``SimulationResult.units``, wins; a
+#: quantity the model leaves without a unit gets a plain label.
+SI_UNITS = {"t": "s", "z": "m", "energy": "J", "displacement": "m"}
+
+
+def unit_label(result: Any, text: str, quantity: str) -> str:
+    """``text [unit]`` with the unit of ``quantity`` that ``result``'s model states."""
+    units = getattr(result, "units", None)
+    return with_unit(text, SI_UNITS if units is None else units, quantity)
+
+
+def _jupyter_shell() -> Any:
+    """Return the Jupyter kernel's shell, or ``None`` (not merely IPython imported)."""
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    return shell if type(shell).__name__ == "ZMQInteractiveShell" else None
+
+
+def _register_png_formatter(shell: Any) -> None:
+    """Let the kernel show a figure that is a cell's value (what ``%matplotlib inline`` does)."""
+    from matplotlib.figure import Figure
+
+    formatter = shell.display_formatter.formatters["image/png"]
+    try:
+        formatter.lookup_by_type(Figure)
+    except KeyError:
+        from IPython.core.pylabtools import print_figure
+
+        formatter.for_type(Figure, lambda fig: print_figure(fig, "png"))
+
+
+def new_figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
+    """Return ``(fig, axes)`` as ``pyplot.subplots`` does, to compose panels.
+
+    The figure lives on an Agg canvas (no display, no pyplot state); in Jupyter it shows
+    as the value of a cell.  Keyword arguments go to the figure (``figsize``, ``dpi``); the
+    layout is constrained.
+
+    Examples
+    --------
+    >>> from phdesign.plots import plot_spectrum
+    >>> fig, axes = new_figure(1, 2, figsize=(8, 3))
+    >>> plot_spectrum(np.array([-1.0 + 1j]), ax=axes[0]) is fig
+    True
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    shell = _jupyter_shell()
+    if shell is not None:
+        _register_png_formatter(shell)
+    fig = Figure(layout="constrained", **kwargs)
+    FigureCanvasAgg(fig)  # explicit Agg: never needs a display
+    axes = fig.subplots(nrows, ncols, squeeze=True)
+    return fig, axes
+
+
+def figure_of(ax: Axes) -> Figure:
+    """Return the top-level figure an Axes belongs to (through any subfigures)."""
+    from matplotlib.figure import Figure
+
+    fig: Any = ax.get_figure()
+    while fig is not None and not isinstance(fig, Figure):
+        fig = fig.get_figure()
+    if fig is None:
+        raise NumericError("the given Axes belongs to no figure")
+    return fig
+
+
+def axes_or_new(ax: Axes | None, **kwargs: Any) -> tuple[Figure, Axes]:
+    """Return the figure of ``ax`` and ``ax``, or a new figure with one Axes."""
+    if ax is not None:
+        return figure_of(ax), ax
+    fig, new = new_figure(**kwargs)
+    return fig, new
+
+
+def require(result: Any, name: str, why: str) -> np.ndarray:
+    """Return the array ``result.name``; raise :class:`NumericError` saying why it is missing."""
+    value = getattr(result, name, None)
+    if value is None:
+        raise NumericError(f"the simulation result has no {name!r}: {why}")
+    return np.asarray(value, dtype=float)
+
+
+def labelled_results(
+    results: Mapping[str, Any] | Sequence[tuple[str, Any]],
+) -> list[tuple[str, Any]]:
+    """``(label, result)`` pairs from a mapping or a sequence; at least one."""
+    items = list(results.items()) if isinstance(results, Mapping) else list(results)
+    if not items:
+        raise NumericError("expected at least one (label, simulation result) pair; found none")
+    return [(str(label), res) for label, res in items]
+
+
+def tip_label(result: Any) -> str:
+    """Where the tip displacement is taken: ``z = 1``."""
+    z = getattr(result, "z_w", None)
+    return "z = b" if z is None or len(z) == 0 else f"z = {float(np.asarray(z)[-1]):g}"
+
+
+def plain_numbers(ax: Axes) -> None:
+    """Tick labels without an offset (a conserved energy reads 0.25, not 1e-13 + 2.5e-1)."""
+    formatter = ax.yaxis.get_major_formatter()
+    if hasattr(formatter, "set_useOffset"):
+        formatter.set_useOffset(False)
+
+
+def legend_in_view(ax: Axes, *, outside: bool = False, **kwargs: Any) -> None:
+    """Draw a legend listing only what is drawn inside the current view.
+
+    A marker series none of whose points lie inside the axes limits is left out (an
+    "unresolved" entry for eigenvalues far outside the window would list nothing drawn).
+    ``outside`` puts the legend below the axes, where it covers no point.
+    """
+    (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
+    handles, labels = [], []
+    for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+        data = getattr(handle, "get_data", None)
+        if data is not None and getattr(handle, "get_linestyle", str)() in (
+            "None",
+            "none",
+            " ",
+            "",
+        ):
+            x, y = (np.asarray(v, dtype=float) for v in data())
+            if not np.any((x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)):
+                continue
+        handles.append(handle)
+        labels.append(label)
+    if not handles:
+        return
+    if outside:
+        kwargs = {"loc": "upper center", "bbox_to_anchor": (0.5, -0.15), "ncols": 2, **kwargs}
+    ax.legend(handles, labels, **kwargs)

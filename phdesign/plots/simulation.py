@@ -1,0 +1,149 @@
+"""The summary figure of one simulation (``simulate --plot``) and the check of its path."""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from phdesign.errors import OutputFileError
+from phdesign.plots._figures import (
+    DESIGN_COLORS,
+    legend_in_view,
+    new_figure,
+    require,
+    unit_label,
+)
+from phdesign.plots.deflection import plot_deflection, plot_outputs, plot_tip
+from phdesign.plots.energy import plot_hamiltonians
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["check_plot_path", "plot_simulation"]
+
+
+def check_plot_path(path: str | os.PathLike[str], force: bool = False) -> str:
+    """Check an output image path before any work is done; return its format.
+
+    The format is the file suffix (``png``, ``pdf``, ``svg``, ...).
+
+    Raises
+    ------
+    OutputFileError
+        The file exists and ``force`` is false, or the suffix is not an image format
+        matplotlib can write.
+
+    Examples
+    --------
+    >>> check_plot_path("beam.PNG")
+    'png'
+    """
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    target = Path(path)
+    fmt = target.suffix.lstrip(".").lower()
+    supported = FigureCanvasBase.get_supported_filetypes()
+    if fmt not in supported:
+        raise OutputFileError(
+            f"plot file {str(target)!r}: unknown image format {fmt!r}; expected a suffix "
+            f"among {', '.join('.' + s for s in sorted(supported))}"
+        )
+    from phdesign.io import check_output_path  # lazily: io imports sympy
+
+    check_output_path(target, force)
+    return fmt
+
+
+def plot_simulation(
+    result: Any,
+    path: str | os.PathLike[str] | None = None,
+    *,
+    force: bool = False,
+    title: str | None = None,
+) -> Figure:
+    r"""Summary figure of one simulation, written to ``path`` (used by ``simulate --plot``).
+
+    Top row: :func:`plot_hamiltonians`.  Bottom row, when the model has a displacement:
+    the end-tip overlay (:func:`plot_tip`) and the heat map of the estimation error
+    :math:`w - \hat w` (of :math:`w` without an observer); otherwise the outputs
+    :math:`y` and :math:`\hat y` (:func:`plot_outputs`) and the output error
+    :math:`|y - \hat y|` on a log scale.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    path : path-like, optional
+        Output file; its suffix picks the format (``.png``, ``.pdf``, ``.svg``, ...).
+        Written atomically.
+    force : bool
+        Overwrite an existing file.
+    title : str, optional
+        Figure title (default: the result's ``title``: model, sensors and gain).
+
+    Returns
+    -------
+    Figure
+
+    Raises
+    ------
+    OutputFileError
+        The file exists (without ``force``), its format is unknown, or it cannot be written.
+    """
+    fmt = None if path is None else check_plot_path(path, force=force)
+    has_w = getattr(result, "w", None) is not None
+    fig, axes = new_figure(2, 2, figsize=(11, 7.5))
+    plot_hamiltonians(result, axes[0])
+    if has_w:
+        plot_tip(result, axes[1, 0])
+        which = "error" if getattr(result, "w_hat", None) is not None else "w"
+        plot_deflection(result, which, axes[1, 1])
+    else:
+        measured = _measured_outputs(result)
+        plot_outputs(result, axes[1, 0], outputs=measured)
+        _plot_output_error(result, axes[1, 1], measured)
+    if title is None:
+        title = getattr(result, "title", None)
+    if title:
+        fig.suptitle(title)
+    if path is not None:
+        from phdesign.io import atomic_write
+
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format=fmt, dpi=110)
+        atomic_write(path, buffer.getvalue(), force=force)
+    return fig
+
+
+def _measured_outputs(result: Any) -> list[int] | None:
+    """Return the measured outputs named by the run's sensors (``"y3, y4"``), else all."""
+    sensors = getattr(result, "info", {}).get("sensors", "")
+    picked = sorted({int(j) for j in re.findall(r"y(\d+)", str(sensors))})
+    return picked or None
+
+
+def _plot_output_error(result: Any, ax: Axes, outputs: list[int] | None) -> None:
+    t = require(result, "t", "no time grid")
+    y = require(result, "y", "no outputs")
+    y_hat = getattr(result, "y_hat", None)
+    if y_hat is None:
+        ax.set_axis_off()
+        ax.text(0.5, 0.5, "no observer: outputs only", ha="center", va="center")
+        return
+    picked = list(range(1, y.shape[1] + 1)) if outputs is None else outputs
+    error = np.abs(y - np.asarray(y_hat, dtype=float))
+    for k, j in enumerate(picked):
+        values = np.where(error[:, j - 1] > 0, error[:, j - 1], np.nan)
+        ax.semilogy(t, values, color=DESIGN_COLORS[k % len(DESIGN_COLORS)], label=f"|y{j} − ŷ{j}|")
+    ax.set(
+        xlabel=unit_label(result, "time t", "t"),
+        ylabel="output error, log scale",
+        title="output error",
+    )
+    ax.grid(True, which="both", alpha=0.3)
+    legend_in_view(ax, fontsize="small")
