@@ -123,6 +123,8 @@ class Abscissa:
         part.
     attained : float or None
         Largest real part attained by a counted eigenvalue.
+    attained_uncertainty : float or None
+        Its accuracy, before any widening by a rising trend.
     counted : ndarray of bool
         The eigenvalues that count (rules 1 and 2).
     converged_mask : ndarray of bool
@@ -141,6 +143,7 @@ class Abscissa:
     kind: Literal["attained", "limit", "extinct", "none"]
     index: int | None
     attained: float | None
+    attained_uncertainty: float | None
     counted: np.ndarray
     converged_mask: np.ndarray
     loose_right: np.ndarray
@@ -228,7 +231,7 @@ def estimate_abscissa(pair: PairSpectrum, tol: float) -> Abscissa:
     cand = pair.candidates
     if not cand.any():
         empty: Literal["extinct", "none"] = "extinct" if looks_empty(pair) else "none"
-        return Abscissa(None, None, empty, None, None, none, none, none, 0, None)
+        return Abscissa(None, None, empty, None, None, None, none, none, none, 0, None)
     re = lam.real
     u = pair.uncertainty
     converged = pair.resolved & (u <= tol * np.maximum(s, np.abs(re)))
@@ -263,6 +266,7 @@ def estimate_abscissa(pair: PairSpectrum, tol: float) -> Abscissa:
         kind=kind,
         index=index,
         attained=attained,
+        attained_uncertainty=u_att,
         counted=counted,
         converged_mask=converged,
         loose_right=loose_right,

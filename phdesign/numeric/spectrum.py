@@ -16,13 +16,16 @@ to the problem's own rate s, whatever its units) in three stages:
    * the real parts do not keep rising with frequency (else the abscissa is a limit that
      no mode attains, which no pair "converges" to).
 
-   It also stops when the abscissa got less accurate at each of the last two refinements
-   (round-off, not resolution, limits it: an ill-conditioned coalescence).
+   It also stops when refinement no longer helps an ill-conditioned abscissa (round-off,
+   not resolution, limits it at a coalescence), and when the
+   last two pairs extrapolate the same high-frequency limit within their uncertainties.
 
 2. **Choice of the pair** (:func:`choose_pair`): the converged pair, else the pair whose
-   abscissa is the most accurate; an earlier pair whose converged abscissa lies clearly
-   right of the chosen one wins (round-off at high degree can make a true eigenvalue
-   fail the drift test at a finer pair).
+   abscissa is the most accurate among those no finer pair contradicts (a finer pair
+   that attains a real part clearly right of a coarser pair's abscissa supersedes it:
+   its wider band saw modes the coarser one did not); an earlier pair whose resolved
+   abscissa lies clearly right of the chosen one wins (round-off at high degree can make
+   a true eigenvalue fail the drift test at a finer pair).
 
 3. **Warnings** (:func:`report_warnings`): not converged and why, a limit at high
    frequency, no exponential decay, ill-conditioned rightmost eigenvalues (energy-norm
@@ -181,6 +184,12 @@ def convergence_rule(pair: PairSpectrum, a: Abscissa, tol: float) -> str:
         return "the real parts keep rising with frequency (the abscissa is a limit)"
     if a.value is None or a.index is None or a.uncertainty is None:
         return "no eigenvalue is resolved"
+    if a.limit is not None and a.limit.value + a.limit.uncertainty > a.value:
+        return (
+            "the real parts rise with frequency at the top of the resolved band and may "
+            f"exceed the largest one attained (limit {a.limit.value:.6g} ± "
+            f"{a.limit.uncertainty:.2g})"
+        )
     if not a.converged_mask[a.index]:
         return (
             f"the rightmost eigenvalue agrees only to {a.uncertainty:.2g} between "
@@ -245,21 +254,49 @@ def refine(
         a = estimate_abscissa(pair, tol)
         reason = convergence_rule(pair, a, tol)
         trail.append(PairResult(pair, a, not reason, reason))
-        if not reason or p_fine >= stop or _degrading(trail):
+        if not reason or p_fine >= stop or _degrading(trail) or _limit_settled(trail):
             return trail, solver.scales
         p = p_fine
 
 
-def _degrading(trail: list[PairResult]) -> bool:
-    """Tell whether the abscissa lost accuracy at each of the last two refinements.
+def _limit_settled(trail: list[PairResult]) -> bool:
+    """Tell whether the last two pairs extrapolate the same high-frequency limit.
 
-    Finer pairs then only lose digits (an ill-conditioned coalescence, N >= 3 at high
-    degree); the refinement stops and the best pair is chosen.
+    A limit approached by no mode is never "converged"; once two pairs agree on it within
+    their uncertainties, finer pairs only cost time.
     """
-    if len(trail) < 3:
+    if len(trail) < 2 or not all(r.abscissa.kind == "limit" for r in trail[-2:]):
         return False
-    u = [r.relative_uncertainty for r in trail[-3:]]
-    return bool(math.isfinite(u[0]) and u[0] < u[1] < u[2])
+    (a, ua), (b, ub) = ((r.abscissa.value, r.abscissa.uncertainty) for r in trail[-2:])
+    if a is None or b is None or ua is None or ub is None:
+        return False
+    return abs(a - b) <= ua + ub
+
+
+def _degrading(trail: list[PairResult]) -> bool:
+    """Tell whether refinement stopped helping an ill-conditioned abscissa.
+
+    At an ill-conditioned coalescence the accuracy is set by round-off, not resolution
+    (finer pairs have larger norms and feed more round-off into the cluster): when the
+    last two pairs are both ill-conditioned at the abscissa and the finer one is not ten
+    times more accurate, the refinement stops and the best pair is chosen.  Resolution-
+    limited accuracy improves by far more than ten times per pair (spectral convergence);
+    a well-conditioned abscissa is left alone.
+    """
+    if len(trail) < 2 or not all(_ill_conditioned_at(r) for r in trail[-2:]):
+        return False
+    before, last = (r.relative_uncertainty for r in trail[-2:])
+    return bool(math.isfinite(before) and last > 0.1 * before)
+
+
+def _ill_conditioned_at(result: PairResult) -> bool:
+    """Tell whether the eigenvalue giving the pair's abscissa is clustered or ill-conditioned."""
+    a, pair = result.abscissa, result.pair
+    if a.index is None:
+        return False
+    kappa = pair.condition
+    cond = float(kappa[a.index]) if kappa is not None else 1.0
+    return bool(pair.clustered[a.index] or cond > ILL_CONDITION)
 
 
 def _lost_rightmost(trail: list[PairResult], chosen: PairResult) -> PairResult | None:
@@ -289,6 +326,25 @@ def _lost_rightmost(trail: list[PairResult], chosen: PairResult) -> PairResult |
     return right if value > a.value + margin else None
 
 
+def _superseded(result: PairResult, finer: list[PairResult]) -> bool:
+    """Tell whether a finer pair attains a real part clearly right of ``result``'s abscissa.
+
+    A wider resolved band can show modes above the coarser band whose real parts lie
+    further right (real parts rising with frequency): the coarser value is then wrong,
+    however well it agreed.
+    """
+    a = result.abscissa
+    if a.attained is None or a.attained_uncertainty is None:
+        return False
+    top = a.attained + a.attained_uncertainty
+    return any(
+        r.abscissa.attained is not None
+        and r.abscissa.attained_uncertainty is not None
+        and r.abscissa.attained - r.abscissa.attained_uncertainty > top
+        for r in finer
+    )
+
+
 def choose_pair(trail: list[PairResult]) -> tuple[PairResult, list[str]]:
     """Stage 2: the pair reported, and the warnings the choice itself raises."""
     last = trail[-1]
@@ -299,7 +355,8 @@ def choose_pair(trail: list[PairResult]) -> tuple[PairResult, list[str]]:
         valued = [r for r in trail if r.abscissa.value is not None]
         if not valued:
             return last, []
-        best = min(reversed(valued), key=lambda r: r.relative_uncertainty)
+        eligible = [r for i, r in enumerate(valued) if not _superseded(r, valued[i + 1 :])]
+        best = min(reversed(eligible), key=lambda r: r.relative_uncertainty)
         chosen = best
         if best is not valued[-1] and best.relative_uncertainty < valued[-1].relative_uncertainty:
             p, q = best.pair.resolutions

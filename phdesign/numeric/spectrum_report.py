@@ -257,6 +257,7 @@ class SpectrumReport:
         *,
         ax: Axes | None = None,
         exact: np.ndarray | None = None,
+        title: str | None = None,
         xlim: tuple[float, float] | None = None,
         ylim: tuple[float, float] | None = None,
     ) -> Figure:
@@ -283,7 +284,7 @@ class SpectrumReport:
             ax=ax,
             abscissa=self.spectral_abscissa,
             exact=exact,
-            title=f"{self.model}: {self.system}",
+            title=title if title is not None else f"{self.model}: {self.system}",
             xlim=xlim,
             ylim=ylim,
         )
