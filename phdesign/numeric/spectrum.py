@@ -175,6 +175,7 @@ class PairResult:
             kind=self.abscissa.kind,
             converged=self.converged,
             all_max_real=self.pair.all_max_real,
+            n_loose=int(np.count_nonzero(self.pair.clustered)),
         )
 
 

@@ -62,6 +62,9 @@ class RefinementStep:
         Whether the pair satisfies the convergence rule.
     all_max_real : float
         Max Re over every discrete eigenvalue of the finer resolution.
+    n_loose : int
+        Unresolved eigenvalues of the resolved band kept (members of a cluster or
+        ill-conditioned).
     """
 
     resolutions: tuple[int, int]
@@ -71,13 +74,16 @@ class RefinementStep:
     kind: str
     converged: bool
     all_max_real: float
+    n_loose: int = 0
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary."""
+        """JSON-ready dictionary (``abscissa_drift`` and ``n_loose`` as in earlier versions)."""
         return {
             "resolutions": list(self.resolutions),
             "n_resolved": self.n_resolved,
+            "n_loose": self.n_loose,
             "spectral_abscissa": finite_or_none(self.spectral_abscissa),
+            "abscissa_drift": finite_or_none(self.uncertainty),
             "uncertainty": finite_or_none(self.uncertainty),
             "kind": self.kind,
             "converged": self.converged,
