@@ -243,7 +243,8 @@ for ax, (name, g) in zip(axes7, designs.items(), strict=True):
 evaluator = AbscissaEvaluator(nm, C, (20, 30))
 l1_grid = np.logspace(-2.5, 0.0, 36)
 l2_grid = np.logspace(-1.5, 1.3, 36)
-alpha_map = np.array([[evaluator(np.diag([a, b])) for a in l1_grid] for b in l2_grid])
+gains = [np.diag([a, b]) for b in l2_grid for a in l1_grid]
+alpha_map = evaluator.abscissas(gains).reshape(l2_grid.size, l1_grid.size)
 j, i = np.unravel_index(np.argmin(alpha_map), alpha_map.shape)
 print(
     f"best grid point: (l1, l2) = ({l1_grid[i]:.3f}, {l2_grid[j]:.3f}), "

@@ -30,11 +30,14 @@ Examples
 (-0.5493061443, -0.5493061443)
 >>> ev.evaluations
 1
+>>> ev.abscissas([np.array([[k]]) for k in (0.25, 3.0)]).round(10).tolist()  # many gains
+[-0.2554128119, -0.3465735903]
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
 import numpy as np
 
@@ -45,6 +48,7 @@ from phdesign.numeric.discretize import discretize, feedback_matrix
 from phdesign.numeric.drift import CLUSTER, PairSpectrum, pair_spectrum
 from phdesign.numeric.eigen import PreparedSystem, prepare, rescaled
 from phdesign.numeric.scales import dimensionless_model
+from phdesign.numeric.threads import small_dense_threads
 
 __all__ = ["AbscissaEvaluator", "default_tolerances", "fine_resolution"]
 
@@ -162,6 +166,15 @@ class AbscissaEvaluator:
     def abscissa(self, L: np.ndarray | None = None) -> Abscissa:
         """Return the abscissa at gain L (:func:`phdesign.numeric.abscissa.estimate_abscissa`)."""
         return estimate_abscissa(self.pair(L), self.tol)
+
+    def abscissas(self, gains: Iterable[np.ndarray]) -> np.ndarray:
+        """Return the abscissas at many gains, on one BLAS thread (a gain map).
+
+        Entering the one-thread limit costs about a millisecond
+        (:mod:`phdesign.numeric.threads`), so many gains share one entry.
+        """
+        with small_dense_threads():
+            return np.array([self(L) for L in gains], dtype=float)
 
     def __call__(self, L: np.ndarray | None = None) -> float:
         """Return the abscissa as a number (``-inf``: empty spectrum, ``nan``: unresolved)."""

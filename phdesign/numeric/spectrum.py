@@ -17,7 +17,8 @@ to the problem's own rate s, whatever its units) in three stages:
      no mode attains, which no pair "converges" to).
 
    It also stops when refinement no longer helps an ill-conditioned abscissa (round-off,
-   not resolution, limits it at a coalescence), and when the
+   not resolution, limits it at a coalescence), when two pairs in a row show the evidence
+   of an empty spectrum, and when the
    last two pairs extrapolate the same high-frequency limit within their uncertainties.
 
 2. **Choice of the pair** (:func:`choose_pair`): the converged pair, else the pair whose
@@ -255,9 +256,15 @@ def refine(
         a = estimate_abscissa(pair, tol)
         reason = convergence_rule(pair, a, tol)
         trail.append(PairResult(pair, a, not reason, reason))
-        if not reason or p_fine >= stop or _degrading(trail) or _limit_settled(trail):
+        settled = _degrading(trail) or _limit_settled(trail) or _extinct(trail)
+        if not reason or p_fine >= stop or settled:
             return trail, solver.scales
         p = p_fine
+
+
+def _extinct(trail: list[PairResult]) -> bool:
+    """Tell whether the last two pairs (three resolutions) both show an empty spectrum."""
+    return len(trail) >= 2 and all(r.abscissa.kind == "extinct" for r in trail[-2:])
 
 
 def _limit_settled(trail: list[PairResult]) -> bool:
@@ -476,7 +483,7 @@ def _unresolved_report(
     gain: list[list[float]] | None,
 ) -> SpectrumReport:
     last = trail[-1]
-    extinct = len(trail) >= 2 and all(r.abscissa.kind == "extinct" for r in trail[-2:])
+    extinct = _extinct(trail)
     p, q = last.pair.resolutions
     if extinct:
         warning = (
