@@ -205,3 +205,22 @@ def test_tune_command_prints_the_result(capsys):
     assert "<table>" in res._repr_html_()
     assert main(["tune", "wave", "--sensors", "2", "--robust", "x%"]) == 2
     assert "--robust" in capsys.readouterr().err
+
+
+def test_blas_threads_are_limited_inside_and_restored_after():
+    # The numeric layer's small dense eigenproblems run on one BLAS thread (threadpoolctl);
+    # the caller's setting comes back afterwards, and nested blocks share the outer limit.
+    from threadpoolctl import threadpool_info
+
+    from phdesign.numeric.threads import small_dense_threads
+
+    def blas_threads():
+        return [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+
+    before = blas_threads()
+    with small_dense_threads():
+        assert set(blas_threads()) == {1}
+        with small_dense_threads():
+            assert set(blas_threads()) == {1}
+        assert set(blas_threads()) == {1}
+    assert blas_threads() == before

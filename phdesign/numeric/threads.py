@@ -16,19 +16,26 @@ libraries), so it wraps whole computations, never a single solve.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from functools import wraps
-from typing import ParamSpec, TypeVar
+from typing import Any, ParamSpec, TypeVar
 
 __all__ = ["limited_threads", "small_dense_threads"]
 
-_depth = 0  # nested entries reuse the outer limit instead of paying for a new one
+_lock = threading.Lock()
+_depth = 0  # blocks currently inside; the limit holds while any of them runs
+_limiter: Any = None  # the threadpoolctl limiter applied by the outermost block
 
 
 @contextmanager
 def small_dense_threads(enabled: bool = True) -> Iterator[None]:
     """Limit BLAS to one thread inside the block (nested blocks cost nothing).
+
+    The BLAS thread count is a property of the process, so the limit holds while any block
+    runs, in any thread (a sweep running spectra in a thread pool), and the previous
+    setting comes back when the last block ends.
 
     Parameters
     ----------
@@ -43,22 +50,21 @@ def small_dense_threads(enabled: bool = True) -> Iterator[None]:
     ...     float(np.linalg.eigvals(np.diag([1.0, -2.0])).min())
     -2.0
     """
-    global _depth
-    if not enabled or _depth:
-        _depth += 1
-        try:
-            yield
-        finally:
-            _depth -= 1
-        return
-    from threadpoolctl import threadpool_limits
+    global _depth, _limiter
+    with _lock:
+        if enabled and _depth == 0:
+            from threadpoolctl import threadpool_limits
 
-    _depth += 1
+            _limiter = threadpool_limits(limits=1, user_api="blas")
+        _depth += 1
     try:
-        with threadpool_limits(limits=1, user_api="blas"):
-            yield
+        yield
     finally:
-        _depth -= 1
+        with _lock:
+            _depth -= 1
+            if _depth == 0 and _limiter is not None:
+                _limiter.restore_original_limits()
+                _limiter = None
 
 
 P = ParamSpec("P")
