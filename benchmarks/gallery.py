@@ -20,32 +20,16 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import scipy.linalg as sl
 
 from phdesign import plots
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import initial_state_function, to_numeric
-from phdesign.numeric.discretize import discretize
+from phdesign.numeric.evaluator import AbscissaEvaluator
 from phdesign.numeric.simulate import simulate
-from phdesign.numeric.spectrum import match_resolved
 from phdesign.numeric.tune import tune
 
 MAX_BYTES = 200_000
 DESIGNS = {"design 1": (0.03, 0.3), "design 2": (0.1, 1.0), "design 3": (0.2, 2.0)}
-
-
-def band_abscissa(pair, gain) -> float:
-    """max Re over the eigenvalues inside the resolved frequency band (never drops one).
-
-    ``pair`` holds (E, J - R, B C_mᵀ) at two Galerkin degrees; an eigenvalue at the finer
-    degree is in the band when its modulus does not exceed that of the largest resolved one
-    (see :func:`phdesign.numeric.spectrum.match_resolved`).
-    """
-    L = np.diag(gain)
-    lams = [sl.eigvals(A0 - Bc @ L @ Bc.T, E) for E, A0, Bc in pair]
-    idx, _ = match_resolved(lams[1], lams[0], 1e-6)
-    band = np.max(np.abs(lams[1][idx]))
-    return float(np.max(lams[1][np.abs(lams[1]) <= band].real))
 
 
 def save(fig, path: Path) -> int:
@@ -86,13 +70,11 @@ def main(argv: list[str] | None = None) -> int:
     fig.suptitle("The paper's three designs: weakly, critically and over-damped (Figs. 5-6)")
     sizes["beam_designs.png"] = save(fig, out / "beam_designs.png")
 
-    pair = []
-    for p in (20, 30):
-        d = discretize(nm, "galerkin", p)
-        pair.append((d.E, d.J - d.R, d.B @ C.T))
+    # the abscissa of spectrum() at the pair (20, 30), prepared once for the 36 x 36 gains
+    evaluator = AbscissaEvaluator(nm, C, (20, 30))
     l1 = np.logspace(-2.5, 0.0, 36)
     l2 = np.logspace(-1.5, 1.3, 36)
-    alpha = np.array([[band_abscissa(pair, (a, b)) for a in l1] for b in l2])
+    alpha = evaluator.abscissas([np.diag([a, b]) for b in l2 for a in l1]).reshape(36, 36)
     tuned = tune(nm, C)
     g = (float(tuned.gain[0, 0]), float(tuned.gain[1, 1]))
     fig = plots.plot_gain_map(
@@ -100,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
         l2,
         alpha,
         optimum=g,
-        optimum_abscissa=band_abscissa(pair, g),
+        optimum_abscissa=tuned.spectral_abscissa,
         designs={k.split()[-1]: v for k, v in DESIGNS.items()},
     )
     sizes["beam_gain_map.png"] = save(fig, out / "beam_gain_map.png")

@@ -88,26 +88,15 @@ assert matched.unbounded_below
 # semi-discretization), which is why only resolved eigenvalues count.
 
 # %%
-from phdesign.numeric.discretize import discretize, feedback_matrix
-from phdesign.numeric.spectrum import eigen, match_resolved
-
 rep = spectrum(nm_wave, C2, np.array([[0.5]]))
 p, p_fine = rep.resolutions
-K = feedback_matrix(C2, np.array([[0.5]]), nm_wave.n_ports)
-coarse = eigen(discretize(nm_wave, "galerkin", p), K)[0]
-fine = eigen(discretize(nm_wave, "galerkin", p_fine), K)[0]
-idx, _ = match_resolved(fine, coarse, 1e-6)
-mask = np.zeros(fine.size, dtype=bool)
-mask[idx] = True
 m = np.arange(-12, 12)
 exact = exact_abscissa(0.5) + 1j * (m + 0.5) * np.pi
-fig = plots.plot_spectrum(
-    fine, mask, abscissa=rep.spectral_abscissa, exact=exact, xlim=(-1.5, 0.2), ylim=(-40, 40)
-)
+fig = rep.plot(exact=exact, xlim=(-1.5, 0.2), ylim=(-40, 40))
 fig
 
 # %%
-print(f"{mask.sum()} of {fine.size} eigenvalues resolved at degrees {p} and {p_fine}")
+print(f"{rep.n_resolved} of {rep.n_total} eigenvalues resolved at degrees {p} and {p_fine}")
 
 # %% [markdown]
 # ## Timoshenko beam: exponential against inconclusive designs

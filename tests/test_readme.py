@@ -68,11 +68,6 @@ RESULTS: dict[str, object] = {}
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="SpectrumReport and TuneResult print themselves in the spec branch (issue 11); "
-    "this test passes once it is merged: then remove this mark",
-)
 def test_readme_spectrum_and_tuning_reports_print_themselves():
     if not RESULTS:
         pytest.skip("runs after test_readme_api_block_runs_and_its_numbers_hold")

@@ -61,9 +61,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     add_observer_arguments(sp, required=True)
     _add_discretization(sp, "default: the first of the refinement pairs")
     sp.add_argument(
+        "--max-resolution",
+        type=int,
+        metavar="N",
+        help="largest resolution the refinement may reach (default: 100-110 for Galerkin)",
+    )
+    sp.add_argument(
         "--tol",
         type=float,
-        help="required agreement of the abscissa; default 1e-10 (galerkin), 1e-3 (fd)",
+        help="required accuracy of the abscissa, relative to the problem's rate "
+        "(default 1e-10 Galerkin, 1e-3 FD)",
     )
     sp.add_argument(
         "--count",
@@ -118,9 +125,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     add_model_argument(tn)
     add_observer_arguments(tn, gain=False)
     tn.add_argument("--full", action="store_true", help="full L instead of positive diagonal")
-    tn.add_argument("--starts", type=int, default=6, help="number of starts; default: %(default)s")
     tn.add_argument(
-        "--seed", type=int, default=0, help="seed of the random starts; default: %(default)s"
+        "--starts",
+        type=int,
+        default=2,
+        help="local searches, from the best points of the grid; default: %(default)s",
+    )
+    tn.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of the random grid (more than 625 points); default: %(default)s",
+    )
+    tn.add_argument(
+        "--robust",
+        metavar="PCT",
+        help="minimize the worst abscissa over a box of gains, e.g. '5%%' (or 0.05) for ±5 %%",
     )
     add_noise_tuning_arguments(tn)
     add_json_argument(tn)
@@ -156,28 +176,22 @@ def _spectrum(args: argparse.Namespace) -> int:
     _check_positive("--resolution", args.resolution)
     _check_positive("--tol", args.tol)
     _check_positive("--count", args.count)
-    model, nm, C_m, L = _numeric_setup(args, "spectrum")
+    _check_positive("--max-resolution", args.max_resolution)
+    _model, nm, C_m, L = _numeric_setup(args, "spectrum")
     rep = spectrum(
-        nm, C_m, L, method=args.method, resolution=args.resolution, tol=args.tol, count=args.count
+        nm,
+        C_m,
+        L,
+        method=args.method,
+        resolution=args.resolution,
+        max_resolution=args.max_resolution,
+        tol=args.tol,
+        count=args.count,
     )
     if args.json:
-        out = {"model": model.name, **rep.to_dict()}
-        emit_json(out)
-        return 0
-    lines = [f"model: {model.name}   system: {rep.system}   method: {rep.method}"]
-    if rep.unbounded_below:
-        lines.append("spectral abscissa: unbounded below (no eigenvalue converges)")
+        emit_json(rep.to_dict())
     else:
-        lines.append(
-            f"spectral abscissa: {rep.spectral_abscissa:.12g}   converged: {rep.converged}   "
-            f"digits: {rep.digits:.1f}   resolved: {rep.n_resolved}/{rep.n_total} "
-            f"at resolutions {rep.resolutions[0]}, {rep.resolutions[1]}"
-        )
-        lines.append("rightmost eigenvalues:")
-        for z, c in zip(rep.rightmost, rep.condition_numbers, strict=False):
-            lines.append(f"  {z.real:+.10g} {z.imag:+.10g}i   (condition {c:.3g})")
-    lines += [f"warning: {w}" for w in rep.warnings]
-    emit("\n".join(lines))
+        emit(str(rep))
     return 0
 
 
@@ -264,6 +278,50 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _robust_fraction(text: str | None) -> float | None:
+    """``--robust``: '5%' or 0.05 for ±5 %."""
+    if text is None:
+        return None
+    body = text.strip()
+    percent = body.endswith("%")
+    try:
+        value = float(body[:-1] if percent else body)
+    except ValueError:
+        raise NumericError(
+            f"--robust expects a percentage such as 5% or a fraction such as 0.05; found {text!r}"
+        ) from None
+    fraction = value / 100 if percent else value
+    if not 0 < fraction < 1:
+        raise NumericError(f"--robust must lie strictly between 0 % and 100 %; found {text!r}")
+    return fraction
+
+
+class _Progress:
+    """A one-line progress display on a terminal, shown once a run passes 2 seconds."""
+
+    DELAY = 2.0
+
+    def __init__(self) -> None:
+        import time
+
+        self._clock = time.perf_counter
+        self._start = self._clock()
+        self._shown = 0
+
+    def __call__(self, line: str) -> None:
+        if self._clock() - self._start < self.DELAY:
+            return
+        text = f"{line}   ({self._clock() - self._start:.0f} s)"
+        sys.stderr.write("\r" + text.ljust(self._shown))
+        sys.stderr.flush()
+        self._shown = len(text)
+
+    def clear(self) -> None:
+        if self._shown:
+            sys.stderr.write("\r" + " " * self._shown + "\r")
+            sys.stderr.flush()
+
+
 def _tune(args: argparse.Namespace) -> int:
     from phdesign.design import numeric_matrix
     from phdesign.numeric.tune import tune
@@ -271,22 +329,26 @@ def _tune(args: argparse.Namespace) -> int:
     if (noisy := noise_tuning(args)) is not None:  # --max-rms / --objective rms
         return noisy
     _check_positive("--starts", args.starts)
+    robust = _robust_fraction(args.robust)
     model = load_model(args)
     observer = observer_from_args(args, model)  # argparse requires --sensors or --cm here
     C_m = numeric_matrix(observer.C_m, "C_m", "tune")
-    res = tune(observer.plant.numeric, C_m, full=args.full, starts=args.starts, seed=args.seed)
-    if args.json:
-        emit_json({"model": model.name, **res.to_dict()})
-        return 0
-    lines = [f"model: {model.name}"]
-    lines.append("gain L = " + str(res.gain.round(8).tolist()))
-    if res.spectral_abscissa is None:
-        lines.append("spectral abscissa: unbounded below at this gain")
-    else:
-        lines.append(
-            f"spectral abscissa: {res.spectral_abscissa:.10g}   converged: {res.converged}   "
-            f"at coalescence: {res.at_coalescence}"
+    progress = _Progress() if sys.stderr.isatty() else None
+    try:
+        res = tune(
+            observer.plant.numeric,
+            C_m,
+            full=args.full,
+            starts=args.starts,
+            seed=args.seed,
+            robust=robust,
+            progress=progress,
         )
-    lines += [f"warning: {w}" for w in res.report.warnings]
-    emit("\n".join(lines))
+    finally:
+        if progress is not None:
+            progress.clear()
+    if args.json:
+        emit_json(res.to_dict())
+    else:
+        emit(str(res))
     return 0

@@ -185,9 +185,10 @@ def check_tune_arguments(
     log_range: Any,
     resolution: Any,
     maxiter: Any,
+    method: str = "galerkin",
 ) -> None:
     """Check the arguments of :func:`~phdesign.numeric.tune.tune`."""
-    _common(nm, "galerkin", resolution)
+    _common(nm, method, resolution)
     if C_m is None:
         raise ObserverError("tuning needs the sensors C_m")
     check_sensors_and_gain(nm, C_m, None, gain_required=False)

@@ -1,205 +1,118 @@
 r"""Converged spectra: spectral abscissa and rightmost eigenvalues under refinement.
 
 The eigenvalues of the generalized problem :math:`(J - R - B K_{cl} B^\top) v = \lambda E v`
-(closed plant, u = 0, or the observer error system, ũ = −C_mᵀ L C_m ỹ) are computed at
-resolutions p and ⌈1.5 p⌉ and only those that agree are kept (the drift-ratio rule of
-Dedalus' eigentools): the discrete spectrum of any semi-discretization contains
-unresolved high-frequency eigenvalues whose real parts are artefacts.  On a damped wave
-they tend to 0 (like h² for finite differences, like p⁻² ... p⁻⁴ for Galerkin), so the
-largest real part over *all* discrete eigenvalues converges to 0, not to the true
-abscissa: the unresolved modes lose the boundary damping.
+(closed plant, u = 0, or the observer error system, ũ = −C_mᵀ L C_m ỹ) are computed on the
+dimensionless model (:mod:`phdesign.numeric.scales`: tolerances and digits are relative
+to the problem's own rate s, whatever its units) in three stages:
 
-An eigenvalue λ at the finer resolution is *resolved* when its nearest neighbour μ at
-the coarser one satisfies :math:`|\lambda - \mu| \le r_{tol} \max(1, |\lambda|)` and the
-pairing is mutual.  The resolution pair is refined (p → 1.5 p) until the rightmost
-resolved eigenvalue's real part agrees to ``tol``.  Digits are
-:math:`-\log_{10}(|\Delta \operatorname{Re}| / \max(1, |\alpha|))`.
+1. **Refinement** (:func:`~phdesign.numeric.spectrum_refinement.refine`): resolution pairs
+   (p, ⌈1.5 p⌉), p → ⌈1.5 p⌉, each through the drift test (:mod:`phdesign.numeric.drift`)
+   and the abscissa rule (:mod:`phdesign.numeric.abscissa`), until a pair satisfies the
+   *convergence rule*:
 
-Ill-conditioning (near a coalescence, e.g. a critically damped gain) is measured by the
-energy-norm eigenvalue condition number
-:math:`\kappa = \|x\|_E \|y\|_E / |y^* E x|` (x right, y left eigenvector of the pencil,
-:math:`y^* A = \lambda y^* E`; 1 for an operator :math:`E^{-1}A` normal in the energy
-inner product) and by the relative gap to the nearest other eigenvalue.  When no
-eigenvalue is resolved at any resolution the spectrum is reported as unbounded below
-(finite-time extinction, e.g. the wave with the matched damper k = 1), never as a number.
+   * the abscissa is attained by an eigenvalue converged to ``tol``, i.e. its real part
+     agrees to :math:`tol \max(s, |\alpha|)` between the two resolutions;
+   * at least :data:`~phdesign.numeric.abscissa.MIN_MODES_ABOVE` resolved modes lie at
+     higher frequency than the rightmost one, so that the band reaches beyond it;
+   * the real parts do not keep rising with frequency (else the abscissa is a limit that
+     no mode attains, which no pair "converges" to).
+
+   It also stops when refinement no longer helps an ill-conditioned abscissa (round-off,
+   not resolution, limits it at a coalescence), when two pairs in a row show the evidence
+   of an empty spectrum, and when the last two pairs extrapolate the same high-frequency
+   limit within their uncertainties.
+
+2. **Choice of the pair** (:func:`~phdesign.numeric.spectrum_refinement.choose_pair`): the
+   converged pair, else the pair whose abscissa is the most accurate among those no finer
+   pair contradicts (a finer pair that attains a real part clearly right of a coarser
+   pair's abscissa supersedes it: its wider band saw modes the coarser one did not); an
+   earlier pair whose resolved abscissa lies clearly right of the chosen one wins
+   (round-off at high degree can make a true eigenvalue fail the drift test at a finer
+   pair).
+
+3. **Warnings** (:func:`report_warnings`): not converged and why, a limit at high
+   frequency, no exponential decay, ill-conditioned rightmost eigenvalues (energy-norm
+   condition number above 1e4, or a relative gap below 1e-3: near a coalescence),
+   eigenvalues right of the abscissa that do not count, artefacts.
+
+The spectrum is *unbounded below* (finite-time extinction, e.g. the string with the
+matched damper) only on evidence: no eigenvalue resolved at the last two pairs and every
+discrete eigenvalue outside the disk of radius 5 s (rule 5 of
+:mod:`phdesign.numeric.abscissa`).  Without that evidence an unresolved spectrum is
+"not resolved at these resolutions", never a number.
+
+Examples
+--------
+>>> import numpy as np
+>>> from phdesign.models import load_builtin
+>>> from phdesign.numeric.bridge import to_numeric
+>>> rep = spectrum(to_numeric(load_builtin("wave")), np.array([[0.0, 1.0]]), np.array([[0.5]]))
+>>> round(rep.spectral_abscissa, 10), rep.converged  # exactly 1/2 ln(1/3)
+(-0.5493061443, True)
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
-from typing import Any
 
 import numpy as np
-import scipy.linalg as sl
 
 from phdesign.errors import NumericError
+from phdesign.numeric.abscissa import estimate_abscissa
 from phdesign.numeric.arguments import check_spectrum_arguments
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
+from phdesign.numeric.discretize import feedback_matrix
+from phdesign.numeric.drift import in_band_unresolved, match_resolved, pair_spectrum
+from phdesign.numeric.eigen import prepare
+from phdesign.numeric.evaluator import default_tolerances
+from phdesign.numeric.phs import DiscretePHS
+from phdesign.numeric.scales import ProblemScales
+from phdesign.numeric.spectrum_refinement import (
+    ILL_CONDITION,
+    PairResult,
+    choose_pair,
+    extinct_twice,
+    refine,
+)
+from phdesign.numeric.spectrum_report import SpectrumReport
+from phdesign.numeric.threads import small_dense_threads
 
 __all__ = [
+    "PairResult",
     "SpectrumReport",
+    "choose_pair",
     "default_resolutions",
     "eigen",
     "in_band_unresolved",
     "match_resolved",
+    "refine",
+    "report_warnings",
     "resolved_abscissa",
     "spectrum",
 ]
 
-
-@dataclass(frozen=True)
-class SpectrumReport:
-    """Result of :func:`spectrum`.
-
-    Attributes
-    ----------
-    spectral_abscissa : float or None
-        max Re over the resolved eigenvalues (None when unbounded below or none resolved).
-    rightmost : list of complex
-        Resolved eigenvalues with the largest real parts (finest resolution), conjugate
-        pairs kept, sorted by decreasing real part then increasing |Im|.
-    converged : bool
-        The abscissa agrees to ``tol`` between the last two resolutions.
-    digits : float or None
-        Agreeing digits of the abscissa between the last two resolutions.
-    n_resolved, n_total : int
-        Resolved eigenvalues and all eigenvalues at the finest resolution.
-    resolutions : tuple of int
-        The last resolution pair.
-    unbounded_below : bool
-        No eigenvalue converges: empty spectrum / finite-time extinction.
-    ill_conditioned : bool
-        The rightmost eigenvalue is ill-conditioned (near a coalescence).
-    condition_numbers : list of float
-        Energy-norm condition numbers of ``rightmost``.
-    all_eigenvalues_max_real : float
-        max Re over ALL discrete eigenvalues at the finest resolution (the trap value; not
-        an approximation of the abscissa).
-    warnings : list of str
-    """
-
-    spectral_abscissa: float | None
-    rightmost: list[complex]
-    converged: bool
-    digits: float | None
-    n_resolved: int
-    n_total: int
-    resolutions: tuple[int, int]
-    method: str
-    system: str
-    unbounded_below: bool = False
-    ill_conditioned: bool = False
-    condition_numbers: list[float] = field(default_factory=list)
-    all_eigenvalues_max_real: float | None = None
-    history: list[dict[str, Any]] = field(default_factory=list)
-    warnings: list[str] = field(default_factory=list)
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary (complex numbers as ``[re, im]``)."""
-        d = asdict(self)
-        d["rightmost"] = [[float(z.real), float(z.imag)] for z in self.rightmost]
-        d["resolutions"] = list(self.resolutions)
-        return d
+ILL_GAP = 1e-3  # relative gap to the nearest other eigenvalue below which it is ill-posed
 
 
 def eigen(
     d: DiscretePHS, K: np.ndarray | None = None, condition: bool = False
 ) -> tuple[np.ndarray, np.ndarray | None]:
-    """Eigenvalues of ``E v' = closed_matrix(K) v`` and, optionally, condition numbers."""
-    A = d.closed_matrix(K)
-    if not condition:
-        return sl.eigvals(A, d.E), None
-    lam, Vl, Vr = sl.eig(A, d.E, left=True, right=True)
-    EVr = d.E @ Vr
-    num = np.sqrt(np.abs(np.einsum("ij,ij->j", Vr.conj(), EVr)))
-    num *= np.sqrt(np.abs(np.einsum("ij,ij->j", Vl.conj(), d.E @ Vl)))
-    den = np.abs(np.einsum("ij,ij->j", Vl.conj(), EVr))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        kappa = np.where(den > 0, num / den, np.inf)
-    return lam, kappa
-
-
-def match_resolved(
-    fine: np.ndarray, coarse: np.ndarray, rtol: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Return the indices of ``fine`` eigenvalues resolved against ``coarse`` and their drifts.
-
-    An eigenvalue is kept when its nearest coarse eigenvalue is within
-    ``rtol * max(1, |λ|)``, the real parts agree within ``rtol * max(1, |Re λ|)``, and
-    the nearest-neighbour pairing is mutual.
+    """Eigenvalues of ``E v' = closed_matrix(K) v`` and, optionally, condition numbers.
 
     Examples
     --------
-    >>> import numpy as np
-    >>> idx, drift = match_resolved(np.array([-1 + 1j, 50j]), np.array([-1 + 1j, 20j]), 1e-8)
-    >>> idx.tolist()
-    [0]
+    >>> from phdesign.models import load_builtin
+    >>> from phdesign.numeric.bridge import to_numeric
+    >>> from phdesign.numeric.discretize import discretize
+    >>> d = discretize(to_numeric(load_builtin("wave")), "galerkin", 8)
+    >>> lam, kappa = eigen(d, condition=True)
+    >>> bool(np.all(np.abs(lam.real) < 1e-12)), bool(np.all(kappa < 1 + 1e-9))  # lossless
+    (True, True)
     """
-    fine = np.asarray(fine)
-    coarse = np.asarray(coarse)
-    finite_f = np.isfinite(fine)
-    finite_c = np.isfinite(coarse)
-    if not finite_f.any() or not finite_c.any():
-        return np.array([], dtype=int), np.array([])
-    f_idx = np.flatnonzero(finite_f)
-    c = coarse[finite_c]
-    dist = np.abs(fine[f_idx][:, None] - c[None, :])
-    nearest_c = np.argmin(dist, axis=1)
-    nearest_f = np.argmin(dist, axis=0)
-    drift = dist[np.arange(f_idx.size), nearest_c]
-    mutual = nearest_f[nearest_c] == np.arange(f_idx.size)
-    scale = np.maximum(1.0, np.abs(fine[f_idx]))
-    # The real part decides the abscissa: it must agree on its own scale too, or a
-    # high-frequency pair with a loose |λ| match could carry a meaningless real part.
-    d_re = np.abs(fine[f_idx].real - c[nearest_c].real)
-    keep = (
-        mutual
-        & (drift <= rtol * scale)
-        & (d_re <= rtol * np.maximum(1.0, np.abs(fine[f_idx].real)))
-    )
-    return f_idx[keep], drift[keep] / scale[keep]
-
-
-def in_band_unresolved(
-    fine: np.ndarray,
-    tight: np.ndarray,
-    kappa: np.ndarray | None = None,
-    cluster: float = 5e-2,
-    kappa_min: float = 10.0,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Split the unresolved ``fine`` eigenvalues inside the resolved band.
-
-    The band is |λ| ≤ max |λ| over the resolved ones; unresolved eigenvalues above it are
-    the high-frequency artefacts of the semi-discretization.  Inside it, an eigenvalue
-    that belongs to a cluster (another eigenvalue within ``cluster max(1, |λ|)``) or is
-    ill-conditioned (``kappa > kappa_min``) is a genuine eigenvalue near a coalescence:
-    its members move by O((eps κ)^(1/m)) between resolutions and fail the drift test, but
-    they must never be dropped.  An isolated, well-conditioned in-band eigenvalue that
-    does not reproduce is a round-off artefact (e.g. N >= 3 at high degree).
-
-    Returns
-    -------
-    kept, artefacts : ndarray of int
-        Indices kept as (ill-conditioned) eigenvalues and indices discarded.
-    """
-    fine = np.asarray(fine)
-    empty = np.array([], dtype=int)
-    if tight.size == 0:
-        return empty, empty
-    band = np.max(np.abs(fine[tight]))
-    rest = np.setdiff1d(np.flatnonzero(np.isfinite(fine)), tight)
-    rest = rest[np.abs(fine[rest]) <= band]
-    keep = []
-    for i in rest:
-        lam = fine[i]
-        others = np.abs(np.delete(fine, i) - lam)
-        clustered = others.size > 0 and np.nanmin(others) <= cluster * max(1.0, abs(lam))
-        ill = kappa is not None and kappa[i] > kappa_min
-        keep.append(bool(clustered or ill))
-    mask = np.array(keep, dtype=bool)
-    return rest[mask], rest[~mask]
+    system = prepare(d, whitened=False)
+    if not condition:
+        return system.eigvals(K), None
+    return system.eigen_condition(K)
 
 
 def resolved_abscissa(
@@ -207,21 +120,17 @@ def resolved_abscissa(
     coarse: np.ndarray,
     rtol: float = 1e-6,
     kappa: np.ndarray | None = None,
+    scale: float = 1.0,
+    tol: float = 1e-10,
 ) -> float | None:
-    """Max real part over the resolved and the kept in-band eigenvalues, or None.
+    """Return the abscissa (:mod:`phdesign.numeric.abscissa`) of two sets of eigenvalues, or None.
 
-    Without condition numbers ``kappa`` every in-band unresolved eigenvalue is kept (an
-    upper bound that an optimizer cannot exploit by driving eigenvalues into a cluster).
+    Kept for callers of earlier versions; :class:`phdesign.numeric.evaluator.AbscissaEvaluator`
+    prepares a resolution pair once and evaluates it for many gains.  Without condition
+    numbers ``kappa`` every in-band unresolved eigenvalue is kept (an upper bound).
     """
-    idx, _ = match_resolved(fine, coarse, rtol)
-    if idx.size == 0:
-        return None
-    if kappa is None:
-        kept = in_band_unresolved(fine, idx, np.full(fine.shape, np.inf))[0]
-    else:
-        kept = in_band_unresolved(fine, idx, kappa)[0]
-    both = np.concatenate([idx, kept]).astype(int)
-    return float(np.max(fine[both].real))
+    pair = pair_spectrum(fine, coarse, resolutions=(0, 0), rtol=rtol, scale=scale, kappa=kappa)
+    return estimate_abscissa(pair, tol).value
 
 
 def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
@@ -239,28 +148,140 @@ def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
     return 20, {1: 100, 2: 110}[nm.order]
 
 
-def _rightmost(lam: np.ndarray, count: int) -> np.ndarray:
-    order = np.lexsort((np.abs(lam.imag), -np.round(lam.real, 12)))
-    return lam[order][:count]
+def _rightmost_order(lam: np.ndarray) -> np.ndarray:
+    return np.lexsort((np.abs(lam.imag), -np.round(lam.real, 12)))
 
 
-def _lost_rightmost(
-    tried: list[dict[str, Any]], chosen: dict[str, Any], rtol_resolved: float
-) -> dict[str, Any] | None:
-    """Return an earlier pair whose resolved abscissa lies clearly right of ``chosen``.
+def report_warnings(
+    chosen: PairResult, value: float, uncertainty: float, attained: float, tol: float
+) -> tuple[list[str], bool, bool]:
+    """Stage 3: warnings for the chosen pair; also (ill_conditioned, no_decay).
 
-    Round-off at high degree (N >= 3) can make a true eigenvalue fail the drift test at a
-    fine pair although it agreed to many digits at a coarser one; the finer pair's
-    abscissa is then the next eigenvalue to the left, a wrong answer. "Clearly" means by
-    far more than both pairs' own drifts, so that the ordinary convergence of one
-    eigenvalue under refinement never triggers this.
+    ``value``, ``uncertainty`` and ``attained`` are the chosen pair's abscissa.
     """
-    agreed = [r for r in tried if r["d_alpha"] <= rtol_resolved * max(1.0, abs(r["alpha"]))]
-    if not agreed:
-        return None
-    right = max(agreed, key=lambda r: r["alpha"])
-    margin = 100.0 * (right["d_alpha"] + chosen["d_alpha"]) + 1e-9 * max(1.0, abs(right["alpha"]))
-    return right if right["alpha"] > chosen["alpha"] + margin else None
+    pair, a = chosen.pair, chosen.abscissa
+    lam, s = pair.eigenvalues, pair.scale
+    warnings: list[str] = []
+    limit = a.limit
+    if limit is not None and a.kind == "limit":
+        warnings.append(
+            f"the real parts of the resolved eigenvalues keep rising with frequency (to "
+            f"{limit.top_real:.6g} at |λ| = {limit.top_frequency:.3g}): the abscissa is their "
+            f"limit, extrapolated from {limit.modes} modes as α∞ − c|λ|^-{limit.exponent:.2g}; "
+            "no mode attains it"
+        )
+    elif limit is not None and limit.value + limit.uncertainty > attained:
+        warnings.append(
+            f"the real parts rise with frequency toward {limit.value:.6g} ± "
+            f"{limit.uncertainty:.2g} at the top of the resolved band: the abscissa may be a "
+            "limit that no mode attains"
+        )
+    no_decay = value + uncertainty >= 0.0
+    if no_decay:
+        warnings.append(
+            "no exponential decay found: the abscissa is 0 within its accuracy"
+            + (
+                " (the real parts approach 0 at high frequency: no uniform decay)"
+                if limit is not None and a.kind == "limit"
+                else ""
+            )
+        )
+    counted = np.flatnonzero(a.counted)
+    lead_index = counted[_rightmost_order(lam[counted])[0]]
+    lead = lam[lead_index]
+    kappa = pair.condition
+    cond = float(kappa[lead_index]) if kappa is not None else 1.0
+    others = lam[np.isfinite(lam) & (np.arange(lam.size) != lead_index)]
+    gap = float(np.min(np.abs(others - lead))) / max(s, abs(lead)) if others.size else np.inf
+    # at the top of a band of rising real parts the "rightmost" mode is just the last one
+    ill = a.kind != "limit" and bool(
+        cond > ILL_CONDITION or gap < ILL_GAP or pair.clustered[lead_index]
+    )
+    if ill:
+        warnings.append(
+            f"the rightmost eigenvalue {lead:.6g} is ill-conditioned (condition number "
+            f"{cond:.3g}, relative gap to its nearest neighbour {gap:.2g}): near a "
+            "coalescence of eigenvalues (e.g. a critically damped gain); few digits are reliable"
+        )
+    if a.loose_right.any():
+        loose = np.flatnonzero(a.loose_right)
+        worst = loose[np.argmax(lam.real[loose])]
+        warnings.append(
+            f"{loose.size} resolved eigenvalues lie right of the abscissa by no more than their "
+            f"own accuracy (max Re {lam.real[worst]:.3g} ± {pair.uncertainty[worst]:.2g} at "
+            f"|λ| = {abs(lam[worst]):.3g}): their real parts are not resolved to {tol:g}, "
+            "so they do not count"
+        )
+    artefacts = np.flatnonzero(pair.artefacts & (lam.real > attained))
+    if artefacts.size:
+        warnings.append(
+            f"{artefacts.size} isolated, well-conditioned eigenvalues in the resolved band do "
+            f"not reproduce under refinement (max Re {float(np.max(lam.real[artefacts])):.3g}); "
+            "discarded as round-off artefacts"
+        )
+    rest = ~(pair.resolved | pair.clustered | pair.artefacts) & np.isfinite(lam)
+    right = np.flatnonzero(rest & (lam.real > attained + 1e-9 * max(s, abs(attained))))
+    if right.size:
+        warnings.append(
+            f"{right.size} unresolved eigenvalues lie to the right of the abscissa (max Re "
+            f"{float(np.max(lam.real[right])):.3g}), all above the resolved frequency band "
+            f"(|λ| > {pair.band:.3g}): unresolved high frequencies, discarded"
+        )
+    if not chosen.converged:
+        warnings.append(
+            f"the spectral abscissa did not converge to {tol:g} (relative to the rate "
+            f"{s:.3g}): {chosen.reason}"
+        )
+    return warnings, ill, no_decay
+
+
+def _unresolved_report(
+    trail: list[PairResult],
+    method: str,
+    system: str,
+    model: str,
+    scales: ProblemScales,
+    sensors: list[list[float]] | None,
+    gain: list[list[float]] | None,
+) -> SpectrumReport:
+    last = trail[-1]
+    extinct = extinct_twice(trail)
+    p, q = last.pair.resolutions
+    if extinct:
+        warning = (
+            f"no eigenvalue converges under refinement up to resolution {q} and every discrete "
+            f"eigenvalue stays outside |λ| <= {5 * scales.rate:.3g} (5 times the rate) at every "
+            "resolution, the nearest ones decaying faster than they oscillate: the spectrum is "
+            "empty (finite-time extinction); the spectral abscissa is unbounded below"
+        )
+    else:
+        warning = (
+            f"no eigenvalue agrees between the resolutions tried (up to {q}), yet discrete "
+            "eigenvalues lie near the origin: the spectrum is not resolved at these resolutions "
+            "(raise max_resolution / --max-resolution); no number is reported"
+        )
+    return SpectrumReport(
+        spectral_abscissa=None,
+        rightmost=[],
+        converged=False,
+        digits=None,
+        n_resolved=0,
+        n_total=int(last.pair.eigenvalues.size),
+        resolutions=(p, q),
+        method=method,
+        system=system,
+        unbounded_below=extinct,
+        all_eigenvalues_max_real=last.pair.all_max_real,
+        history=tuple(r.step() for r in trail),
+        warnings=[warning],
+        model=model,
+        kind="unbounded below" if extinct else "not resolved",
+        rate_scale=scales.rate,
+        eigenvalues=last.pair.eigenvalues,
+        resolved=last.pair.resolved,
+        sensors=sensors,
+        gain=gain,
+    )
 
 
 def spectrum(
@@ -275,7 +296,7 @@ def spectrum(
     rtol_resolved: float | None = None,
     count: int = 6,
 ) -> SpectrumReport:
-    """Converged spectral abscissa and rightmost eigenvalues.
+    """Converged spectral abscissa and rightmost eigenvalues (module docstring).
 
     Parameters
     ----------
@@ -287,8 +308,9 @@ def spectrum(
     resolution, max_resolution : int, optional
         First and largest resolution (degree or nodes per group).
     tol : float, optional
-        Required agreement of the abscissa (absolute, times max(1, abs(α))); default 1e-10
-        for Galerkin, 1e-3 for the second-order finite differences.
+        Required accuracy of the abscissa, relative to max(rate, abs(α)) with the problem's
+        rate (:mod:`phdesign.numeric.scales`); default 1e-10 for Galerkin, 1e-3 for the
+        second-order finite differences.
     rtol_resolved : float, optional
         Relative drift under which an eigenvalue counts as resolved; default 1e-6 for
         Galerkin, 1e-2 for finite differences.
@@ -313,171 +335,53 @@ def spectrum(
     if (C_m is None) != (L is None):
         raise NumericError("give both the sensors C_m and the gain L, or neither")
     K = None if C_m is None or L is None else feedback_matrix(C_m, L, nm.n_ports)
-    if tol is None:
-        tol = 1e-10 if method == "galerkin" else 1e-3
-    if rtol_resolved is None:
-        rtol_resolved = 1e-6 if method == "galerkin" else 1e-2
+    default_tol, default_rtol = default_tolerances(method)
+    tol = default_tol if tol is None else float(tol)
+    rtol_resolved = default_rtol if rtol_resolved is None else float(rtol_resolved)
     p0, pmax = default_resolutions(nm, method)
     p = int(resolution) if resolution is not None else p0
     pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
     system = "plant (u = 0)" if K is None else "observer error system"
-
-    def solve(res: int) -> np.ndarray:
-        return eigen(discretize(nm, method, res), K)[0]
-
-    history: list[dict[str, Any]] = []
-    tried: list[dict[str, Any]] = []
-    coarse = solve(p)
-    prev_alpha: float | None = None
-    result: dict[str, Any] = {}
-    best: dict[str, Any] | None = None
-    while True:
-        fine_res = math.ceil(1.5 * p)
-        d_fine = discretize(nm, method, fine_res)
-        fine, kappa = eigen(d_fine, K, condition=True)
-        idx, _drift = match_resolved(fine, coarse, rtol_resolved)
-        loose, artefacts = in_band_unresolved(fine, idx, kappa)
-        n_tight = int(idx.size)
-        idx = np.concatenate([idx, loose]).astype(int)
-        entry: dict[str, Any] = {
-            "resolutions": [p, fine_res],
-            "n_resolved": n_tight,
-            "n_loose": int(loose.size),
-            "all_max_real": float(np.max(fine.real[np.isfinite(fine)])),
-        }
-        if idx.size:
-            res_lam = fine[idx]
-            # drift of each resolved eigenvalue's real part between the two resolutions
-            nearest = coarse[np.argmin(np.abs(coarse[None, :] - res_lam[:, None]), axis=1)]
-            drifts = np.abs(res_lam.real - nearest.real)
-            # the abscissa is the eigenvalue with the largest real part *less its drift*:
-            # where many eigenvalues share the abscissa (a wave damper with k > 1), a
-            # noisy high frequency must not stand for an exactly resolved low one
-            j = int(np.argmax(res_lam.real - drifts))
-            alpha = float(res_lam.real[j])
-            d_alpha = float(drifts[j])
-            entry.update({"spectral_abscissa": alpha, "abscissa_drift": d_alpha})
-            result = {
-                "lam": fine,
-                "kappa": kappa,
-                "idx": idx,
-                "n_tight": n_tight,
-                "loose": loose,
-                "artefacts": artefacts,
-                "alpha": alpha,
-                "d_alpha": d_alpha,
-                "res": (p, fine_res),
-                "prev_alpha": prev_alpha,
-            }
-            prev_alpha = alpha
-            tried.append(result)
-            rel = d_alpha / max(1.0, abs(alpha))
-            if best is None or rel < best["d_alpha"] / max(1.0, abs(best["alpha"])):
-                best = result
-            if d_alpha <= tol * max(1.0, abs(alpha)):
-                history.append(entry)
-                break
-        history.append(entry)
-        if fine_res >= pmax:
-            break
-        p, coarse = fine_res, fine
-    if not result:
-        return SpectrumReport(
-            spectral_abscissa=None,
-            rightmost=[],
-            converged=False,
-            digits=None,
-            n_resolved=0,
-            n_total=int(fine.size),
-            resolutions=(p, fine_res),
-            method=method,
-            system=system,
-            unbounded_below=True,
-            all_eigenvalues_max_real=float(np.max(fine.real)),
-            history=history,
-            warnings=[
-                "no eigenvalue converges under refinement up to resolution "
-                f"{fine_res}: the spectrum is empty or runs off to -infinity "
-                "(finite-time extinction); the spectral abscissa is unbounded below"
-            ],
+    with small_dense_threads():
+        trail, scales = refine(
+            nm, K, method=method, start=p, stop=pmax, tol=tol, rtol_resolved=rtol_resolved
         )
-    warnings: list[str] = []
-    if best is not None and best is not result:
-        # Refinement made agreement worse (round-off at high degree): keep the best pair.
-        warnings.append(
-            f"agreement degraded beyond resolutions {best['res'][0]}, {best['res'][1]} "
-            "(round-off at high degree); that pair is reported"
-        )
-        result = best
-    lost = _lost_rightmost(tried, result, rtol_resolved)
-    if lost is not None:
-        warnings.append(
-            f"the eigenvalue {lost['alpha']:.10g} agreed between resolutions {lost['res'][0]} "
-            f"and {lost['res'][1]} but not at the pair first chosen ({result['res'][0]}, "
-            f"{result['res'][1]}), whose abscissa {result['alpha']:.6g} lies to its left; "
-            "an eigenvalue that once agreed is real, so that pair is reported"
-        )
-        result = lost
-    lam, kap, idx = result["lam"], result["kappa"], result["idx"]
-    loose_set = {int(i) for i in result["loose"]}
-    alpha, d_alpha = result["alpha"], result["d_alpha"]
-    res_lam, res_kap = lam[idx], kap[idx]
-    order = np.lexsort((np.abs(res_lam.imag), -np.round(res_lam.real, 12)))
-    top = order[:count]
-    rightmost = [complex(z) for z in res_lam[top]]
-    conds = [float(c) for c in res_kap[top]]
-    converged = bool(d_alpha <= tol * max(1.0, abs(alpha)))
-    digits = float(-np.log10(max(d_alpha, 1e-17) / max(1.0, abs(alpha))))
-    arte = result["artefacts"]
-    arte = arte[lam.real[arte] > alpha]
-    if arte.size:
-        warnings.append(
-            f"{arte.size} isolated, well-conditioned eigenvalues in the resolved band do not "
-            f"reproduce under refinement (max Re {float(np.max(lam.real[arte])):.3g}); "
-            "discarded as round-off artefacts"
-        )
-    # Rightmost eigenvalue conditioning and neighbour gap (coalescence detector).
-    lead = res_lam[top[0]]
-    others = lam[np.abs(lam - lead) > 0]
-    gap = float(np.min(np.abs(others - lead))) / max(1.0, abs(lead)) if others.size else np.inf
-    lead_loose = int(idx[top[0]]) in loose_set
-    ill = bool(conds[0] > 1e4 or gap < 1e-3 or lead_loose)
-    if ill:
-        warnings.append(
-            f"the rightmost eigenvalue {lead:.6g} is ill-conditioned (condition number "
-            f"{conds[0]:.3g}, relative gap to its nearest neighbour {gap:.2g}): near a "
-            "coalescence of eigenvalues (e.g. a critically damped gain); few digits are reliable"
-        )
-    # Never drop the rightmost silently: unresolved eigenvalues to the right.
-    unresolved = np.setdiff1d(np.arange(lam.size), idx)
-    right_unres = unresolved[lam.real[unresolved] > alpha + 1e-9 * max(1.0, abs(alpha))]
-    if right_unres.size:
-        low = right_unres[np.abs(lam[right_unres]) <= np.max(np.abs(res_lam))]
-        warnings.append(
-            f"{right_unres.size} unresolved eigenvalues lie to the right of the abscissa (max Re "
-            f"{float(np.max(lam.real[right_unres])):.3g}); {low.size} of them within the "
-            "resolved frequency band"
-            + (": check them" if low.size else " (unresolved high frequencies, discarded)")
-        )
-    if not converged:
-        warnings.append(
-            f"the spectral abscissa did not converge to {tol:g}: it drifts by {d_alpha:.2g} "
-            f"between resolutions {result['res'][0]} and {result['res'][1]}"
-        )
+    sensors = None if C_m is None else np.atleast_2d(np.asarray(C_m, float)).tolist()
+    gain = None if L is None else np.atleast_2d(np.asarray(L, float)).tolist()
+    chosen, notes = choose_pair(trail)
+    a, pair = chosen.abscissa, chosen.pair
+    if a.value is None or a.uncertainty is None or a.attained is None:
+        return _unresolved_report(trail, method, system, nm.name, scales, sensors, gain)
+    warnings, ill, no_decay = report_warnings(chosen, a.value, a.uncertainty, a.attained, tol)
+    lam = pair.eigenvalues
+    counted = np.flatnonzero(a.counted)
+    top = counted[_rightmost_order(lam[counted])[:count]]
+    kappa = pair.condition if pair.condition is not None else np.ones(lam.shape)
+    scale = max(pair.scale, abs(a.value))
+    digits = -math.log10(max(a.uncertainty, np.finfo(float).eps * scale) / scale)
     return SpectrumReport(
-        spectral_abscissa=alpha,
-        rightmost=rightmost,
-        converged=converged,
-        digits=digits,
-        n_resolved=int(result["n_tight"]),
+        spectral_abscissa=float(a.value),
+        rightmost=[complex(z) for z in lam[top]],
+        converged=chosen.converged,
+        digits=float(digits),
+        n_resolved=pair.n_resolved,
         n_total=int(lam.size),
-        resolutions=tuple(result["res"]),
+        resolutions=pair.resolutions,
         method=method,
         system=system,
         unbounded_below=False,
         ill_conditioned=ill,
-        condition_numbers=conds,
-        all_eigenvalues_max_real=float(np.max(lam.real)),
-        history=history,
-        warnings=warnings,
+        condition_numbers=[float(c) for c in kappa[top]],
+        all_eigenvalues_max_real=pair.all_max_real,
+        history=tuple(r.step() for r in trail),
+        warnings=notes + warnings,
+        model=nm.name,
+        uncertainty=float(a.uncertainty),
+        kind=a.kind,
+        no_decay=no_decay,
+        rate_scale=scales.rate,
+        eigenvalues=lam,
+        resolved=pair.resolved,
+        sensors=sensors,
+        gain=gain,
     )

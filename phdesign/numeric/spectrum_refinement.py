@@ -1,0 +1,287 @@
+r"""Refinement of the resolution pair and the choice of the pair reported (stages 1 and 2).
+
+Stage 1, :func:`refine`: pairs (p, ⌈1.5 p⌉), p → ⌈1.5 p⌉, each through the drift test
+(:mod:`phdesign.numeric.drift`) and the abscissa rule (:mod:`phdesign.numeric.abscissa`),
+until a pair satisfies the convergence rule (:func:`convergence_rule`), the largest
+resolution is reached, or refinement stops helping (an ill-conditioned coalescence, an
+empty spectrum seen twice, a high-frequency limit extrapolated alike twice).  Each
+resolution is solved once (QZ, with condition numbers) and serves two pairs.
+
+Stage 2, :func:`choose_pair`: the converged pair, else the most accurate pair that no finer
+pair contradicts, unless an earlier pair's resolved abscissa lies clearly to the right.
+:func:`phdesign.numeric.spectrum.spectrum` runs both and writes the report (stage 3).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from phdesign.numeric.abscissa import MIN_MODES_ABOVE, Abscissa, estimate_abscissa
+from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.discretize import discretize
+from phdesign.numeric.drift import PairSpectrum, pair_spectrum
+from phdesign.numeric.eigen import prepare, rescaled
+from phdesign.numeric.evaluator import fine_resolution
+from phdesign.numeric.scales import ProblemScales, dimensionless_model
+from phdesign.numeric.spectrum_report import RefinementStep
+
+__all__ = [
+    "ILL_CONDITION",
+    "PairResult",
+    "choose_pair",
+    "convergence_rule",
+    "extinct_twice",
+    "refine",
+]
+
+ILL_CONDITION = 1e4  # energy-norm condition number of an ill-conditioned rightmost eigenvalue
+
+
+@dataclass(frozen=True)
+class PairResult:
+    """One resolution pair of the refinement: its drift test, abscissa and verdict.
+
+    Attributes
+    ----------
+    pair : PairSpectrum
+    abscissa : Abscissa
+    converged : bool
+        The convergence rule holds (module docstring).
+    reason : str
+        Why it does not ("" when it does).
+    """
+
+    pair: PairSpectrum
+    abscissa: Abscissa
+    converged: bool
+    reason: str
+
+    @property
+    def relative_uncertainty(self) -> float:
+        """Uncertainty of the abscissa over max(rate, |α|); inf when there is none."""
+        a = self.abscissa
+        if a.value is None or a.uncertainty is None:
+            return math.inf
+        return a.uncertainty / max(self.pair.scale, abs(a.value))
+
+    def step(self) -> RefinementStep:
+        """Return the summary kept in the report's history."""
+        return RefinementStep(
+            resolutions=self.pair.resolutions,
+            n_resolved=self.pair.n_resolved,
+            spectral_abscissa=self.abscissa.value,
+            uncertainty=self.abscissa.uncertainty,
+            kind=self.abscissa.kind,
+            converged=self.converged,
+            all_max_real=self.pair.all_max_real,
+            n_loose=int(np.count_nonzero(self.pair.clustered)),
+        )
+
+
+def convergence_rule(pair: PairSpectrum, a: Abscissa, tol: float) -> str:
+    """Return why the pair is not converged, or "" when it is (module docstring)."""
+    if a.kind == "limit":
+        return "the real parts keep rising with frequency (the abscissa is a limit)"
+    if a.value is None or a.index is None or a.uncertainty is None:
+        return "no eigenvalue is resolved"
+    if a.limit is not None and a.limit.value + a.limit.uncertainty > a.value:
+        return (
+            "the real parts rise with frequency at the top of the resolved band and may "
+            f"exceed the largest one attained (limit {a.limit.value:.6g} ± "
+            f"{a.limit.uncertainty:.2g})"
+        )
+    if not a.converged_mask[a.index]:
+        return (
+            f"the rightmost eigenvalue agrees only to {a.uncertainty:.2g} between "
+            f"resolutions {pair.resolutions[0]} and {pair.resolutions[1]}"
+        )
+    if a.uncertainty > tol * max(pair.scale, abs(a.value)):
+        return (
+            f"the abscissa is known to {a.uncertainty:.2g} only (the real parts near the top "
+            "of the resolved band may still rise)"
+        )
+    if a.modes_above < MIN_MODES_ABOVE:
+        return (
+            f"only {a.modes_above} resolved modes lie above the rightmost one "
+            f"({MIN_MODES_ABOVE} are needed to see the rightmost modes)"
+        )
+    return ""
+
+
+class _Resolutions:
+    """Eigenvalues (with condition numbers) of the closed loop, once per resolution."""
+
+    def __init__(self, nm: NumericModel, method: str, K: np.ndarray | None) -> None:
+        self.dimensionless, self.scales = dimensionless_model(nm)
+        self.method, self.K = method, K
+        self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def solve(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+        if p not in self._cache:
+            # QZ, not the whitened Hessenberg QR: a report keeps every digit it can
+            system = prepare(discretize(self.dimensionless, self.method, p), whitened=False)
+            lam, kappa = system.eigen_condition(self.K)
+            self._cache[p] = (rescaled(lam, self.scales.rate), kappa)
+        return self._cache[p]
+
+
+def refine(
+    nm: NumericModel,
+    K: np.ndarray | None,
+    *,
+    method: str,
+    start: int,
+    stop: int,
+    tol: float,
+    rtol_resolved: float,
+) -> tuple[list[PairResult], ProblemScales]:
+    """Stage 1: pairs (p, ⌈1.5 p⌉) from ``start`` until one converges or p_fine >= ``stop``."""
+    solver = _Resolutions(nm, method, K)
+    trail: list[PairResult] = []
+    p = int(start)
+    while True:
+        p_fine = fine_resolution(p)
+        coarse, _ = solver.solve(p)
+        fine, kappa = solver.solve(p_fine)
+        pair = pair_spectrum(
+            fine,
+            coarse,
+            resolutions=(p, p_fine),
+            rtol=rtol_resolved,
+            scale=solver.scales.rate,
+            kappa=kappa,
+        )
+        a = estimate_abscissa(pair, tol)
+        reason = convergence_rule(pair, a, tol)
+        trail.append(PairResult(pair, a, not reason, reason))
+        settled = _degrading(trail) or _limit_settled(trail) or extinct_twice(trail)
+        if not reason or p_fine >= stop or settled:
+            return trail, solver.scales
+        p = p_fine
+
+
+def extinct_twice(trail: list[PairResult]) -> bool:
+    """Tell whether the last two pairs (three resolutions) both show an empty spectrum."""
+    return len(trail) >= 2 and all(r.abscissa.kind == "extinct" for r in trail[-2:])
+
+
+def _limit_settled(trail: list[PairResult]) -> bool:
+    """Tell whether the last two pairs extrapolate the same high-frequency limit.
+
+    A limit approached by no mode is never "converged"; once two pairs agree on it within
+    their uncertainties, finer pairs only cost time.
+    """
+    if len(trail) < 2 or not all(r.abscissa.kind == "limit" for r in trail[-2:]):
+        return False
+    (a, ua), (b, ub) = ((r.abscissa.value, r.abscissa.uncertainty) for r in trail[-2:])
+    if a is None or b is None or ua is None or ub is None:
+        return False
+    return abs(a - b) <= ua + ub
+
+
+def _degrading(trail: list[PairResult]) -> bool:
+    """Tell whether refinement stopped helping an ill-conditioned abscissa.
+
+    At an ill-conditioned coalescence the accuracy is set by round-off, not resolution
+    (finer pairs have larger norms and feed more round-off into the cluster): when the
+    last two pairs are both ill-conditioned at the abscissa and the finer one is not ten
+    times more accurate, the refinement stops and the best pair is chosen.  Resolution-
+    limited accuracy improves by far more than ten times per pair (spectral convergence);
+    a well-conditioned abscissa is left alone.
+    """
+    if len(trail) < 2 or not all(_ill_conditioned_at(r) for r in trail[-2:]):
+        return False
+    before, last = (r.relative_uncertainty for r in trail[-2:])
+    return bool(math.isfinite(before) and last > 0.1 * before)
+
+
+def _ill_conditioned_at(result: PairResult) -> bool:
+    """Tell whether the eigenvalue giving the pair's abscissa is clustered or ill-conditioned."""
+    a, pair = result.abscissa, result.pair
+    if a.index is None:
+        return False
+    kappa = pair.condition
+    cond = float(kappa[a.index]) if kappa is not None else 1.0
+    return bool(pair.clustered[a.index] or cond > ILL_CONDITION)
+
+
+def _lost_rightmost(trail: list[PairResult], chosen: PairResult) -> PairResult | None:
+    """Return an earlier pair whose resolved abscissa lies clearly right of ``chosen``'s.
+
+    Round-off at high degree (N >= 3) can make a true eigenvalue fail the drift test at a
+    fine pair although it agreed to many digits at a coarser one; the finer pair's
+    abscissa is then the next eigenvalue to the left, a wrong answer.  "Clearly" means by
+    far more than both pairs' own uncertainties, so that the ordinary convergence of one
+    eigenvalue under refinement never triggers this.
+    """
+    a = chosen.abscissa
+    if a.value is None or a.uncertainty is None:
+        return None
+    agreed = [
+        r
+        for r in trail
+        if r.abscissa.kind == "attained"
+        and r.abscissa.index is not None
+        and r.pair.resolved[r.abscissa.index]
+    ]
+    if not agreed:
+        return None
+    right = max(agreed, key=lambda r: r.abscissa.value or -math.inf)
+    value, uncertainty = right.abscissa.value or 0.0, right.abscissa.uncertainty or 0.0
+    margin = 100.0 * (uncertainty + a.uncertainty) + 1e-9 * max(right.pair.scale, abs(value))
+    return right if value > a.value + margin else None
+
+
+def _superseded(result: PairResult, finer: list[PairResult]) -> bool:
+    """Tell whether a finer pair attains a real part clearly right of ``result``'s abscissa.
+
+    A wider resolved band can show modes above the coarser band whose real parts lie
+    further right (real parts rising with frequency): the coarser value is then wrong,
+    however well it agreed.
+    """
+    a = result.abscissa
+    if a.attained is None or a.attained_uncertainty is None:
+        return False
+    top = a.attained + a.attained_uncertainty
+    return any(
+        r.abscissa.attained is not None
+        and r.abscissa.attained_uncertainty is not None
+        and r.abscissa.attained - r.abscissa.attained_uncertainty > top
+        for r in finer
+    )
+
+
+def choose_pair(trail: list[PairResult]) -> tuple[PairResult, list[str]]:
+    """Stage 2: the pair reported, and the warnings the choice itself raises."""
+    last = trail[-1]
+    notes: list[str] = []
+    if last.converged:
+        chosen = last
+    else:
+        valued = [r for r in trail if r.abscissa.value is not None]
+        if not valued:
+            return last, []
+        eligible = [r for i, r in enumerate(valued) if not _superseded(r, valued[i + 1 :])]
+        best = min(reversed(eligible), key=lambda r: r.relative_uncertainty)
+        chosen = best
+        if best is not valued[-1] and best.relative_uncertainty < valued[-1].relative_uncertainty:
+            p, q = best.pair.resolutions
+            notes.append(
+                f"agreement degraded beyond resolutions {p}, {q} (round-off at high degree); "
+                "that pair is reported"
+            )
+    lost = _lost_rightmost(trail, chosen)
+    if lost is not None:
+        lp, lq = lost.pair.resolutions
+        cp, cq = chosen.pair.resolutions
+        notes.append(
+            f"the eigenvalue {lost.abscissa.value:.10g} agreed between resolutions {lp} and "
+            f"{lq} but not at the pair first chosen ({cp}, {cq}), whose abscissa "
+            f"{chosen.abscissa.value:.6g} lies to its left; an eigenvalue that once agreed "
+            "is real, so that pair is reported"
+        )
+        chosen = lost
+    return chosen, notes
