@@ -33,6 +33,7 @@ from typing import Any
 import sympy
 
 from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
+from phdesign.symbolic.definiteness import check_definite
 from phdesign.symbolic.expressions import (
     Z,
     canonical,
@@ -48,9 +49,6 @@ from phdesign.symbolic.expressions import (
 )
 
 __all__ = ["BCPHS", "Displacement", "Z"]
-
-#: Points of the grid on which H(z) is checked when exact positivity is out of reach.
-POSITIVITY_GRID_POINTS = 2001
 
 
 @dataclass(frozen=True)
@@ -358,12 +356,21 @@ def _validate(model: BCPHS) -> list[str]:
                 f"{residual.tolist()}"
             )
     checks.append("P_k symmetry: exact")
-    checks.append(_check_semidefinite(model.P[0] + model.P[0].T, defaults))
+    checks.append(
+        check_definite(
+            model.P[0] + model.P[0].T,
+            model.interval,
+            name="P0 + P0^T",
+            sign=-1,
+            strict=False,
+            defaults=defaults,
+        )
+    )
     checks.append(_check_invertible(model.P[N], f"P{N}", defaults))
     residual = (model.H - model.H.T).applyfunc(canonical)
     if not all(vanishes(x) for x in residual):
         raise ModelError(f"H must be symmetric; found H - H^T = {residual.tolist()}")
-    checks.append(_check_positive_definite(model.H, model.interval, defaults))
+    checks.append(check_definite(model.H, model.interval, name="H", defaults=defaults))
     if model.displacement is not None:
         d = model.displacement
         if not (1 <= d.component <= n) or d.integrations < 0:
@@ -425,22 +432,6 @@ def _check_ports(model: BCPHS, symbols: set[sympy.Symbol]) -> None:
                 raise ExpressionError(f"{what} holds unknown symbols {names}")
 
 
-def _at_defaults(matrix: sympy.MatrixBase, defaults: Mapping[sympy.Symbol, sympy.Expr]) -> Any:
-    return matrix.xreplace(dict(defaults))
-
-
-def _check_semidefinite(S: sympy.MatrixBase, defaults: Mapping[sympy.Symbol, sympy.Expr]) -> str:
-    how = "exact"
-    if S.free_symbols:
-        S, how = _at_defaults(S, defaults), "exact at the parameter defaults"
-    if S.is_negative_semidefinite is False:
-        raise ModelError(
-            f"P0 + P0^T must be negative semidefinite ({how}); found eigenvalues "
-            f"{sorted(sympy.ImmutableMatrix(S).eigenvals())}"
-        )
-    return f"P0 + P0^T <= 0: {how}"
-
-
 def _check_invertible(
     P: sympy.MatrixBase, name: str, defaults: Mapping[sympy.Symbol, sympy.Expr]
 ) -> str:
@@ -455,89 +446,3 @@ def _check_invertible(
             )
         return f"{name} invertible: det = {det}, nonzero at the parameter defaults"
     return f"{name} invertible: exact"
-
-
-def _check_positive_definite(
-    H: sympy.MatrixBase,
-    interval: tuple[sympy.Expr, sympy.Expr],
-    defaults: Mapping[sympy.Symbol, sympy.Expr],
-) -> str:
-    if not H.free_symbols:
-        if H.is_positive_definite:
-            return "H > 0: exact"
-        raise ModelError(
-            "H must be positive definite; found eigenvalues "
-            f"{sorted(sympy.ImmutableMatrix(H).eigenvals())}"
-        )
-    H_defaults = _at_defaults(H, defaults)
-    if not H_defaults.free_symbols:
-        if H_defaults.is_positive_definite:
-            return "H > 0: exact at the parameter defaults"
-        raise ModelError(
-            "H must be positive definite; at the parameter defaults found eigenvalues "
-            f"{sorted(sympy.ImmutableMatrix(H_defaults).eigenvals())}"
-        )
-    exact = _check_positive_definite_exactly(H_defaults, interval)
-    return exact if exact is not None else _check_positive_definite_on_grid(H_defaults, interval)
-
-
-def _check_positive_definite_exactly(
-    H: sympy.MatrixBase, interval: tuple[sympy.Expr, sympy.Expr]
-) -> str | None:
-    """Prove min over [a, b] of every leading principal minor > 0, for rational H(z).
-
-    Returns ``None`` when sympy cannot decide (then the grid check runs).
-    """
-    from sympy.calculus.util import minimum
-
-    minors = [sympy.cancel(H[:k, :k].det()) for k in range(1, H.shape[0] + 1)]
-    if not all(m.is_rational_function(Z) for m in minors):
-        return None
-    domain = sympy.Interval(*interval)
-    for k, minor in enumerate(minors, start=1):
-        _, denominator = sympy.fraction(minor)
-        if sympy.solveset(denominator, Z, domain) != sympy.EmptySet:
-            raise ModelError(
-                f"H must be bounded on [{interval[0]}, {interval[1]}]; its minor {k} = {minor} "
-                "has a pole there (parameter defaults)"
-            )
-        try:
-            smallest = minimum(minor, Z, domain)
-        except (NotImplementedError, ValueError):
-            return None
-        if not smallest.is_number:
-            return None
-        if not smallest > 0:
-            raise ModelError(
-                f"H must be positive definite on [{interval[0]}, {interval[1]}]; found leading "
-                f"principal minor {k} = {minor} with minimum {smallest} (parameter defaults)"
-            )
-    return "H > 0: exact on [a, b] at the parameter defaults (leading principal minors)"
-
-
-def _check_positive_definite_on_grid(
-    H: sympy.MatrixBase, interval: tuple[sympy.Expr, sympy.Expr]
-) -> str:
-    import numpy as np  # only for the grid check of a z-dependent H
-
-    a, b = (float(p) for p in interval)
-    grid = np.linspace(a, b, POSITIVITY_GRID_POINTS)
-    evaluate = sympy.lambdify(Z, H, modules="numpy")
-    with np.errstate(all="ignore"):
-        values = np.array([np.asarray(evaluate(z), dtype=float) for z in grid])
-    if not np.all(np.isfinite(values)):
-        bad = grid[~np.all(np.isfinite(values), axis=(1, 2))][0]
-        raise ModelError(
-            f"H must be bounded on [{a}, {b}]; found a non-finite entry at z = {bad:g}"
-        )
-    smallest = np.linalg.eigvalsh(values).min(axis=1)
-    worst = int(np.argmin(smallest))
-    if smallest[worst] <= 0:
-        raise ModelError(
-            f"H must be positive definite on [{a}, {b}]; found smallest eigenvalue "
-            f"{smallest[worst]:.6g} at z = {grid[worst]:g} (parameter defaults)"
-        )
-    return (
-        f"H > 0: on a grid of {POSITIVITY_GRID_POINTS} points at the parameter defaults "
-        f"(smallest eigenvalue {smallest[worst]:.6g} at z = {grid[worst]:g})"
-    )
