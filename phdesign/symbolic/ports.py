@@ -50,11 +50,15 @@ from functools import lru_cache
 from typing import Protocol
 
 import sympy
+from sympy.polys.constructor import construct_domain
+from sympy.polys.matrices import DomainMatrix
+from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.errors import PortError
 from phdesign.symbolic.expressions import (
     Trace,
     canonical,
+    exact_matrix,
     linear_coefficients,
     trace_symbol,
     vanishes,
@@ -136,16 +140,16 @@ def q_matrix(P: Sequence[sympy.MatrixBase], order: int) -> sympy.ImmutableMatrix
         ``N``.
     """
     n = P[order].shape[0]
-    blocks = [
-        [
-            (-1) ** (i - 1) * sympy.Matrix(P[i + j - 1])
+    rows = []
+    for i in range(1, order + 1):
+        blocks = [
+            (-1) ** (i - 1) * exact_matrix(P[i + j - 1], f"P{i + j - 1}", symbols=True)
             if i + j - 1 <= order
             else sympy.zeros(n, n)
             for j in range(1, order + 1)
         ]
-        for i in range(1, order + 1)
-    ]
-    return sympy.ImmutableMatrix(sympy.BlockMatrix(blocks).as_explicit())
+        rows.append(sympy.Matrix.hstack(*blocks))
+    return sympy.ImmutableMatrix(sympy.Matrix.vstack(*rows))
 
 
 def coefficient_matrix(
@@ -203,13 +207,63 @@ class Ports:
 
 def sigma_matrix(dimension: int) -> sympy.ImmutableMatrix:
     r"""Return :math:`\Sigma = [[0, I], [I, 0]]` with ``I`` of size ``dimension``."""
-    eye, zero = sympy.eye(dimension), sympy.zeros(dimension)
-    return sympy.ImmutableMatrix(sympy.BlockMatrix([[zero, eye], [eye, zero]]).as_explicit())
+    return sympy.ImmutableMatrix(
+        2 * dimension, 2 * dimension, lambda i, j: 1 if abs(i - j) == dimension else 0
+    )
+
+
+def _exact_matrices(*matrices: sympy.MatrixBase) -> tuple[DomainMatrix, ...]:
+    """Return the matrices over one exact domain (rationals, algebraic, rational functions).
+
+    Products and inverses cost far less there than in sympy's generic matrices, and
+    zero is recognized exactly.
+    """
+    entries = [x for M in matrices for x in M]
+    try:
+        domain, elements = construct_domain(entries, extension=True, field=True)
+    except (sympy.PolynomialError, NotImplementedError, ValueError):
+        domain, elements = construct_domain(entries, field=True)
+    out = []
+    offset = 0
+    for M in matrices:
+        rows, cols = M.shape
+        block = elements[offset : offset + rows * cols]
+        offset += rows * cols
+        out.append(
+            DomainMatrix(
+                [block[i * cols : (i + 1) * cols] for i in range(rows)], (rows, cols), domain
+            )
+        )
+    return tuple(out)
+
+
+def _exact_zero(M: DomainMatrix) -> bool:
+    """Whether ``M`` vanishes identically (decided by the domain, or by :func:`vanishes`)."""
+    if not M.domain.is_EX:
+        return bool(M.is_zero_matrix)
+    return all(vanishes(x) for x in M.to_Matrix())
+
+
+def _rank(M: sympy.MatrixBase) -> int:
+    (exact,) = _exact_matrices(M)
+    if exact.domain.is_EX:
+        return int(M.rank(iszerofunc=vanishes))
+    return int(exact.rank())
 
 
 @lru_cache(maxsize=256)
 def derive_ports(model: PortedSystem) -> Ports:
-    """Derive and check the port structure of ``model``.
+    r"""Derive and check the port structure of ``model``.
+
+    With :math:`u = U v`, :math:`U = (U_b\ U_a)` split by the halves
+    :math:`\phi(b), \phi(a)` of :math:`v`, :math:`R_{ext}^{-1} = \tfrac{1}{\sqrt2}
+    \begin{pmatrix} Q^{-1} & I \\ -Q^{-1} & I \end{pmatrix}` gives
+    :math:`W_B = \tfrac{1}{\sqrt 2}\big((U_b - U_a) Q^{-1} \;\; U_b + U_a\big)`, and
+    (with :math:`Q` symmetric) :math:`W_B \Sigma W_B^\top = U_b Q^{-1} U_b^\top -
+    U_a Q^{-1} U_a^\top`, likewise :math:`W_C \Sigma W_C^\top` and
+    :math:`W_C \Sigma W_B^\top = Y_b Q^{-1} U_b^\top - Y_a Q^{-1} U_a^\top`: the
+    identities are checked in exact rational (or algebraic) arithmetic, without the
+    :math:`\sqrt 2` of :math:`R_{ext}`.
 
     Raises
     ------
@@ -217,34 +271,42 @@ def derive_ports(model: PortedSystem) -> Ports:
         If the inputs or the outputs are linearly dependent, or an identity fails;
         the message names the identity and its largest residual.
     """
+    for attribute in ("order", "size", "P", "inputs", "outputs", "parameter_defaults"):
+        if not hasattr(model, attribute):
+            raise PortError(
+                f"derive_ports needs a model (a BCPHS); found {type(model).__name__} "
+                f"{str(model)[:60]!r}"
+            )
     N, n = model.order, model.size
+    nn = N * n
     Q = q_matrix(model.P, N)
-    eye = sympy.eye(N * n)
-    R_ext = sympy.ImmutableMatrix(
-        sympy.BlockMatrix([[Q, -Q], [eye, eye]]).as_explicit() / sympy.sqrt(2)
-    )
-    Q_inv = Q.inv()
-    R_inv = sympy.ImmutableMatrix(
-        sympy.BlockMatrix([[Q_inv, eye], [-Q_inv, eye]]).as_explicit() / sympy.sqrt(2)
-    )
     U = coefficient_matrix(model.inputs, N, n, "inputs")
     Y = coefficient_matrix(model.outputs, N, n, "outputs")
     defaults = model.parameter_defaults
     for name, M in (("inputs", U), ("outputs", Y)):
-        rank = M.xreplace(defaults).rank(iszerofunc=vanishes)
-        if rank != N * n:
+        rank = _rank(M.xreplace(defaults))
+        if rank != nn:
             raise PortError(
                 f"the {name} are linearly dependent: rank of "
                 f"{'W_B' if name == 'inputs' else 'W_C'} "
-                f"is {rank}, expected N*n = {N * n}"
+                f"is {rank}, expected N*n = {nn}"
             )
-    W_B = (U * R_inv).applyfunc(canonical)
-    W_C = (Y * R_inv).applyfunc(canonical)
-    Sigma = sigma_matrix(N * n)
+    dQ, dU, dY = _exact_matrices(Q, U, Y)
+    try:
+        Q_inv = dQ.inv()
+    except (DMNonInvertibleMatrixError, ZeroDivisionError):
+        raise PortError(f"Q is singular: P{N} must be invertible") from None
+    halves = {}
+    for name, M in (("U", dU), ("Y", dY)):
+        b_half, a_half = M[:, :nn], M[:, nn:]
+        halves[name] = (b_half, a_half)
+    (U_b, U_a), (Y_b, Y_a) = halves["U"], halves["Y"]
     residuals = {
-        "WB_Sigma_WBt": W_B * Sigma * W_B.T,
-        "WC_Sigma_WCt": W_C * Sigma * W_C.T,
-        "WC_Sigma_WBt_minus_I": W_C * Sigma * W_B.T - eye,
+        "WB_Sigma_WBt": U_b * Q_inv * U_b.transpose() - U_a * Q_inv * U_a.transpose(),
+        "WC_Sigma_WCt": Y_b * Q_inv * Y_b.transpose() - Y_a * Q_inv * Y_a.transpose(),
+        "WC_Sigma_WBt_minus_I": Y_b * Q_inv * U_b.transpose()
+        - Y_a * Q_inv * U_a.transpose()
+        - DomainMatrix.eye(nn, dQ.domain),
     }
     statements = {
         "WB_Sigma_WBt": "W_B Σ W_Bᵀ = 0",
@@ -253,24 +315,40 @@ def derive_ports(model: PortedSystem) -> Ports:
     }
     identities: dict[str, sympy.Expr] = {}
     for key in IDENTITY_NAMES:
-        residual = residuals[key].applyfunc(canonical)
+        if _exact_zero(residuals[key]):
+            identities[key] = sympy.Integer(0)
+            continue
+        residual = residuals[key].to_Matrix().applyfunc(canonical)
         largest = _max_abs(residual, defaults)
-        identities[key] = largest
-        if not all(vanishes(x) for x in residual):
-            at = " at the parameter defaults" if residual.free_symbols else ""
-            raise PortError(
-                f"port identity {statements[key]} fails: largest residual |entry| = "
-                f"{_short(largest)}{at}; the outputs must be the power conjugates of the inputs"
-            )
+        at = " at the parameter defaults" if residual.free_symbols else ""
+        raise PortError(
+            f"port identity {statements[key]} fails: largest residual |entry| = "
+            f"{_short(largest)}{at}; the outputs must be the power conjugates of the inputs"
+        )
+    half = sympy.sqrt(2) / 2
+
+    def port_map(b_half: DomainMatrix, a_half: DomainMatrix) -> sympy.ImmutableMatrix:
+        left = ((b_half - a_half) * Q_inv).to_Matrix()
+        right = (b_half + a_half).to_Matrix()
+        return sympy.ImmutableMatrix(
+            sympy.Matrix.hstack(left, right).applyfunc(lambda x: half * x)
+        )
+
+    eye = sympy.eye(nn)
+    R_ext = sympy.ImmutableMatrix(
+        sympy.Matrix.vstack(sympy.Matrix.hstack(Q, -Q), sympy.Matrix.hstack(eye, eye)).applyfunc(
+            lambda x: half * x
+        )
+    )
     return Ports(
         trace_vector=trace_vector(N, n),
         Q=Q,
         R_ext=R_ext,
         U=U,
         Y=Y,
-        W_B=sympy.ImmutableMatrix(W_B),
-        W_C=sympy.ImmutableMatrix(W_C),
-        Sigma=Sigma,
+        W_B=port_map(U_b, U_a),
+        W_C=port_map(Y_b, Y_a),
+        Sigma=sigma_matrix(nn),
         identities=identities,
     )
 
