@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import ModelError, ParameterError, check_shape
+from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
 from phdesign.symbolic.ports import trace_index
 
 __all__ = [
@@ -169,7 +169,7 @@ def _free_symbols_message(what: str, symbols: set[Any]) -> str:
 
 def _parameter_values(model: Any, parameters: Mapping[str, Any] | None) -> dict[Any, Any]:
     """Defaults of ``model`` overridden by ``parameters`` (keys by name)."""
-    import sympy
+    from phdesign.symbolic.expressions import exact_number
 
     if parameters and hasattr(model, "with_parameters"):
         model = model.with_parameters({str(k): v for k, v in parameters.items()})
@@ -181,11 +181,10 @@ def _parameter_values(model: Any, parameters: Mapping[str, Any] | None) -> dict[
         if name not in by_name:
             known = ", ".join(sorted(by_name)) or "none"
             raise ParameterError(f"unknown parameter {name!r}; the model's parameters: {known}")
-        try:
-            expr = sympy.sympify(val) if not isinstance(val, sympy.Basic) else val
-        except (sympy.SympifyError, TypeError) as exc:
-            raise ParameterError(f"parameter {name!r}: cannot read value {val!r}") from exc
-        values[by_name[name]] = expr
+        try:  # text goes through the safe parser, never sympify
+            values[by_name[name]] = exact_number(val, f"parameter {name}")
+        except ExpressionError as exc:
+            raise ParameterError(str(exc)) from None
     return values
 
 
@@ -209,8 +208,8 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         When a parameter is unknown or a symbol other than z stays free (the message
         names them).
     """
-    import sympy
-
+    from phdesign.symbolic.evaluation import evaluate
+    from phdesign.symbolic.expressions import exact_matrix, exact_number
     from phdesign.symbolic.model import Z
     from phdesign.symbolic.ports import derive_ports
 
@@ -218,13 +217,13 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
     N, n = int(model.order), int(model.size)
 
     def subs_matrix(name: str, mat: Any, allow_z: bool) -> Any:
-        out = sympy.ImmutableMatrix(mat).subs(values)
+        out = exact_matrix(mat, name, symbols=True).xreplace(values)
         free = set(out.free_symbols) - ({Z} if allow_z else set())
         if free:
             raise ParameterError(_free_symbols_message(name, free))
         return out
 
-    a_s, b_s = (sympy.sympify(s).subs(values) for s in model.interval)
+    a_s, b_s = (exact_number(s, "interval endpoint") for s in model.interval)
     for nm_, s in (("interval start a", a_s), ("interval end b", b_s)):
         if s.free_symbols:
             raise ParameterError(_free_symbols_message(nm_, set(s.free_symbols)))
@@ -241,13 +240,11 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
     if H_constant:
         Hfun = constant_H(np.array(Hs.evalf(), dtype=float))
     else:
-        entries = [
-            sympy.lambdify(Z, Hs[i, j], modules="numpy") for i in range(n) for j in range(n)
-        ]
+        entries = [Hs[i, j] for i in range(n) for j in range(n)]
 
         def Hfun(z: np.ndarray) -> np.ndarray:
             zz = np.atleast_1d(np.asarray(z, dtype=float))
-            vals = [np.broadcast_to(np.asarray(f(zz), dtype=float), zz.shape) for f in entries]
+            vals = [evaluate(entry, zz) for entry in entries]  # no code generation
             return np.stack(vals, axis=-1).reshape(zz.size, n, n)
 
     disp = None
@@ -332,7 +329,6 @@ def initial_state_function(
     n = nm.size
     if text is None or not text.strip():
         return lambda z: np.zeros((np.atleast_1d(z).size, n))
-    import sympy
 
     names = {s: i for i, s in enumerate(nm.state_names)}
     names.update({f"x{i + 1}": i for i in range(n)})
@@ -363,9 +359,9 @@ def initial_state_function(
         if idx in exprs:
             raise ParameterError(f"initial state: component {key!r} given twice")
         exprs[idx] = _parse_z_expression(expr_text, model, parameters)
-    from phdesign.symbolic.model import Z
+    from phdesign.symbolic.evaluation import evaluate
 
-    funcs = {i: sympy.lambdify(Z, e, modules="numpy") for i, e in exprs.items()}
+    funcs = {i: (lambda zz, e=e: evaluate(e, zz)) for i, e in exprs.items()}
 
     def x0(z: np.ndarray) -> np.ndarray:
         zz = np.atleast_1d(np.asarray(z, dtype=float))

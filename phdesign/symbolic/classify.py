@@ -192,7 +192,7 @@ def _number(x: sympy.Expr) -> Any:
 
 
 def _rows(M: sympy.MatrixBase) -> list[list[Any]]:
-    return [[_number(sympy.sympify(x)) for x in row] for row in M.tolist()]
+    return [[_number(sympy.sympify(x, strict=True)) for x in row] for row in M.tolist()]
 
 
 def _result_json(r: VariantResult, interval: Sequence[Any]) -> dict[str, Any]:

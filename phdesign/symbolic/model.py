@@ -26,6 +26,7 @@ Examples
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -33,6 +34,7 @@ from typing import Any
 import sympy
 
 from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
+from phdesign.limits import check_model_dimensions, check_parameter_count
 from phdesign.symbolic.definiteness import check_definite
 from phdesign.symbolic.expressions import (
     Z,
@@ -47,6 +49,7 @@ from phdesign.symbolic.expressions import (
     trace_of,
     vanishes,
 )
+from phdesign.symbolic.parser import check_expression
 
 __all__ = ["BCPHS", "Displacement", "Z"]
 
@@ -166,6 +169,11 @@ class BCPHS:
         """
         if not isinstance(order, int) or isinstance(order, bool) or order < 1:
             raise ModelError(f"order must be an integer N >= 1; found {order!r}")
+        if parameters is not None and not isinstance(parameters, Mapping):
+            raise ModelError(f"parameters must be a table of name = value; found {parameters!r}")
+        check_parameter_count(len(parameters or {}))
+        if isinstance(H, Sequence) and not isinstance(H, str):
+            check_model_dimensions(order, len(H))  # before any entry is parsed
         names = list(parameters or {})
         for parameter in names:
             check_parameter_name(parameter)
@@ -331,8 +339,9 @@ def _validate(model: BCPHS) -> list[str]:
     check_shape("H", model.H, (n, n))
     for k, P_k in enumerate(model.P):
         check_shape(f"P{k}", P_k, (n, n))
-    if len(model.state_names) != n:
-        raise ModelError(f"state_names must hold {n} labels; found {len(model.state_names)}")
+    check_model_dimensions(N, n)
+    check_parameter_count(len(model.parameters))
+    _check_state_names(model.state_names, n)
 
     symbols = {s for s, _ in model.parameters}
     for s, value in model.parameters:
@@ -341,6 +350,9 @@ def _validate(model: BCPHS) -> list[str]:
     for k, P_k in enumerate(model.P):
         _check_symbols(P_k, f"P{k}", symbols)
     _check_symbols(model.H, "H", symbols | {Z})
+    for matrix, label in ((model.H, "H"), *((P_k, f"P{k}") for k, P_k in enumerate(model.P))):
+        for (i, j), entry in sympy.ImmutableMatrix(matrix).todok().items():
+            check_expression(entry, f"{label}[{i + 1},{j + 1}]")
 
     defaults = model.parameter_defaults
     for k, P_k in enumerate(model.P):
@@ -384,6 +396,40 @@ def _validate(model: BCPHS) -> list[str]:
     derive_ports(model)
     checks.append("port identities: exact")
     return checks
+
+
+#: Characters a state label may not hold: they separate the items of an initial state.
+_LABEL_SEPARATORS = frozenset(":,()[]")
+
+
+def _check_state_names(names: Sequence[object], n: int) -> None:
+    """Refuse labels that are not text, repeat, or could be read as another component.
+
+    ``--x0 'x2: ...'`` and ``'e2: ...'`` address components by position; a label ``x2``
+    on component 1, or any label ``e<i>``, would make such an item ambiguous.
+    """
+    if len(names) != n:
+        raise ModelError(f"state_names must hold {n} labels; found {len(names)}")
+    for i, label in enumerate(names):
+        if not isinstance(label, str) or not label.strip():
+            raise ModelError(f"state label {i + 1} must be non-empty text; found {label!r}")
+        if any(c in _LABEL_SEPARATORS or not c.isprintable() for c in label):
+            raise ModelError(
+                f"state label {label!r} holds a separator or control character; expected "
+                "none of : , ( ) [ ] and no control characters"
+            )
+        match = _COMPONENT_NAME.fullmatch(label.strip())
+        if match is not None and (match[1] == "e" or int(match[2]) != i + 1):
+            raise ModelError(
+                f"state label {label!r} of component {i + 1} is ambiguous: it names "
+                f"{'the effort' if match[1] == 'e' else 'state component'} {match[2]}; "
+                f"expected a label other than x<j> (j != {i + 1}) and e<j>"
+            )
+    if len({str(label).strip() for label in names}) != n:
+        raise ModelError(f"state labels must be distinct; found {list(names)}")
+
+
+_COMPONENT_NAME = re.compile(r"([xe])(\d+)")
 
 
 def _check_finite(

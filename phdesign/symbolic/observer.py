@@ -57,7 +57,7 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.errors import ExpressionError, ObserverError, check_shape
-from phdesign.symbolic.expressions import exact_number, vanishes
+from phdesign.symbolic.expressions import exact_matrix, exact_number, vanishes
 from phdesign.symbolic.model import BCPHS
 
 __all__ = [
@@ -217,7 +217,7 @@ def parse_gain(text: str, q: int) -> sympy.ImmutableMatrix:
 
 # --------------------------------------------------------------------------- checks
 def _check_cm(C_m: sympy.MatrixBase, n_outputs: int) -> sympy.ImmutableMatrix:
-    C_m = sympy.ImmutableMatrix(C_m)
+    C_m = _safe_matrix(C_m, "C_m")
     if C_m.rows < 1 or C_m.rows > n_outputs:
         raise ObserverError(
             f"Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) with "
@@ -239,6 +239,19 @@ def _check_cm(C_m: sympy.MatrixBase, n_outputs: int) -> sympy.ImmutableMatrix:
             f"{C_m.rows} but found {rank}"
         )
     return C_m
+
+
+def _safe_matrix(value: object, what: str) -> sympy.ImmutableMatrix:
+    """Return a caller's matrix as sympy, its text read by the safe parser (no sympify)."""
+    if (
+        isinstance(value, sympy.MatrixBase)
+        or getattr(getattr(value, "dtype", None), "kind", "O") in "biuf"
+    ):
+        return sympy.ImmutableMatrix(value)  # sympy or numeric numpy: no text to parse
+    try:
+        return exact_matrix(value, what, symbols=True)
+    except ExpressionError as error:
+        raise ObserverError(str(error)) from None
 
 
 def _exactify_entries(M: sympy.MatrixBase, what: str) -> sympy.ImmutableMatrix:
@@ -271,7 +284,7 @@ def _py(x: object) -> object:
 
 
 def _check_gain(L: sympy.MatrixBase, q: int) -> sympy.ImmutableMatrix:
-    L = sympy.ImmutableMatrix(L)
+    L = _safe_matrix(L, "L")
     try:
         check_shape("L", L, (q, q))
     except ValueError as error:
@@ -383,8 +396,8 @@ def error_system(
     nn = order * size
     C_m = _check_cm(C_m, nn)
     L = _check_gain(L, C_m.rows)
-    U = sympy.ImmutableMatrix(U)
-    Y = sympy.ImmutableMatrix(Y)
+    U = _safe_matrix(U, "U")
+    Y = _safe_matrix(Y, "Y")
     T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
     G = C_m.T * L * C_m
     boundary = sympy.ImmutableMatrix(U + G * Y)

@@ -47,7 +47,16 @@ from phdesign.limits import (
     MAX_NUMBER_DIGITS,
 )
 
-__all__ = ["CONSTANTS", "FUNCTIONS", "Token", "check_text", "degree_bound", "parse", "tokenize"]
+__all__ = [
+    "CONSTANTS",
+    "FUNCTIONS",
+    "Token",
+    "check_expression",
+    "check_text",
+    "degree_bound",
+    "parse",
+    "tokenize",
+]
 
 #: The largest argument of exp, sinh and cosh whose value stays within MAX_MAGNITUDE.
 _LARGEST_EXPONENTIAL_ARGUMENT = math.log(MAX_MAGNITUDE) + math.log(2)
@@ -141,17 +150,7 @@ class _Parser:
                 f"cannot read {self.context.text!r}: unexpected {token.text!r} "
                 f"at position {token.position}"
             )
-        if expr.has(sympy.I, sympy.zoo, sympy.nan, sympy.oo, -sympy.oo):
-            raise ExpressionError(
-                f"{self.context.text!r} is not a finite real expression; found {expr}"
-            )
-        degree = degree_bound(expr)
-        if degree > MAX_DEGREE:
-            raise ExpressionError(
-                f"{self.context.text!r} has degree {degree} once built; expected at most "
-                f"{MAX_DEGREE} (the budget phdesign.limits.MAX_DEGREE)"
-            )
-        return expr
+        return check_expression(expr, repr(self.context.text))
 
     def peek(self) -> Token | None:
         return self.tokens[self.index] if self.index < len(self.tokens) else None
@@ -355,6 +354,49 @@ def degree_bound(expr: sympy.Basic) -> int:
         return result
 
     return bound(expr)
+
+
+#: Functions sympy forms by itself from the grammar (``sqrt(z**2)`` is ``Abs(z)``,
+#: ``tan(pi/2 - z)`` is ``cot(z)``); the printer writes them back in the grammar.
+_FORMED = frozenset({"Abs", "cot"})
+
+
+def check_expression(expr: sympy.Expr, what: str) -> sympy.Expr:
+    """Return ``expr`` if it is what the parser could have built, within the budgets.
+
+    The same checks apply to expressions a caller builds with sympy: finite and real,
+    only the grammar's functions, exact numbers within ``MAX_NUMBER_BITS`` and a degree
+    within ``MAX_DEGREE`` (:mod:`phdesign.limits`).
+
+    Raises
+    ------
+    ExpressionError
+        Naming ``what`` and what was found.
+    """
+    if not isinstance(expr, sympy.Expr):
+        raise ExpressionError(f"{what} must be an expression; found {type(expr).__name__}")
+    if expr.has(sympy.I, sympy.zoo, sympy.nan, sympy.oo, -sympy.oo):
+        raise ExpressionError(f"{what} is not a finite real expression; found {_brief(expr)}")
+    for function in expr.atoms(sympy.Function):
+        name = type(function).__name__
+        if name not in FUNCTIONS and name not in _FORMED:
+            raise ExpressionError(
+                f"{what} uses the function {name}; expected only {', '.join(sorted(FUNCTIONS))}"
+            )
+    for number in expr.atoms(sympy.Rational):
+        if max(abs(number.p).bit_length(), number.q.bit_length()) > MAX_NUMBER_BITS:
+            raise ExpressionError(
+                f"a number in {what} is out of range; expected magnitudes between 1e-300 and 1e300"
+            )
+    if expr.atoms(sympy.Float):
+        raise ExpressionError(f"{what} holds a floating-point number; expected exact numbers")
+    degree = degree_bound(expr)
+    if degree > MAX_DEGREE:
+        raise ExpressionError(
+            f"{what} has degree {degree} once built; expected at most "
+            f"{MAX_DEGREE} (the budget phdesign.limits.MAX_DEGREE)"
+        )
+    return expr
 
 
 def check_text(text: object, what: str) -> str:
