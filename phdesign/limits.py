@@ -75,6 +75,7 @@ phdesign.errors.ObserverError: the sensor search classifies 2^30 - 1 = 107374182
 from __future__ import annotations
 
 import math
+import numbers
 import operator
 from typing import Any
 
@@ -149,7 +150,7 @@ _LARGEST_DEFAULT_RESOLUTION = 70
 
 
 def _budget(name: str) -> str:
-    return f"the budget is {globals()[name]:,} (phdesign.limits.{name})"
+    return f"the budget phdesign.limits.{name}"
 
 
 def _integer(value: object, what: str, error: type[Exception]) -> int:
@@ -238,21 +239,20 @@ def check_discretization(nm: Any, method: object, *resolutions: object) -> None:
 
 def check_simulation(
     nm: Any,
-    observed: bool,
-    *,
+    C_m: Any,
     t_end: object,
     samples: object,
     method: object,
     resolution: object,
-    states: int | None = None,
+    discrete: Any = None,
 ) -> None:
     """Refuse a simulation whose time span or size is beyond the budgets.
 
     Parameters
     ----------
     nm : NumericModel
-    observed : bool
-        Whether the observer runs too (twice the states).
+    C_m : array or None
+        The sensors (the observer runs too when given: twice the states).
     t_end : float
         Final time: ``0 < t_end <= MAX_T_END``.
     samples : int
@@ -260,12 +260,13 @@ def check_simulation(
         states at most :data:`MAX_SIMULATION_VALUES`.
     method, resolution
         The discretization (checked by :func:`check_discretization`).
-    states : int, optional
-        The states of a discretization given ready-made (overrides the estimate).
+    discrete : DiscretePHS, optional
+        A discretization given ready-made (its states replace the estimate).
     """
-    if isinstance(t_end, bool) or not isinstance(t_end, int | float):
+    if isinstance(t_end, bool) or not isinstance(t_end, numbers.Real):
         raise NumericError(f"t_end must be a number; found {type(t_end).__name__} {t_end!r}")
-    if not (math.isfinite(t_end) and 0 < t_end <= MAX_T_END):
+    end = float(t_end)
+    if not (math.isfinite(end) and 0 < end <= MAX_T_END):
         raise NumericError(
             f"t_end must be a positive number at most {MAX_T_END:g}; found {t_end} "
             f"({_budget('MAX_T_END')})"
@@ -273,28 +274,37 @@ def check_simulation(
     count = _integer(samples, "samples", NumericError)
     if count < 2:
         raise NumericError(f"samples must be at least 2; found {count}")
-    step = t_end / (count - 1)
+    step = end / (count - 1)
     if not step >= MIN_TIME_STEP:
         raise NumericError(
             f"t_end / (samples - 1) = {step:.3g} is below {MIN_TIME_STEP:g}: the time stamps "
             f"would not be distinct; expected a longer t_end or fewer samples "
             f"({_budget('MIN_TIME_STEP')})"
         )
-    if states is None:
+    if discrete is not None:
+        states = int(discrete.dim)
+    else:
         check_discretization(nm, method, resolution)
         res = _LARGEST_DEFAULT_RESOLUTION if resolution is None else int(resolution)  # type: ignore[call-overload]
         states = _states(nm, res)
-    total = count * states * (2 if observed else 1)
+    states *= 1 if C_m is None else 2
+    total = count * states
     if total > MAX_SIMULATION_VALUES:
         raise NumericError(
-            f"samples = {count} times {states * (2 if observed else 1):,} states is "
-            f"{total:,} values; expected at most {MAX_SIMULATION_VALUES:,} "
-            f"({_budget('MAX_SIMULATION_VALUES')}): ask for fewer samples"
+            f"samples = {count} times {states:,} states is {total:,} values; expected at "
+            f"most {MAX_SIMULATION_VALUES:,} ({_budget('MAX_SIMULATION_VALUES')}): ask for "
+            "fewer samples"
         )
 
 
-def check_tuning(*, starts: object, seed: object, maxiter: object) -> None:
-    """Refuse a tuning run beyond :data:`MAX_STARTS` or :data:`MAX_TUNE_ITERATIONS`."""
+def check_tuning(
+    nm: Any, starts: object, seed: object, maxiter: object, resolution: object
+) -> None:
+    """Refuse a tuning run beyond :data:`MAX_STARTS` or :data:`MAX_TUNE_ITERATIONS`.
+
+    The resolution pair (``resolution`` and 1.5 times it) is checked by
+    :func:`check_discretization`.
+    """
     for what, value, name in (
         ("starts", starts, "MAX_STARTS"),
         ("maxiter", maxiter, "MAX_TUNE_ITERATIONS"),
@@ -307,3 +317,6 @@ def check_tuning(*, starts: object, seed: object, maxiter: object) -> None:
             )
     if _integer(seed, "seed", NumericError) < 0:
         raise NumericError(f"seed must be a non-negative integer; found {seed}")
+    if resolution is not None:
+        fine = math.ceil(1.5 * _integer(resolution, "resolution", NumericError))
+        check_discretization(nm, "galerkin", resolution, fine)

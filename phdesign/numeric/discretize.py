@@ -34,6 +34,7 @@ Methods
 
 from __future__ import annotations
 
+from phdesign import limits
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.phs import DiscretePHS, feedback_matrix
@@ -60,6 +61,7 @@ def discretize(
     -------
     DiscretePHS
     """
+    limits.check_discretization(nm, method, resolution)
     if method == "galerkin":
         from phdesign.numeric.galerkin import galerkin
 

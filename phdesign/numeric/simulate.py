@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sl
 
+from phdesign import limits
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
@@ -347,6 +348,7 @@ def simulate(
     -------
     SimulationResult
     """
+    limits.check_simulation(nm, C_m, t_end, samples, method, resolution, discrete)
     if not (np.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a positive number; found {t_end}")
     if int(samples) < 2:

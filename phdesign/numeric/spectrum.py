@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sl
 
+from phdesign import limits
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
@@ -298,6 +299,7 @@ def spectrum(
     -------
     SpectrumReport
     """
+    limits.check_discretization(nm, method, resolution, max_resolution)
     if (C_m is None) != (L is None):
         raise NumericError("give both the sensors C_m and the gain L, or neither")
     K = None if C_m is None or L is None else feedback_matrix(C_m, L, nm.n_ports)

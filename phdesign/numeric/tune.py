@@ -25,6 +25,7 @@ import numpy as np
 import scipy.linalg as sl
 from scipy.optimize import minimize
 
+from phdesign import limits
 from phdesign.errors import NumericError, ObserverError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
@@ -136,6 +137,7 @@ def tune(
     -------
     TuneResult
     """
+    limits.check_tuning(nm, starts, seed, maxiter, resolution)
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
     q = C.shape[0]
     if q == 0:

@@ -39,6 +39,7 @@ from typing import Any
 
 import sympy
 
+from phdesign import limits
 from phdesign.errors import ObserverError
 from phdesign.symbolic.assumption import Partition, check_assumption
 from phdesign.symbolic.model import BCPHS
@@ -252,6 +253,7 @@ def search_sensors(
     -------
     SensorSearch
     """
+    limits.check_sensor_outputs(model.order * model.size)
     order, size = model.order, model.size
     nn = order * size
     gains = _gain_vector(gain, nn)
