@@ -14,7 +14,6 @@ parser: user text is never evaluated.
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
 from phdesign.cli.common import (
@@ -24,9 +23,10 @@ from phdesign.cli.common import (
     emit,
     emit_json,
     load_model,
+    non_negative_int,
     observer_matrices,
     sensor_matrix_from_args,
-    write_output,
+    warn,
 )
 from phdesign.errors import NumericError
 
@@ -88,7 +88,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     group.add_argument("--cm", metavar="ROWS", help="C_m in full, e.g. '[[0,0,1,0]]'")
     tn.add_argument("--full", action="store_true", help="full L instead of positive diagonal")
     tn.add_argument("--starts", type=int, default=6, help="number of starts")
-    tn.add_argument("--seed", type=int, default=0, help="seed of the random starts")
+    tn.add_argument("--seed", type=non_negative_int, default=0, help="seed of the random starts")
     add_json_argument(tn)
     tn.set_defaults(handler=_tune)
 
@@ -148,6 +148,7 @@ def _spectrum(args: argparse.Namespace) -> int:
 def _simulate(args: argparse.Namespace) -> int:
     from phdesign.numeric.bridge import initial_state_function
     from phdesign.numeric.simulate import simulate
+    from phdesign.outputs import OutputFiles
 
     _check_positive("--resolution", args.resolution)
     _check_positive("--t-end", args.t_end)
@@ -158,44 +159,82 @@ def _simulate(args: argparse.Namespace) -> int:
         raise NumericError("--xhat0 needs an observer: give --sensors or --cm")
     x0 = initial_state_function(args.x0, nm, model=model)
     xh0 = initial_state_function(args.xhat0, nm, model=model)
-    # refuse unwritable or existing outputs before the (possibly long) simulation
-    if args.output:
-        from phdesign.io import check_output_path
+    # every output is checked before the (possibly long) simulation and written together
+    # at the end: on any failure or interrupt none is left, and no temporary file
+    import warnings
 
-        check_output_path(args.output, args.force)
-    if args.plot:
-        from phdesign.plots import check_plot_path
+    import numpy as np
 
-        check_plot_path(args.plot, args.force)
-    res = simulate(
-        nm,
-        C_m,
-        L,
-        x0=x0,
-        xhat0=xh0,
-        t_end=args.t_end,
-        samples=args.samples,
-        method=args.method,
-        resolution=args.resolution,
-        scheme=args.scheme,
-    )
-    if args.json:
-        import json
+    with OutputFiles(args.force) as out, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fmt = None
+        if args.output:
+            out.add(args.output)
+        if args.plot:
+            from phdesign.plots import check_plot_path
 
-        text = json.dumps({"model": model.name, **res.to_dict()})
-    else:
-        text = res.to_csv()
-    if args.output:
-        write_output(args.output, text, args.force)
-    else:
+            fmt = check_plot_path(args.plot, args.force)
+            out.add(args.plot)
+        with np.errstate(all="ignore"):  # an overflow is refused below, with one line
+            res = simulate(
+                nm,
+                C_m,
+                L,
+                x0=x0,
+                xhat0=xh0,
+                t_end=args.t_end,
+                samples=args.samples,
+                method=args.method,
+                resolution=args.resolution,
+                scheme=args.scheme,
+            )
+        check_finite_series(res)
+        if args.json:
+            from phdesign.io import dumps_json
+
+            text = dumps_json({"model": model.name, **res.to_dict()}, indent=None)
+        else:
+            text = res.to_csv()
+        if args.plot:
+            import io
+
+            from phdesign.plots import plot_simulation
+
+            # the name is a title, not mathtext: "$\frac{1}{$" must not break the plot
+            figure = plot_simulation(res, title=model.name.replace("$", r"\$"))
+            picture = io.BytesIO()
+            figure.savefig(picture, format=fmt, dpi=110)
+            out.stage(args.plot, picture.getvalue())
+        if args.output:
+            out.stage(args.output, text)
+        out.commit()
+    if not args.output:
         emit(text)
-    if args.plot:
-        from phdesign.plots import plot_simulation
-
-        plot_simulation(res, args.plot, force=args.force, title=model.name)
-    for warning in res.warnings:
-        print(f"phdesign: warning: {warning}", file=sys.stderr)
+    for warning in (*res.warnings, *dict.fromkeys(str(w.message) for w in caught)):
+        warn(warning)
     return 0
+
+
+def check_finite_series(result: Any) -> None:
+    """Refuse a simulation whose series overflowed (NaN or infinity), naming the first one.
+
+    Large initial states, tiny parameters or huge gains can overflow double precision;
+    such a run is an error, never rows of NaN.
+    """
+    import numpy as np
+
+    for name in ("H", "H_hat", "H_err", "y", "y_hat", "w", "w_hat"):
+        series = getattr(result, name, None)
+        if series is None:
+            continue
+        values = np.asarray(series, dtype=float)
+        bad = ~np.isfinite(values.reshape(values.shape[0], -1)).all(axis=1)
+        if bad.any():
+            first = float(result.t[int(np.argmax(bad))])
+            raise NumericError(
+                f"the simulation overflowed: {name} is not finite from t = {first:.6g} on; "
+                "the initial state, parameters or gain are too large for double precision"
+            )
 
 
 def _tune(args: argparse.Namespace) -> int:
