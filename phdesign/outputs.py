@@ -24,8 +24,7 @@ Examples
 >>> import tempfile, pathlib
 >>> folder = pathlib.Path(tempfile.mkdtemp())
 >>> with OutputFiles() as out:
-...     out.add(folder / "a.txt")
-...     out.add(folder / "b.txt")
+...     reserved = [out.add(folder / name) for name in ("a.txt", "b.txt")]
 ...     out.stage(folder / "a.txt", "one")
 ...     out.stage(folder / "b.txt", b"two")
 ...     out.commit()
