@@ -22,6 +22,7 @@ from phdesign.cli.common import (
     observer_matrices,
 )
 from phdesign.errors import ObserverError
+from phdesign.symbolic.expressions import format_number
 
 __all__ = ["register"]
 
@@ -107,7 +108,7 @@ def _table(result: Any) -> str:
         else:
             kappa = "—"
         if len(kappa) > 28:
-            kappa = f"{r.kappa_float:.6g}" if r.kappa_float is not None else kappa[:27] + "…"
+            kappa = format_number(r.kappa if r.kappa is not None else r.kappa_float)
         lines.append(f"{r.proposition:<5} {r.variant:<3} {holds:<6} {kappa:<28} {r.rhs}")
         notes = []
         if not r.applicable or not r.holds:

@@ -41,6 +41,7 @@ the non-zero root branches.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -48,6 +49,8 @@ from typing import Any
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
+from phdesign.errors import ObserverError
+from phdesign.limits import EXACT_KAPPA_OPERATIONS
 from phdesign.symbolic.observer import ErrorSystem, vanishes
 
 __all__ = ["Certificate", "certify", "float_kappa"]
@@ -166,15 +169,35 @@ def certify(
     if symbolic:
         kappa, conditions = _symbolic_kappa(A_r, B_r)
         return Certificate(True, kappa, None, False, None, (), "symbolic", conditions, pencil)
-    if method in ("auto", "exact"):
+    affordable = _operations(A_r, B_r) <= EXACT_KAPPA_OPERATIONS
+    if method == "exact" and not affordable:
+        raise ObserverError(
+            f"the exact κ* of this pencil is over budget ({_operations(A_r, B_r)} operations "
+            f"> {EXACT_KAPPA_OPERATIONS}, phdesign.limits.EXACT_KAPPA_OPERATIONS); "
+            "use method='float'"
+        )
+    if method in ("auto", "exact") and affordable:
         exact = _exact_kappa(A_r, B_r)
         if exact is not None:
             return Certificate(
-                True, exact, float(exact.evalf(30)), False, None, (), "exact", None, pencil
+                True, exact, _as_float(exact), False, None, (), "exact", None, pencil
             )
         if method == "exact":
-            raise ValueError("no exact root available for this pencil; use method='float'")
+            raise ObserverError("no exact root available for this pencil; use method='float'")
     return Certificate(True, None, float_kappa(A_r, B_r), False, None, (), "float", None, pencil)
+
+
+def _operations(*matrices: sympy.MatrixBase) -> int:
+    """Size of a pencil's entries: the measure of :data:`EXACT_KAPPA_OPERATIONS`."""
+    return sum(sympy.count_ops(x) for M in matrices for x in M)
+
+
+def _as_float(value: sympy.Expr) -> float | None:
+    """``value`` as a float, or ``None`` when a double cannot hold it (1e-500, 1e400)."""
+    number = float(value.evalf(30))
+    if value != 0 and (number == 0.0 or not math.isfinite(number)):
+        return None
+    return number
 
 
 def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | None:

@@ -48,6 +48,7 @@ __all__ = [
     "exact_matrix",
     "exact_number",
     "format_expression",
+    "format_number",
     "linear_coefficients",
     "parameter_symbol",
     "parse_scalar",
@@ -532,6 +533,34 @@ class _Printer(StrPrinter):
 
 
 _PRINTER = _Printer()
+
+
+def format_number(value: object, width: int = 28) -> str:
+    """Print a number exactly when it is short, else with 6 digits in scientific notation.
+
+    Unlike a float, the scientific form never underflows or overflows: a κ* of 1e-500
+    prints as ``1.0e-500``, not ``0``.
+
+    Examples
+    --------
+    >>> format_number(sympy.Rational(1, 4))
+    '1/4'
+    >>> format_number(sympy.Rational(1, 10**500))
+    '1.0e-500'
+    """
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if not isinstance(value, sympy.Expr):
+        return str(value)
+    text = format_expression(value)
+    if len(text) <= width or not value.is_number:
+        return text
+    import mpmath
+
+    approximation = sympy.N(value, 15)
+    if not approximation.is_Number:
+        return text
+    return str(mpmath.nstr(approximation._to_mpmath(53), 6))
 
 
 def format_expression(expr: sympy.Basic, interval: Sequence[object] | None = None) -> str:
