@@ -47,7 +47,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Protocol
+from typing import Any, Protocol
 
 import sympy
 from sympy.polys.constructor import construct_domain
@@ -229,12 +229,27 @@ def _exact_matrices(*matrices: sympy.MatrixBase) -> tuple[DomainMatrix, ...]:
         rows, cols = M.shape
         block = elements[offset : offset + rows * cols]
         offset += rows * cols
-        out.append(
-            DomainMatrix(
-                [block[i * cols : (i + 1) * cols] for i in range(rows)], (rows, cols), domain
-            )
+        dense = DomainMatrix(
+            [block[i * cols : (i + 1) * cols] for i in range(rows)], (rows, cols), domain
         )
+        out.append(dense)
+    zeros = sum(1 for x in elements if not x)
+    if zeros > 0.8 * len(elements):  # mostly zeros (most models): products skip them
+        return tuple(M.to_sparse() for M in out)
     return tuple(out)
+
+
+def _integral(M: DomainMatrix) -> tuple[Any, DomainMatrix]:
+    """``(s, N)`` with ``M = N / s``: ``N`` over the integers when ``M`` is rational."""
+    if M.domain == sympy.QQ:
+        scale, integral = M.clear_denoms(convert=True)
+        return scale.element, integral
+    return M.domain.one, M
+
+
+def _identity(size: int, like: DomainMatrix) -> DomainMatrix:
+    eye = DomainMatrix.eye(size, like.domain)
+    return eye.to_sparse() if like.rep.fmt == "sparse" else eye.to_dense()
 
 
 def _exact_zero(M: DomainMatrix) -> bool:
@@ -296,17 +311,24 @@ def derive_ports(model: PortedSystem) -> Ports:
         Q_inv = dQ.inv()
     except (DMNonInvertibleMatrixError, ZeroDivisionError):
         raise PortError(f"Q is singular: P{N} must be invertible") from None
-    halves = {}
-    for name, M in (("U", dU), ("Y", dY)):
-        b_half, a_half = M[:, :nn], M[:, nn:]
-        halves[name] = (b_half, a_half)
-    (U_b, U_a), (Y_b, Y_a) = halves["U"], halves["Y"]
+    # over the rationals, clear the denominators: integer products are far cheaper, and
+    # each residual below is the true one times a positive constant (same zero test)
+    s_Q, Qi = _integral(Q_inv)
+    s_U, Ui = _integral(dU)
+    s_Y, Yi = _integral(dY)
+    U_b, U_a, Y_b, Y_a = Ui[:, :nn], Ui[:, nn:], Yi[:, :nn], Yi[:, nn:]
+    UQ_b, UQ_a, YQ_b, YQ_a = (M * Qi for M in (U_b, U_a, Y_b, Y_a))
     residuals = {
-        "WB_Sigma_WBt": U_b * Q_inv * U_b.transpose() - U_a * Q_inv * U_a.transpose(),
-        "WC_Sigma_WCt": Y_b * Q_inv * Y_b.transpose() - Y_a * Q_inv * Y_a.transpose(),
-        "WC_Sigma_WBt_minus_I": Y_b * Q_inv * U_b.transpose()
-        - Y_a * Q_inv * U_a.transpose()
-        - DomainMatrix.eye(nn, dQ.domain),
+        "WB_Sigma_WBt": UQ_b * U_b.transpose() - UQ_a * U_a.transpose(),
+        "WC_Sigma_WCt": YQ_b * Y_b.transpose() - YQ_a * Y_a.transpose(),
+        "WC_Sigma_WBt_minus_I": YQ_b * U_b.transpose()
+        - YQ_a * U_a.transpose()
+        - _identity(nn, Qi) * (s_Y * s_U * s_Q),
+    }
+    scales = {
+        "WB_Sigma_WBt": s_U * s_U * s_Q,
+        "WC_Sigma_WCt": s_Y * s_Y * s_Q,
+        "WC_Sigma_WBt_minus_I": s_Y * s_U * s_Q,
     }
     statements = {
         "WB_Sigma_WBt": "W_B Σ W_Bᵀ = 0",
@@ -318,7 +340,8 @@ def derive_ports(model: PortedSystem) -> Ports:
         if _exact_zero(residuals[key]):
             identities[key] = sympy.Integer(0)
             continue
-        residual = residuals[key].to_Matrix().applyfunc(canonical)
+        scale = Qi.domain.to_sympy(scales[key])
+        residual = residuals[key].to_Matrix().applyfunc(lambda x, c=scale: canonical(x / c))
         largest = _max_abs(residual, defaults)
         at = " at the parameter defaults" if residual.free_symbols else ""
         raise PortError(
@@ -327,12 +350,15 @@ def derive_ports(model: PortedSystem) -> Ports:
         )
     half = sympy.sqrt(2) / 2
 
-    def port_map(b_half: DomainMatrix, a_half: DomainMatrix) -> sympy.ImmutableMatrix:
-        left = ((b_half - a_half) * Q_inv).to_Matrix()
-        right = (b_half + a_half).to_Matrix()
-        return sympy.ImmutableMatrix(
-            sympy.Matrix.hstack(left, right).applyfunc(lambda x: half * x)
-        )
+    def port_map(
+        b_half: DomainMatrix, a_half: DomainMatrix, bq: DomainMatrix, aq: DomainMatrix, s: Any
+    ) -> sympy.ImmutableMatrix:
+        # W = (1/sqrt 2) ((M_b - M_a) Q^-1, M_b + M_a) with M = (b_half, a_half) / s
+        c_left = half / Qi.domain.to_sympy(s * s_Q)
+        c_right = half / Qi.domain.to_sympy(s)
+        left = (bq - aq).to_Matrix().applyfunc(lambda x: c_left * x)
+        right = (b_half + a_half).to_Matrix().applyfunc(lambda x: c_right * x)
+        return sympy.ImmutableMatrix(sympy.Matrix.hstack(left, right))
 
     eye = sympy.eye(nn)
     R_ext = sympy.ImmutableMatrix(
@@ -346,8 +372,8 @@ def derive_ports(model: PortedSystem) -> Ports:
         R_ext=R_ext,
         U=U,
         Y=Y,
-        W_B=port_map(U_b, U_a),
-        W_C=port_map(Y_b, Y_a),
+        W_B=port_map(U_b, U_a, UQ_b, UQ_a, s_U),
+        W_C=port_map(Y_b, Y_a, YQ_b, YQ_a, s_Y),
         Sigma=sigma_matrix(nn),
         identities=identities,
     )
