@@ -268,7 +268,7 @@ def check_simulation(
     end = float(t_end)
     if not (math.isfinite(end) and 0 < end <= MAX_T_END):
         raise NumericError(
-            f"t_end must be a positive number at most {MAX_T_END:g}; found {t_end} "
+            f"t_end must be a positive number at most {MAX_T_END:g}; found {end:g} "
             f"({_budget('MAX_T_END')})"
         )
     count = _integer(samples, "samples", NumericError)
