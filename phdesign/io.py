@@ -11,15 +11,20 @@ expression strings in ``z`` and the parameters, and omitted ``P_k`` are zero::
     [parameters]
     d = 0.2
     [matrices]
-    P0 = [["-d", 0], [0, 0]]
+    P0 = [["-d", 0], [0, 0]]                   # P0 may depend on z: [["-d*z", 0], [0, 0]]
     P2 = [[0, -1], [1, 0]]
     H  = [[1, 0], [0, 1]]
     [ports]
     inputs  = ["e1(0)", "e1'(0)", "e2(1)", "e2'(1)"]
-    outputs = ["e2'(0)", "-e2(0)", "e1'(1)", "-e1(1)"]
+    outputs = ["e2'(0)", "-e2(0)", "e1'(1)", "-e1(1)"]   # or "conjugate" (or omitted)
     [displacement]                             # optional
     component = 2
     integrations = 2
+    [feedback]                                 # optional: u4 = -k y4, a tip damper
+    inputs = [4]                               # 1-based indices into [ports].inputs
+    gain = [["k"]]                             # K, K + K^T >= 0
+    [units]                                    # optional: t, z, energy, displacement,
+    t = "s"                                    # parameters and states
 
 Every model phdesign can read it can write, and ``read(write(model)) == model``.
 
@@ -63,7 +68,7 @@ __all__ = [
 ]
 
 _REQUIRED = ("name", "interval", "order", "matrices", "ports")
-_OPTIONAL = ("description", "states", "parameters", "displacement")
+_OPTIONAL = ("description", "states", "parameters", "displacement", "feedback", "units")
 
 
 def read_model(path: str | os.PathLike[str]) -> BCPHS:
@@ -131,11 +136,24 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
     if "H" not in matrices:
         raise ModelFileError(f"{source}: [matrices] lacks H")
     bad_ports = sorted(set(ports) - {"inputs", "outputs"})
-    if bad_ports or "inputs" not in ports or "outputs" not in ports:
+    if bad_ports or "inputs" not in ports:
         raise ModelFileError(
-            f"{source}: [ports] must hold exactly inputs and outputs; found "
-            f"{', '.join(sorted(ports)) or 'nothing'}"
+            f"{source}: [ports] must hold exactly inputs and outputs (outputs may be "
+            f'"conjugate" or omitted); found {", ".join(sorted(ports)) or "nothing"}'
         )
+    outputs = ports.get("outputs", "conjugate")
+    if isinstance(outputs, str) and outputs != "conjugate":
+        raise ModelFileError(
+            f"{source}: [ports] outputs must be a list of trace expressions or "
+            f'"conjugate"; found {outputs!r}'
+        )
+    feedback = _table(data, "feedback", source) if "feedback" in data else None
+    if feedback is not None and set(feedback) != {"inputs", "gain"}:
+        raise ModelFileError(
+            f"{source}: [feedback] must hold exactly inputs and gain; found "
+            f"{', '.join(sorted(feedback)) or 'nothing'}"
+        )
+    units = _table(data, "units", source) if "units" in data else None
     displacement = None
     if "displacement" in data:
         table = _table(data, "displacement", source)
@@ -164,9 +182,11 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
         H=matrices["H"],
         parameters=parameters,
         inputs=ports["inputs"],
-        outputs=ports["outputs"],
+        outputs=outputs,
         state_names=tuple(states),
         displacement=displacement,
+        feedback=feedback,
+        units=units,
     )
 
 
@@ -214,13 +234,22 @@ def model_to_dict(model: BCPHS) -> dict[str, Any]:
     data["matrices"] = matrices
     data["ports"] = {
         "inputs": [format_expression(e, model.interval) for e in model.inputs],
-        "outputs": [format_expression(e, model.interval) for e in model.outputs],
+        "outputs": "conjugate"
+        if model.derived_outputs
+        else [format_expression(e, model.interval) for e in model.outputs],
     }
     if model.displacement is not None:
         data["displacement"] = {
             "component": model.displacement.component,
             "integrations": model.displacement.integrations,
         }
+    if model.feedback is not None:
+        data["feedback"] = {
+            "inputs": list(model.feedback.inputs),
+            "gain": rows(model.feedback.gain),
+        }
+    if model.units:
+        data["units"] = dict(model.units)
     return data
 
 

@@ -11,8 +11,11 @@ stays light.  New figures are plain :class:`~matplotlib.figure.Figure` objects o
 canvas (no display, no pyplot global state: safe in scripts, servers and tests); inside a
 Jupyter kernel they are made through pyplot instead, so that the inline backend shows them.
 
-Units: the built-in models are written in SI units (unit density and stiffness), so time
-is in s, position in m, deflection in m, energy in J and eigenvalues in 1/s.
+Units: labels carry the units the model states in its ``[units]`` section (through
+``SimulationResult.units``); a quantity with no stated unit gets a plain label.  A result
+built by hand (``units`` None) and the spectrum plots, which take bare arrays, use the
+SI convention of the built-in models: time in s, position and deflection in m, energy
+in J, eigenvalues in 1/s.
 
 The quantities drawn are the paper's (Section V):
 
@@ -47,6 +50,7 @@ import numpy as np
 
 from phdesign.errors import NumericError, OutputFileError
 from phdesign.io import check_output_path
+from phdesign.symbolic.units import with_unit
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
@@ -67,9 +71,6 @@ __all__ = [
     "plot_tip_error",
 ]
 
-TIME_LABEL = "time t [s]"
-ENERGY_LABEL = "energy [J]"
-POSITION_LABEL = "position z [m]"
 RE_LABEL = "Re λ [1/s]"
 IM_LABEL = "Im λ [rad/s]"
 ABSCISSA_LABEL = "spectral abscissa α [1/s]"
@@ -80,10 +81,18 @@ PLANT_COLOR, OBSERVER_COLOR, ERROR_COLOR = "tab:blue", "tab:orange", "tab:red"
 DESIGN_COLORS = ("goldenrod", "tab:orange", "tab:purple", "tab:green", "tab:brown", "tab:cyan")
 
 _FIELDS = {
-    "w": ("deflection w(z, t) [m]", "plant deflection w"),
-    "w_hat": ("estimate ŵ(z, t) [m]", "estimated deflection ŵ"),
-    "error": ("error w − ŵ [m]", "estimation error w − ŵ"),
+    "w": ("deflection w(z, t)", "plant deflection w"),
+    "w_hat": ("estimate ŵ(z, t)", "estimated deflection ŵ"),
+    "error": ("error w − ŵ", "estimation error w − ŵ"),
 }
+#: Units assumed for a result that states none (the built-in models are in SI).
+SI_UNITS = {"t": "s", "z": "m", "energy": "J", "displacement": "m"}
+
+
+def _label(result: Any, text: str, quantity: str) -> str:
+    """``text [unit]`` with the unit of ``quantity`` the result's model states."""
+    units = getattr(result, "units", None)
+    return with_unit(text, SI_UNITS if units is None else units, quantity)
 
 
 # ----------------------------------------------------------------------------- figures
@@ -195,8 +204,9 @@ def plot_hamiltonians(result: Any, axes: Sequence[Axes] | None = None) -> Figure
         ax_lin.plot(t, H_err, color=ERROR_COLOR, ls="-", label="H̃ (estimation error)")
         ax_log.semilogy(t, H_err, color=ERROR_COLOR, ls="-", label="H̃ (estimation error)")
     ax_log.semilogy(t, H, color=PLANT_COLOR, ls=":", label="H (plant)")
-    ax_lin.set(xlabel=TIME_LABEL, ylabel=ENERGY_LABEL, title="Hamiltonians")
-    ax_log.set(xlabel=TIME_LABEL, ylabel=f"{ENERGY_LABEL}, log scale", title="decay (log scale)")
+    time, energy = _label(result, "time t", "t"), _label(result, "energy", "energy")
+    ax_lin.set(xlabel=time, ylabel=energy, title="Hamiltonians")
+    ax_log.set(xlabel=time, ylabel=f"{energy}, log scale", title="decay (log scale)")
     for ax in (ax_lin, ax_log):
         ax.grid(True, alpha=0.3)
         ax.legend()
@@ -238,8 +248,10 @@ def plot_error_energy(
     if normalize:
         for level in levels:
             ax.axhline(level, color="gray", ls=":", lw=1, label=f"level {level:g}")
-    ylabel = "H̃(t) / H̃(0)  (log scale)" if normalize else f"H̃(t) {ENERGY_LABEL} (log scale)"
-    ax.set(xlabel=TIME_LABEL, ylabel=ylabel, title="estimation-error energy")
+    first = _items(results)[0][1]
+    energy = _label(first, "H̃(t)", "energy")
+    ylabel = "H̃(t) / H̃(0)  (log scale)" if normalize else f"{energy} (log scale)"
+    ax.set(xlabel=_label(first, "time t", "t"), ylabel=ylabel, title="estimation-error energy")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     return fig
@@ -296,9 +308,13 @@ def plot_deflection(
         t, z, data.T, shading="nearest", cmap=cmap or "RdBu_r", vmin=-scale, vmax=scale
     )
     mesh.set_label(_FIELDS[which][1])
-    ax.set(xlabel=TIME_LABEL, ylabel=POSITION_LABEL, title=_FIELDS[which][1])
+    ax.set(
+        xlabel=_label(result, "time t", "t"),
+        ylabel=_label(result, "position z", "z"),
+        title=_FIELDS[which][1],
+    )
     if colorbar:
-        fig.colorbar(mesh, ax=ax, label=_FIELDS[which][0])
+        fig.colorbar(mesh, ax=ax, label=_label(result, _FIELDS[which][0], "displacement"))
     return fig
 
 
@@ -320,7 +336,11 @@ def plot_tip(result: Any, ax: Axes | None = None) -> Figure:
     if getattr(result, "w_hat", None) is not None:
         w_hat = np.asarray(result.w_hat, dtype=float)
         ax.plot(t, w_hat[:, -1], color=OBSERVER_COLOR, ls="--", label=f"ŵ({where}, t) (observer)")
-    ax.set(xlabel=TIME_LABEL, ylabel="end-tip deflection [m]", title="end-tip position")
+    ax.set(
+        xlabel=_label(result, "time t", "t"),
+        ylabel=_label(result, "end-tip deflection", "displacement"),
+        title="end-tip position",
+    )
     ax.grid(True, alpha=0.3)
     ax.legend()
     return fig
@@ -362,7 +382,7 @@ def plot_tip_error(
     Figure
     """
     fig, ax = _axes(ax, figsize=(6, 4))
-    where = "b"
+    where, res = "b", None
     for k, (label, res) in enumerate(_items(results)):
         t = _require(res, "t", "no time grid")
         err = _field(res, "error")[:, -1]
@@ -370,8 +390,8 @@ def plot_tip_error(
         ax.plot(t, err, color=DESIGN_COLORS[k % len(DESIGN_COLORS)], label=label)
     ax.axhline(0.0, color="black", lw=0.6)
     ax.set(
-        xlabel=TIME_LABEL,
-        ylabel=f"w − ŵ at {where} [m]",
+        xlabel=_label(res, "time t", "t"),
+        ylabel=_label(res, f"w − ŵ at {where}", "displacement"),
         title="end-tip estimation error",
     )
     ax.grid(True, alpha=0.3)

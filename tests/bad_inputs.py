@@ -166,6 +166,80 @@ BAD_MODELS = [
         r"\[displacement\] must hold integers",
     ),
     ({"states": ["a"]}, ModelError, "state_names must hold 2 labels; found 1"),
+    # --- issue 13 (model): [feedback], P0(z), outputs = "conjugate", [units]
+    (
+        {"feedback": {"inputs": [5], "gain": [[1]]}},
+        ModelError,
+        r"feedback.inputs\[1\] = 5 is not an input of the model; expected an index in 1..4",
+    ),
+    (
+        {"feedback": {"inputs": [4, 4], "gain": [[1, 0], [0, 1]]}},
+        ModelError,
+        r"feedback.inputs\[2\] = 4 is repeated",
+    ),
+    (
+        {"feedback": {"inputs": [4], "gain": [[-1]]}},
+        ModelError,
+        r"K \+ K\^T must be positive semidefinite \(exact\); found eigenvalues \[-2\]",
+    ),
+    (
+        # K + Kᵀ = [[2, 3], [3, 2]] has eigenvalues -1 and 5: the skew part cannot hide it
+        {"feedback": {"inputs": [3, 4], "gain": [[1, 3], [0, 1]]}},
+        ModelError,
+        r"K \+ K\^T must be positive semidefinite \(exact\); found eigenvalues \[-1, 5\]",
+    ),
+    (
+        {"feedback": {"inputs": [4], "gain": [["-d"]]}},
+        ModelError,
+        r"K \+ K\^T must be positive semidefinite \(exact at the parameter defaults\)",
+    ),
+    ({"feedback": {"inputs": [4], "gain": [[1, 0]]}}, ModelError, "gain K must be square"),
+    ({"feedback": {"inputs": [4]}}, ModelFileError, r"\[feedback\] must hold exactly inputs"),
+    ({"feedback": {"inputs": 4, "gain": [[1]]}}, ModelError, "feedback.inputs must be a list"),
+    ({"feedback": {"inputs": [4], "gain": [["z"]]}}, ExpressionError, "z is not allowed"),
+    ({"feedback": {"inputs": [4], "gain": [["kk"]]}}, ExpressionError, "unknown symbol 'kk'"),
+    (
+        # 1/100 - (z - 1/2)² > 0 inside (0, 1): refused at the minimum of -(P0 + P0ᵀ)
+        {"matrices__P0": [["0.01 - (z - 0.5)**2", 0], [0, 0]]},
+        ModelError,
+        r"negative semidefinite on \[0, 1\]; found principal minor \{1\} of -\(P0 \+ "
+        r"P0\^T\) = 2\*z\*\*2 - 2\*z \+ 12/25 with minimum -1/50 at z = 1/2",
+    ),
+    (
+        # grid: P0 + P0ᵀ = 2 cos(3z) is largest at z = 0
+        {"matrices__P0": [["cos(3*z)", 0], [0, 0]]},
+        ModelError,
+        r"negative semidefinite on \[0, 1\]; found largest eigenvalue 2 at z = 0",
+    ),
+    ({"matrices__P0": [["-1/(z - 0.5)", 0], [0, 0]]}, ModelError, "has a pole there"),
+    (
+        {"matrices__P2": [[0, "-1 - z"], ["1 + z", 0]]},
+        ExpressionError,
+        "derived for constant P_1..P_N; only P0 and H may depend on z",
+    ),
+    (
+        # velocity and shear force at z = 0 are conjugate: both cannot be imposed
+        {"ports__inputs": ["e1(0)", "e2'(0)", "e2(1)", "e2'(1)"], "ports__outputs": "conjugate"},
+        PortError,
+        r"inputs are not admissible: .*inputs\[1\] = e1\(0\) and inputs\[2\] = e2'\(0\) "
+        "exchange power",
+    ),
+    (
+        {"ports__inputs": ["e1(0)", "e1'(0)", "e2(1)", "e2'(1) + e1(1)"], "ports__outputs": None},
+        PortError,
+        r"inputs\[4\] = e1\(1\) \+ e2'\(1\) carries power by itself.*close it with \[feedback\]",
+    ),
+    ({"ports__outputs": "conjugated"}, ModelFileError, "a list of trace expressions or"),
+    ({"units": "SI"}, ModelFileError, "units must be a table"),
+    ({"units": {"t": "$s$"}}, ModelError, r"units.t = '\$s\$' is malformed"),
+    ({"units": {"t": 1}}, ModelError, "units.t must be text"),
+    ({"units": {"z": "m" * 40}}, ModelError, "at most 32 characters"),
+    ({"units": {"speed": "m/s"}}, ModelError, "units: unknown quantity 'speed'"),
+    (
+        {"units": {"x1": "kg/s", "momentum": "kg/s"}},
+        ModelError,
+        "'momentum' and 'x1' name the same state",
+    ),
     # ---- issue 12: budgets before the work (each of these ran for minutes or GBs)
     (
         {"matrices__H": [["((z+1)**64)**64", 0], [0, 1]]},

@@ -76,6 +76,7 @@ def beams_toml(count: int) -> str:
 BEAM_SENSORS = "classify euler-bernoulli --sensors"
 BEAM_GAIN = "classify euler-bernoulli --sensors 3,4 --gain"
 SIM = "simulate wave --sensors 2"
+EXPORT = "export euler-bernoulli --sensors 3,4 --gain 0.1,1 --format json"
 COMMAND_ROWS = [
     # model selection and parameters
     row("ports nosuch", "unknown model 'nosuch'; expected a built-in model", ModelFileError),
@@ -258,6 +259,135 @@ COMMAND_ROWS = [
     row("tune wave", "tune: one of the arguments --sensors --cm is required", None),
     row("tune wave --sensors 5", "output index 5 is out of range; expected 1..2", ObserverError),
     row("tune wave --sensors 2 --starts 0", "--starts", NumericError),
+    # export and the sampled simulation (issue 15): checked before any work, nothing written
+    row(
+        f"{EXPORT} --dt 0 -o {{tmp}}/o.json", "--dt must be a finite positive number", NumericError
+    ),
+    row(f"{EXPORT} --dt=-1e-3 -o {{tmp}}/o.json", "seconds; found -0.001", NumericError),
+    row(f"{EXPORT} --dt nan -o {{tmp}}/o.json", "seconds; found nan", NumericError),
+    row(f"{EXPORT} --dt inf -o {{tmp}}/o.json", "seconds; found inf", NumericError),
+    row(f"{EXPORT} --dt 1ms -o {{tmp}}/o.json", "argument --dt: invalid float value: '1ms'", None),
+    row(
+        f"{EXPORT} --dt 1e-3 --sampler spline -o {{tmp}}/o.json",
+        "argument --sampler: invalid choice: 'spline' (choose from 'average', 'point')",
+        None,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --order 60 --plant-resolution 48 -o {{tmp}}/o.json",
+        "order 60 needs a verification plant of at least 120 states; the plant "
+        "(Galerkin degree 48) has 98",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --order 500 -o {{tmp}}/o.json",
+        "the largest for this model has 222 (Galerkin degree 110)",
+        NumericError,
+    ),
+    row(f"{EXPORT} --dt 1e-3 --order 0 -o {{tmp}}/o.json", "found 0", NumericError),
+    row(
+        f"{EXPORT} --dt 1e-3 --order 33 -o {{tmp}}/o.json",
+        "order 33 is not a Galerkin order of this model",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --order 34 --reduce modal -o {{tmp}}/o.json",
+        "cannot be combined with the modal reduction",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 -o {{tmp}}/o.json",
+        "output file .*o.json' exists; pass --force",
+        OutputFileError,
+        **{"o.json": "an earlier export"},
+    ),
+    row(
+        "export wave --sensors 2 --dt 1e-3 --format c -o {tmp}",
+        "output folder .* exists; pass --force to replace it",
+        OutputFileError,
+    ),
+    row(
+        "export wave --sensors 2 --dt 1e-3 --format c -o {tmp}/obs",
+        "is a file; --format c writes a folder",
+        OutputFileError,
+        obs="a file",
+    ),
+    row(f"{EXPORT} --dt 1e-3 -o {{tmp}}/none/o.json", "none' does not exist", OutputFileError),
+    row(
+        f"{EXPORT} --dt 1e-3 -o /proc/phdesign-export.json",
+        "cannot write '/proc/phdesign-export.json'",
+        OutputFileError,
+    ),
+    row(
+        "export wave --sensors 2 --dt 1e-3 --format c -o /proc/phdesign-export",
+        "cannot write '/proc/phdesign-export'",
+        OutputFileError,
+    ),
+    row(
+        "export euler-bernoulli --dt 1e-3 --format json -o {tmp}/o.json",
+        "export needs --sensors or --cm",
+        ObserverError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --at 2 -o {{tmp}}/o.json",
+        r"--at: expected numbers in \[0, 1\]; found '2'",
+        NumericError,
+    ),
+    row(
+        "export wave --sensors 2 --dt 1e-3 --at 1 --format json -o {tmp}/o.json",
+        "--at: model 'wave' has no displacement",
+        NumericError,
+    ),
+    row(f"{EXPORT} --dt 1e-3 --t-end 0 -o {{tmp}}/o.json", "--t-end must be", NumericError),
+    row(f"{EXPORT} --dt 1e-3 --output-tol=-1 -o {{tmp}}/o.json", "--output-tol", NumericError),
+    row(
+        "export wave --sensors 2 --dt 1e-3 -o {tmp}/o.json",
+        "the following arguments are required: --format",
+        None,
+    ),
+    row(f"{SIM} --dt 0", "--dt must be a finite positive number of seconds", NumericError),
+    row(f"{SIM} --sampler point", "--sampler needs --dt, the sampling period", NumericError),
+    row("simulate wave --dt 1e-3", "act on the observer: give --sensors or --cm", NumericError),
+    row(f"{SIM} --dt 1e-3 --scheme midpoint", "stepped exactly: drop --scheme", NumericError),
+    row(f"{SIM} --observer-resolution 0", "--observer-resolution must be positive", NumericError),
+    row(
+        f"{SIM} --method fd --resolution 20 --observer-resolution 10",
+        "is not contained in the plant's",
+        NumericError,
+    ),
+    # --- issue 13 (model): plant inputs --u, closed plants ([feedback])
+    row(
+        "simulate wave --u u3:sin(t)",
+        "--u: unknown input 'u3'; the model's inputs are u1, u2",
+        ParameterError,
+    ),
+    row(
+        "simulate wave-damper --u u2:t",
+        "unknown input 'u2'; the model's inputs are u1",
+        ParameterError,
+    ),
+    row("simulate wave --u u1", "--u item 'u1': expected 'u<i>: expression in t'", ParameterError),
+    row("simulate wave --u u1:1,u1:2", "--u: input 'u1' given twice", ParameterError),
+    row(
+        "simulate wave --u u1:sin(q*t)",
+        "unknown symbol 'q' in 'sin(q*t)'; expected t",
+        ExpressionError,
+    ),
+    row("simulate wave --u u1:__import__('os')", "unexpected character", ExpressionError),
+    row("simulate wave --u u1:log(t-1)", "--u: input u1 is not finite at t = 0", NumericError),
+    row(
+        "simulate wave --u u1:exp(exp(1000*t))", "input u1 is not finite at t = 0.01", NumericError
+    ),
+    row(
+        "classify wave-damper --sensors 2",
+        "output index 2 is out of range; expected 1..1",
+        ObserverError,
+    ),
+    row("spectrum wave-damper --param k=-1", "K + K^T must be positive semidefinite", ModelError),
+    row(
+        "spectrum beam-tip-damper --cm [[0,0,0,1]]",
+        r"expected \(q, 3\) but found \(1, 4\)",
+        ObserverError,
+    ),
     # ---- issue 12, item 2: every input's cost is bounded, refused before the work
     row(
         "spectrum wave --resolution 20000",

@@ -37,6 +37,7 @@ def test_define_from_code_equals_the_builtin():
         outputs=["e2'(0)", "-e2(0)", "e1'(1)", "-e1(1)"],
         state_names=["momentum", "curvature"],
         displacement=load_builtin("euler-bernoulli").displacement,
+        units=load_builtin("euler-bernoulli").unit_map,
     )
     assert beam == load_builtin("euler-bernoulli")
     assert dict(beam.parameters)[sympy.Symbol("d", real=True)] == sympy.Rational(1, 5)

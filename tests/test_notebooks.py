@@ -50,6 +50,7 @@ def test_there_are_four_notebooks():
         "02_euler_bernoulli_paper",
         "03_wave_and_timoshenko",
         "04_higher_order",
+        "06_implementation",
     ]
 
 

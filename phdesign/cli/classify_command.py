@@ -89,6 +89,12 @@ def _table(result: Any) -> str:
         f"sensors: {sensors}",
         f"gain L = {result.L.tolist()}",
     ]
+    if model.feedback is not None:  # the plant's own dampers: part of the error boundary
+        closed = ", ".join(f"u{i}" for i in model.feedback.inputs)
+        lines.append(
+            f"plant feedback: {closed} = -K y (K = {model.feedback.gain.tolist()}); "
+            "sensors index the remaining outputs"
+        )
     if result.assumption is not None:
         if result.assumption.holds:
             parts = "; ".join(p.label(model.state_names) for p in result.assumption.partitions)

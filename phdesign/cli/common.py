@@ -92,7 +92,7 @@ def sensor_matrix_from_args(args: argparse.Namespace, model: BCPHS) -> Any:
     """Return ``C_m`` from ``--sensors`` or ``--cm``, or ``None`` when neither is given."""
     from phdesign.symbolic import observer
 
-    n_outputs = model.order * model.size
+    n_outputs = model.n_ports  # the external outputs ([feedback] closes the others)
     if args.sensors is not None:
         return observer.parse_sensors(args.sensors, n_outputs)
     if args.cm is not None:

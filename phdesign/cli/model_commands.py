@@ -87,6 +87,11 @@ def _ports(args: argparse.Namespace) -> int:
     model = load_model(args)
     ports = derive_ports(model)
     identities = {key: float(ports.identities[key]) for key in IDENTITY_NAMES}
+    closed = None
+    if model.feedback is not None:  # the plant's own [feedback]: the closed ports too
+        from phdesign.symbolic.feedback import closed_ports
+
+        closed = closed_ports(model)
     if args.json:
         emit_json(
             {
@@ -98,6 +103,7 @@ def _ports(args: argparse.Namespace) -> int:
                 "W_B": ports.W_B,
                 "W_C": ports.W_C,
                 "identities": identities,
+                "feedback": None if closed is None else closed.to_dict(),
             }
         )
         return 0
@@ -114,5 +120,7 @@ def _ports(args: argparse.Namespace) -> int:
         sympy.pretty(ports.W_C),
         *(f"max |{key}| = {value:g}" for key, value in identities.items()),
     ]
+    if closed is not None:
+        lines.append(str(closed))
     emit("\n".join(lines))
     return 0

@@ -28,6 +28,7 @@ from phdesign.cli.common import (
     sensor_matrix_from_args,
     warn,
 )
+from phdesign.cli.export_command import add_sampling_arguments, sampled_simulation
 from phdesign.errors import NumericError
 
 __all__ = ["register"]
@@ -70,6 +71,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "--x0", metavar="EXPRS", help="plant initial state, e.g. 'x1: 0, x2: z - 0.9'"
     )
     sim.add_argument("--xhat0", metavar="EXPRS", help="observer initial state (default zero)")
+    sim.add_argument(
+        "--u", metavar="EXPRS", help="plant inputs in t, e.g. 'u2: sin(2*t)' (others zero)"
+    )
     sim.add_argument("--t-end", type=float, default=5.0, metavar="T", help="final time")
     sim.add_argument("--samples", type=int, default=501, help="output samples on [0, T]")
     sim.add_argument("--scheme", choices=("expm", "midpoint"), default="expm")
@@ -79,6 +83,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument("--output", "-o", metavar="FILE", help="write to FILE instead of stdout")
     sim.add_argument("--plot", metavar="FILE", help="also draw a summary figure to FILE")
     sim.add_argument("--force", action="store_true", help="overwrite existing files")
+    add_sampling_arguments(sim)  # --dt, --sampler, --observer-resolution (export command)
     sim.set_defaults(handler=_simulate)
 
     tn = subparsers.add_parser("tune", help="observer gain minimizing the converged abscissa")
@@ -146,7 +151,11 @@ def _spectrum(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from phdesign.numeric.bridge import initial_state_function
+    import warnings
+
+    import numpy as np
+
+    from phdesign.numeric.bridge import initial_state_function, input_function
     from phdesign.numeric.simulate import simulate
     from phdesign.outputs import OutputFiles
 
@@ -159,12 +168,9 @@ def _simulate(args: argparse.Namespace) -> int:
         raise NumericError("--xhat0 needs an observer: give --sensors or --cm")
     x0 = initial_state_function(args.x0, nm, model=model)
     xh0 = initial_state_function(args.xhat0, nm, model=model)
+    u = input_function(args.u, nm, model=model)
     # every output is checked before the (possibly long) simulation and written together
     # at the end: on any failure or interrupt none is left, and no temporary file
-    import warnings
-
-    import numpy as np
-
     with OutputFiles(args.force) as out, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         fmt = None
@@ -176,7 +182,8 @@ def _simulate(args: argparse.Namespace) -> int:
             fmt = check_plot_path(args.plot, args.force)
             out.add(args.plot)
         with np.errstate(all="ignore"):  # an overflow is refused below, with one line
-            res = simulate(
+            # a sampled or lower-order observer (--dt, --sampler, --observer-resolution)
+            res = sampled_simulation(args, nm, C_m, L, x0, xh0) or simulate(
                 nm,
                 C_m,
                 L,
@@ -187,6 +194,7 @@ def _simulate(args: argparse.Namespace) -> int:
                 method=args.method,
                 resolution=args.resolution,
                 scheme=args.scheme,
+                u=u,
             )
         check_finite_series(res)
         if args.json:
@@ -200,7 +208,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
             from phdesign.plots import plot_simulation
 
-            # the name is a title, not mathtext: "$\frac{1}{$" must not break the plot
+            # the name is a title, not mathtext: "$\\frac{1}{$" must not break the plot
             figure = plot_simulation(res, title=model.name.replace("$", r"\$"))
             picture = io.BytesIO()
             figure.savefig(picture, format=fmt, dpi=110)

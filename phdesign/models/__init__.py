@@ -1,12 +1,14 @@
 """The built-in models, shared by tests, notebooks and the command line.
 
-``wave``, ``timoshenko``, ``euler-bernoulli`` and ``airy`` are defined in DESIGN.md;
-each is stored as a TOML model file in this package.
+``wave``, ``timoshenko``, ``euler-bernoulli`` and ``airy`` are the paper's and the
+design notes' models; ``wave-damper`` (the string with a damper at z = 1) and
+``beam-tip-damper`` (the clamped beam with a damper at its tip) close one input with a
+boundary feedback (``[feedback]``).  Each is stored as a TOML model file in this package.
 
 Examples
 --------
 >>> builtin_names()
-('airy', 'euler-bernoulli', 'timoshenko', 'wave')
+('airy', 'beam-tip-damper', 'euler-bernoulli', 'timoshenko', 'wave', 'wave-damper')
 >>> load_builtin("euler-bernoulli").order
 2
 """

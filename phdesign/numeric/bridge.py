@@ -22,19 +22,22 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import numpy as np
 
-from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
+from phdesign.errors import ExpressionError, ModelError, NumericError, ParameterError, check_shape
 from phdesign.symbolic.ports import trace_index
 
 __all__ = [
     "DisplacementSpec",
     "NumericModel",
+    "PortFeedback",
     "constant_H",
     "gain_to_numeric",
     "initial_state_function",
+    "input_function",
     "to_numeric",
     "trace_index",
 ]
@@ -53,6 +56,18 @@ class DisplacementSpec:
 
 
 @dataclass(frozen=True)
+class PortFeedback:
+    r"""The plant's own boundary feedback :math:`u_c = -K y_c`, with numbers.
+
+    ``closed`` are 0-based indices into the open ports (the rows of ``U`` and ``Y``);
+    ``gain`` is :math:`K` (``c x c``, :math:`K + K^\top \succeq 0`).
+    """
+
+    closed: tuple[int, ...]
+    gain: np.ndarray = field(compare=False)
+
+
+@dataclass(frozen=True)
 class NumericModel:
     r"""A BC-PHS with every parameter substituted: the numeric layer's input.
 
@@ -63,7 +78,12 @@ class NumericModel:
 
     with ``P[k]`` of shape ``(n, n)``, ``U`` and ``Y`` of shape ``(N n, 2 N n)`` over the
     trace vector ``v`` (see the module docstring) and ``H(z)`` a vectorized callable that
-    maps an array of ``m`` points to an array of shape ``(m, n, n)``.
+    maps an array of ``m`` points to an array of shape ``(m, n, n)``.  ``U`` and ``Y`` are
+    the open plant's ports; with ``feedback`` the inputs ``feedback.closed`` are closed by
+    :math:`u_c = -K y_c` and the model's external ports are the others (:attr:`n_ports`
+    of them): every discretization returns the closed plant.  When :math:`P_0` depends on
+    z, ``P0`` is its vectorized callable and ``P[0]`` is filled with NaN, so that no code
+    can use a constant :math:`P_0` by mistake (:meth:`P0_at` serves both cases).
 
     Parameters
     ----------
@@ -85,6 +105,13 @@ class NumericModel:
         How to reconstruct a physical displacement, if the model has one.
     H_constant : bool
         True when H does not depend on z (lets discretizations skip quadrature work).
+    feedback : PortFeedback or None
+        The plant's own boundary feedback.
+    P0 : callable or None
+        ``P0(z) -> (m, n, n)`` when :math:`P_0` depends on z, else ``None``.
+    units : mapping
+        Units stated by the model (``t``, ``z``, ``energy``, ``displacement``, parameters,
+        states).
     """
 
     name: str
@@ -101,6 +128,9 @@ class NumericModel:
     displacement: DisplacementSpec | None = None
     H_constant: bool = False
     extra: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    feedback: PortFeedback | None = None
+    P0: Callable[[np.ndarray], np.ndarray] | None = field(default=None, compare=False)
+    units: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         a, b = (float(s) for s in self.interval)
@@ -119,17 +149,40 @@ class NumericModel:
         object.__setattr__(self, "P", tuple(np.asarray(Pk, dtype=float) for Pk in self.P))
         object.__setattr__(self, "U", np.asarray(self.U, dtype=float))
         object.__setattr__(self, "Y", np.asarray(self.Y, dtype=float))
+        if self.feedback is not None:
+            closed = self.feedback.closed
+            if len(set(closed)) != len(closed) or not all(0 <= c < N * n for c in closed):
+                raise ModelError(
+                    f"feedback must close distinct ports in 0..{N * n - 1}; found {closed}"
+                )
+            check_shape("feedback gain K", np.asarray(self.feedback.gain), (len(closed),) * 2)
+        m = self.n_ports
         if not self.input_labels:
-            object.__setattr__(self, "input_labels", tuple(f"u{i + 1}" for i in range(N * n)))
+            object.__setattr__(self, "input_labels", tuple(f"u{i + 1}" for i in range(m)))
         if not self.output_labels:
-            object.__setattr__(self, "output_labels", tuple(f"y{i + 1}" for i in range(N * n)))
+            object.__setattr__(self, "output_labels", tuple(f"y{i + 1}" for i in range(m)))
         if not self.state_names:
             object.__setattr__(self, "state_names", tuple(f"x{i + 1}" for i in range(n)))
 
     @property
     def n_ports(self) -> int:
-        """Number of inputs (= number of outputs) ``N n``."""
-        return self.order * self.size
+        """Number of external inputs (= outputs): ``N n`` less the closed ones."""
+        closed = 0 if self.feedback is None else len(self.feedback.closed)
+        return self.order * self.size - closed
+
+    @property
+    def P0_constant(self) -> bool:
+        """True when :math:`P_0` does not depend on z (then ``P[0]`` holds it)."""
+        return self.P0 is None
+
+    def P0_at(self, z: np.ndarray | float) -> np.ndarray:
+        """Evaluate :math:`P_0` at the points ``z``; returns shape ``(m, n, n)``."""
+        zz = np.atleast_1d(np.asarray(z, dtype=float))
+        n = self.size
+        if self.P0 is None:
+            return np.broadcast_to(self.P[0], (zz.size, n, n)).copy()
+        out = np.asarray(self.P0(zz), dtype=float)
+        return np.broadcast_to(out, (zz.size, n, n)).copy()
 
     def H_at(self, z: np.ndarray | float) -> np.ndarray:
         """Evaluate H at the points ``z``; returns shape ``(m, n, n)``."""
@@ -208,7 +261,6 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         When a parameter is unknown or a symbol other than z stays free (the message
         names them).
     """
-    from phdesign.symbolic.evaluation import evaluate
     from phdesign.symbolic.expressions import exact_matrix, exact_number
     from phdesign.symbolic.model import Z
     from phdesign.symbolic.ports import derive_ports
@@ -230,29 +282,38 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
     P = [
         np.array(subs_matrix(f"P{k}", Pk, False).evalf(), dtype=float)
         for k, Pk in enumerate(model.P)
+        if k > 0
     ]
+    P0s = subs_matrix("P0", model.P[0], True)
+    P0fun = None
+    if Z in P0s.free_symbols:
+        P0fun = _matrix_function(P0s, n)
+        P.insert(0, np.full((n, n), np.nan))
+    else:
+        P.insert(0, np.array(P0s.evalf(), dtype=float))
     Hs = subs_matrix("H", model.H, True)
     ports = derive_ports(model)
     U = np.array(subs_matrix("U", ports.U, False).evalf(), dtype=float)
     Y = np.array(subs_matrix("Y", ports.Y, False).evalf(), dtype=float)
 
     H_constant = Z not in Hs.free_symbols
-    if H_constant:
-        Hfun = constant_H(np.array(Hs.evalf(), dtype=float))
-    else:
-        entries = [Hs[i, j] for i in range(n) for j in range(n)]
-
-        def Hfun(z: np.ndarray) -> np.ndarray:
-            zz = np.atleast_1d(np.asarray(z, dtype=float))
-            vals = [evaluate(entry, zz) for entry in entries]  # no code generation
-            return np.stack(vals, axis=-1).reshape(zz.size, n, n)
-
+    Hfun = constant_H(np.array(Hs.evalf(), dtype=float)) if H_constant else _matrix_function(Hs, n)
+    feedback = None
+    if getattr(model, "feedback", None) is not None:
+        K = np.array(subs_matrix("feedback gain K", model.feedback.gain, False).evalf(), float)
+        if np.min(np.linalg.eigvalsh(K + K.T)) < -1e-12 * max(1.0, float(np.max(np.abs(K)))):
+            raise ParameterError(
+                "feedback gain K + K^T is not positive semidefinite for these parameter values"
+            )
+        feedback = PortFeedback(tuple(model.feedback.closed), K)
     disp = None
     d = getattr(model, "displacement", None)
     if d is not None:
         disp = DisplacementSpec(int(d.component), int(d.integrations))
-    in_labels = tuple(str(e) for e in model.inputs)
-    out_labels = tuple(str(e) for e in model.outputs)
+    inputs = getattr(model, "external_inputs", model.inputs)
+    outputs = getattr(model, "external_outputs", model.outputs)
+    in_labels = tuple(str(e) for e in inputs)
+    out_labels = tuple(str(e) for e in outputs)
     nm = NumericModel(
         name=str(model.name),
         interval=(float(a_s), float(b_s)),
@@ -267,6 +328,9 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         state_names=tuple(model.state_names),
         displacement=disp,
         H_constant=H_constant,
+        feedback=feedback,
+        P0=P0fun,
+        units=dict(getattr(model, "units", ())),
     )
     # H must be positive definite after substitution (the symbolic check used defaults).
     zs = np.linspace(nm.interval[0], nm.interval[1], 33)
@@ -277,7 +341,37 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         raise ParameterError(
             "H is not positive definite on the interval for these parameter values"
         )
+    P0v = nm.P0_at(zs)
+    if not np.all(np.isfinite(P0v)):
+        raise ParameterError("P0 is not finite on the interval for these parameter values")
+    if np.max(np.linalg.eigvalsh(P0v + P0v.transpose(0, 2, 1))) > 1e-12 * max(
+        1.0, float(np.max(np.abs(P0v)))
+    ):
+        raise ParameterError(
+            "P0 + P0^T is not negative semidefinite on the interval for these parameter values"
+        )
     return nm
+
+
+def _evaluate_at(expr: Any, variable: Any, t: float) -> Any:
+    """``expr`` at ``variable = t`` (the safe evaluator: no code generation)."""
+    from phdesign.symbolic.evaluation import evaluate
+
+    return evaluate(expr, np.array(t), variable=variable)
+
+
+def _matrix_function(matrix: Any, n: int) -> Callable[[np.ndarray], np.ndarray]:
+    """Return a vectorized callable ``f(z) -> (m, n, n)`` of a sympy matrix in z."""
+    from phdesign.symbolic.evaluation import evaluate
+
+    entries = [matrix[i, j] for i in range(n) for j in range(n)]
+
+    def values(z: np.ndarray) -> np.ndarray:
+        zz = np.atleast_1d(np.asarray(z, dtype=float))
+        vals = [evaluate(entry, zz) for entry in entries]  # no code generation
+        return np.stack(vals, axis=-1).reshape(zz.size, n, n)
+
+    return values
 
 
 def gain_to_numeric(matrix: Any, name: str = "L") -> np.ndarray:
@@ -417,3 +511,85 @@ def _parse_z_expression(text: str, model: Any, parameters: Mapping[str, Any] | N
     if free:
         raise ParameterError(_free_symbols_message(f"initial state expression {text!r}", free))
     return expr
+
+
+def input_function(
+    text: str | None,
+    nm: NumericModel,
+    parameters: Mapping[str, Any] | None = None,
+    model: Any = None,
+) -> Callable[[float], np.ndarray] | None:
+    """Parse plant inputs ``'u2: sin(2*t), u1: 0.1'`` into ``u(t) -> (n_ports,)``.
+
+    Syntax: comma-separated ``u<i>: expression`` items, ``i`` a 1-based index into the
+    model's external inputs and the expression a formula in the time ``t`` and the
+    model's parameters, read by the symbolic layer's safe parser (never evaluated as
+    Python).  Inputs not named are zero; ``None`` or empty text gives ``None`` (no input).
+
+    Raises
+    ------
+    ParameterError
+        On an unknown or repeated input name, or a missing ``:``.
+    ExpressionError
+        On a malformed expression or an unknown symbol (named in the message).
+
+    Examples
+    --------
+    >>> P = (np.zeros((1, 1)), np.ones((1, 1)))
+    >>> U = np.array([[0.0, 1.0]]); Y = np.array([[1.0, 0.0]])
+    >>> nm = NumericModel("t", (0.0, 1.0), 1, 1, P, constant_H([[1.0]]), U, Y)
+    >>> input_function("u1: 2*t", nm)(0.25)
+    array([0.5])
+    """
+    if text is None or not text.strip():
+        return None
+    import sympy
+
+    from phdesign.errors import ExpressionError
+    from phdesign.symbolic.parser import check_text, parse
+
+    check_text(text, "--u")
+    values = _parameter_values(model, parameters) if model is not None else {}
+    by_name = {str(s): v for s, v in values.items()}
+    time = sympy.Symbol("t", real=True)
+
+    def resolve(name: str, expression: str) -> Any:
+        if name == "t":
+            return time
+        if name in by_name:
+            return by_name[name]
+        known = ", ".join(["t", *sorted(by_name)])
+        raise ExpressionError(f"unknown symbol {name!r} in {expression!r}; expected {known}")
+
+    m = nm.n_ports
+    names = {f"u{i + 1}": i for i in range(m)}
+    funcs: dict[int, Callable[[float], Any]] = {}
+    for part in _split_top_level(text):
+        if ":" not in part:
+            raise ParameterError(
+                f"--u item {part.strip()!r}: expected 'u<i>: expression in t', e.g. 'u1: sin(2*t)'"
+            )
+        key, body = (x.strip() for x in part.split(":", 1))
+        if key not in names:
+            expected = ", ".join(names) if names else "none (every input is closed)"
+            raise ParameterError(f"--u: unknown input {key!r}; the model's inputs are {expected}")
+        if names[key] in funcs:
+            raise ParameterError(f"--u: input {key!r} given twice")
+        try:
+            expr = parse(body, resolve)
+        except ExpressionError as error:
+            raise ExpressionError(f"--u {key}: {error}") from None
+        funcs[names[key]] = partial(_evaluate_at, expr, time)
+
+    def u(t: float) -> np.ndarray:
+        out = np.zeros(m)
+        for i, f in funcs.items():
+            try:
+                out[i] = float(f(float(t)))
+            except (ArithmeticError, ValueError, TypeError):
+                out[i] = np.nan
+            if not np.isfinite(out[i]):
+                raise NumericError(f"--u: input u{i + 1} is not finite at t = {t:g}")
+        return out
+
+    return u

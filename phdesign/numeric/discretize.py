@@ -37,6 +37,7 @@ from __future__ import annotations
 from phdesign import limits
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.feedback import close_plant_feedback
 from phdesign.numeric.phs import DiscretePHS, feedback_matrix
 
 __all__ = ["METHODS", "DiscretePHS", "discretize", "feedback_matrix"]
@@ -69,9 +70,14 @@ def discretize(
         # like p^(4N-3); degree 16 already resolves airy's slow modes to 1e-5 while the
         # time stepping keeps its energy balance (degree 40 loses it: tests/test_honesty.py)
         default = 40 if nm.order <= 2 else 16
-        return galerkin(nm, default if resolution is None else int(resolution))
+        # the model's own [feedback] closes the open discretization (numeric.feedback)
+        return close_plant_feedback(
+            galerkin(nm, default if resolution is None else int(resolution))
+        )
     if method == "fd":
         from phdesign.numeric.staggered import staggered_fd
 
-        return staggered_fd(nm, 70 if resolution is None else int(resolution))
+        return close_plant_feedback(
+            staggered_fd(nm, 70 if resolution is None else int(resolution))
+        )
     raise NumericError(f"unknown discretization method {method!r}; expected one of {METHODS}")

@@ -87,6 +87,7 @@ from numpy.polynomial import legendre as leg
 
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel, trace_index
+from phdesign.numeric.distributed import galerkin_p0
 from phdesign.numeric.phs import DiscretePHS
 
 __all__ = [
@@ -207,10 +208,14 @@ def galerkin(nm: NumericModel, degree: int, basis: str | None = None) -> Discret
     V0 = legendre_basis(zq, p, 0, iv) * s
     A = np.zeros((n * nb, n * nb))
     for k, Pk in enumerate(nm.P):
-        if not np.any(Pk):
+        if not np.any(Pk) or (k == 0 and not nm.P0_constant):  # P0(z): quadrature below
             continue
         Dk = (V0 * wq[:, None]).T @ (legendre_basis(zq, p, k, iv) * s)
         A += np.kron(Pk, Dk)
+    if not nm.P0_constant:  # P0(z): its weak form by Gauss quadrature (numeric.distributed)
+        zd, wd = _gauss(2 * nb + 20, iv)
+        A0 = galerkin_p0(nm, zd, wd, legendre_basis(zd, p, 0, iv) * s)
+        A += A0
     # Gram matrix of the working basis: diag(s^2), exactly.
     G = np.diag(s * s)
     # Mass matrix: exact for constant H, Gauss rule with extra points else.
@@ -234,8 +239,11 @@ def galerkin(nm: NumericModel, degree: int, basis: str | None = None) -> Discret
     UT, YT = nm.U @ T, nm.Y @ T
     JR = A - YT.T @ UT
     J = 0.5 * (JR - JR.T)
-    sym0 = 0.5 * (nm.P[0] + nm.P[0].T)
-    R = -np.kron(sym0, G)
+    if nm.P0_constant:
+        sym0 = 0.5 * (nm.P[0] + nm.P[0].T)
+        R = -np.kron(sym0, G)
+    else:
+        R = -0.5 * (A0 + A0.T)
     B = YT.T.copy()
     sym_defect = 0.5 * (JR + JR.T) + R
     info = {

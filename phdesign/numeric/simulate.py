@@ -75,6 +75,9 @@ class SimulationResult:
         Displacement of the plant and its estimate (models with a displacement only).
     states, states_hat : ndarray (nt, dim)
         Discrete effort coordinates (kept for exports and checks; not written to files).
+    units : mapping or None
+        Units the model states (``t``, ``z``, ``energy``, ``displacement``, ...), for labels
+        and JSON; ``None`` for a result built by hand (plots then assume SI).
     """
 
     t: np.ndarray
@@ -93,6 +96,7 @@ class SimulationResult:
     states_hat: np.ndarray | None = field(default=None, repr=False)
     info: dict[str, Any] = field(default_factory=dict, repr=False)
     warnings: tuple[str, ...] = ()
+    units: dict[str, str] | None = field(default=None, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary of the time series (no discrete states)."""
@@ -113,6 +117,7 @@ class SimulationResult:
             out["w_hat"] = None if self.w_hat is None else self.w_hat.tolist()
         out.update({k: v for k, v in self.info.items() if isinstance(v, (int, float, str))})
         out["warnings"] = list(self.warnings)
+        out["units"] = dict(self.units or {})
         return out
 
     def to_json(self) -> str:
@@ -423,4 +428,5 @@ def simulate(
             **{f"energy_balance_residual_{k.replace(' ', '_')}": v for k, v in audits.items()},
         },
         warnings=warnings,
+        units=dict(nm.units),
     )

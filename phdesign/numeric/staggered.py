@@ -35,6 +35,7 @@ import numpy as np
 
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel, trace_index
+from phdesign.numeric.distributed import staggered_p0
 from phdesign.numeric.phs import DiscretePHS
 
 __all__ = ["staggered_fd"]
@@ -149,14 +150,8 @@ def staggered_fd(nm: NumericModel, m: int) -> DiscretePHS:
     J0 = np.zeros((dim, dim))
     J0[sq, sp] = Kpq
     J0[sp, sq] = -Kpq.T
-    # P0 in weak form; cross blocks through the averaging Pi (q values at p nodes).
-    P0 = nm.P[0]
-    K0 = np.zeros((dim, dim))
-    K0[sp, sp] = np.kron(np.diag(wp), P0[np.ix_(p, p)])
-    K0[sq, sq] = np.kron(np.diag(wq), P0[np.ix_(q, q)])
-    WPi = np.diag(wp) @ Pi
-    K0[sp, sq] = np.kron(WPi, P0[np.ix_(p, q)])
-    K0[sq, sp] = np.kron(WPi.T, P0[np.ix_(q, p)])
+    # P0(z) in weak form, nodal; cross blocks through the averaging Pi (q values at p nodes)
+    K0 = staggered_p0(nm, (p, q), (zp, zq), (wp, wq), Pi)
     J = J0 + 0.5 * (K0 - K0.T)
     R = -0.5 * (K0 + K0.T)
     if np.min(np.linalg.eigvalsh(R)) < -1e-12 * max(1.0, np.max(np.abs(R))):

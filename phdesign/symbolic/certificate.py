@@ -24,7 +24,11 @@ with the pencil reduced to a complement of :math:`\ker\mathrm{LHS}`.
 C_m\tilde y = 0\}`, and there :math:`C_m^\top L C_m \tilde y = 0`, so
 :math:`v = T^{-1}(0; \tilde y)`: the kernel does not depend on :math:`L`.  The
 variant holds iff :math:`S\,T^{-1}(0; N_C) = 0` for a basis :math:`N_C` of
-:math:`\ker C_m` — an exact, gain-free test.  (For unit-row sensors, :math:`N_C`
+:math:`\ker C_m` — an exact, gain-free test.  (With the plant's own feedback,
+:math:`C_m` and :math:`L` stand for the factor :math:`(C_d, L_d)` of
+:attr:`~phdesign.symbolic.observer.ErrorSystem.dissipation`, and the witness is
+:math:`v = K_{\mathcal K} n` in the basis of :math:`\mathcal K`, which equals
+:math:`T^{-1}(0; n)` whenever :math:`G n = 0`.)  (For unit-row sensors, :math:`N_C`
 is the unit vectors of the unmeasured outputs: an unmeasured output :math:`j`
 whose column of :math:`T^{-1}` touches a selected trace breaks the variant.)
 A failing variant returns that :math:`v` as witness: LHS = 0, RHS > 0.
@@ -142,19 +146,18 @@ def certify(
     -------
     Certificate
     """
-    nn = es.order * es.size
     rows = list(selected)
+    # LHS = ½ zᵀ(L + Lᵀ)z, z = C ỹ: the observer's sensors, and the plant's own dampers
+    C_m, L = es.dissipation
     # ---- decision (exact, independent of L)
-    W = es.T_inv[:, nn:]
-    for n_c in _nullspace(es.C_m):
-        v = W * n_c
+    for n_c in _nullspace(C_m):
+        v = es.K * n_c  # the admissible trace with error output n_c (= T⁻¹(0; n_c) when G n_c = 0)
         zero = [vanishes(v[i]) for i in rows]
         if not all(zero):
             free = tuple(i for i, z in zip(rows, zero, strict=True) if not z)
             witness = tuple(sympy.S.Zero if vanishes(x) else sympy.expand(x) for x in v)
             return Certificate(False, None, None, False, witness, free, "exact")
     # ---- constant
-    C_m, L = es.C_m, es.L
     right_inverse = C_m.T * (C_m * C_m.T).inv()
     K_m = sympy.ImmutableMatrix(es.K * right_inverse)
     SK = K_m.extract(rows, list(range(K_m.cols))) if rows else sympy.zeros(0, K_m.cols)

@@ -45,7 +45,7 @@ Examples
 --------
 >>> import sympy
 >>> from phdesign.symbolic.expressions import Z
->>> check_definite(sympy.Matrix([[1 + Z**2]]), (0, 1), name="H")
+>>> check_definite(sympy.Matrix([[1 + Z**2]]), "H", (0, 1))
 'H > 0: exact on [a, b] at the parameter defaults (leading principal minors)'
 """
 
@@ -87,30 +87,33 @@ _KINDS = {
 
 def check_definite(
     matrix: sympy.MatrixBase,
-    interval: Sequence[Any],
-    *,
     name: str,
+    interval: Sequence[Any],
+    defaults: Mapping[sympy.Symbol, sympy.Expr] | None = None,
+    *,
     sign: int = 1,
     strict: bool = True,
-    defaults: Mapping[sympy.Symbol, sympy.Expr] | None = None,
 ) -> str:
     r"""Check that ``sign * matrix`` is positive (semi)definite on ``interval``.
+
+    The one definiteness checker of the model: :math:`\mathcal H \succ 0`,
+    :math:`P_0 + P_0^\top \preceq 0` and a feedback's :math:`K + K^\top \succeq 0`.
 
     Parameters
     ----------
     matrix : sympy matrix
         Symmetric, entries in :math:`z` and the parameters.
-    interval : (a, b)
-        Exact endpoints.
     name : str
         The matrix as the user knows it (``"H"``, ``"P0 + P0^T"``).
+    interval : (a, b)
+        Exact endpoints.
+    defaults : mapping, optional
+        Parameter values substituted before the check.
     sign : {1, -1}
         ``1`` for :math:`\succ 0` / :math:`\succeq 0`, ``-1`` for :math:`\prec 0` /
         :math:`\preceq 0`.
     strict : bool
         Definite (``True``) or semidefinite (``False``).
-    defaults : mapping, optional
-        Parameter values substituted before the check.
 
     Returns
     -------
@@ -261,13 +264,13 @@ class _Check:
 
     def fail_minor(self, rows: tuple[int, ...], p: sympy.Poly, denominator: sympy.Poly) -> None:
         minor = sympy.cancel(p.as_expr() / denominator.as_expr())
-        of = self.name if self.sign == 1 else f"-({self.name})"
+        of = "" if self.sign == 1 else f" of -({self.name})"
         label = "leading principal minor" if self.strict else "principal minor"
-        index = len(rows) if self.strict else "{" + ",".join(str(i + 1) for i in rows) + "}"
+        index = len(rows) if self.strict else "{" + ", ".join(str(i + 1) for i in rows) + "}"
         raise ModelError(
-            f"{self.name} must be {self.kind} on {self.where}; found {label} {index}"
-            f"{'' if self.sign == 1 else ' of ' + of} = {_brief(minor)} with minimum "
-            f"{_minimum(minor, self.a, self.b)} (parameter defaults)"
+            f"{self.name} must be {self.kind} on {self.where}; found {label} {index}{of} = "
+            f"{_brief(minor)} with minimum {_minimum(minor, self.a, self.b)} "
+            "(parameter defaults)"
         )
 
     # ------------------------------------------------------------------ numeric path
@@ -291,7 +294,7 @@ class _Check:
             if not np.all(np.isfinite(V)):
                 bad = z[~np.all(np.isfinite(V), axis=(1, 2))][0]
                 raise ModelError(
-                    f"{self.name} must be bounded on [{a}, {b}]; found a non-finite entry "
+                    f"{self.name} must be bounded on {self.where}; found a non-finite entry "
                     f"at z = {bad:g}"
                 )
             return np.linalg.eigvalsh(V)[:, 0]
@@ -334,7 +337,7 @@ class _Check:
                 break
             lo, hi = np.concatenate([lo, mid]), np.concatenate([mid, hi])
         raise ModelError(
-            f"{self.name} must be {self.kind} on [{a}, {b}]; it could not be proved near "
+            f"{self.name} must be {self.kind} on {self.where}; it could not be proved near "
             f"z = {lo[0]:g} (smallest eigenvalue found {lowest[0]:.6g} at z = {lowest[1]:g}; "
             "interval bounds of the entries do not separate it from 0) (parameter defaults)"
         )
@@ -345,6 +348,8 @@ class _Check:
         tolerance = _SEMIDEFINITE_TOLERANCE * scale
         order = np.argsort(lam)[:8]
         lowest = (float(lam[order[0]]), float(grid[order[0]]))
+        if lowest[0] < -tolerance:  # fails on the grid already: name that point
+            self.fail_point(*lowest)
         for k in order:  # refine around the smallest grid values (golden-section search)
             left, right = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
             for _ in range(60):
@@ -366,7 +371,7 @@ class _Check:
     def fail_point(self, value: float, z: float) -> None:
         which, shown = ("smallest", value) if self.sign == 1 else ("largest", -value)
         raise ModelError(
-            f"{self.name} must be {self.kind} on [{float(self.a)}, {float(self.b)}]; found "
+            f"{self.name} must be {self.kind} on {self.where}; found "
             f"{which} eigenvalue {shown:.6g} at z = {z:g} (parameter defaults)"
         )
 
@@ -404,17 +409,25 @@ def _sign_at(p: sympy.Poly, point: sympy.Expr) -> int:
 
 
 def _minimum(minor: sympy.Expr, a: sympy.Expr, b: sympy.Expr) -> str:
-    """Return the exact minimum for small degrees, else a sampled one (for the message)."""
-    numerator, denominator = sympy.fraction(minor)
-    if sympy.degree(numerator, Z) + sympy.degree(denominator, Z) <= 4:
-        from sympy.calculus.util import minimum
+    """Return the minimum on [a, b] and where it is attained (for the message).
 
-        try:
-            return str(minimum(minor, Z, sympy.Interval(a, b)))
-        except (NotImplementedError, ValueError):
-            pass
-    points = [a + (b - a) * sympy.Rational(k, 400) for k in range(401)]
-    lowest = min(points, key=lambda c: float(minor.subs(Z, c)))
+    Exact (endpoints and the derivative's real roots) for small degrees, else sampled.
+    """
+    numerator, denominator = sympy.fraction(sympy.cancel(minor))
+    if sympy.degree(numerator, Z) + sympy.degree(denominator, Z) <= 8:
+        slope = sympy.fraction(sympy.cancel(sympy.diff(minor, Z)))[0]
+        points = [a, b]
+        if slope.has(Z):
+            points += [r for r in sympy.Poly(slope, Z).real_roots() if a < r < b]
+        value, point = min(
+            ((sympy.cancel(minor.subs(Z, c)), c) for c in points),
+            key=lambda item: float(sympy.N(item[0], 30)),
+        )
+        shown = value if value.is_Rational else sympy.N(value, 6)
+        where = point if point.is_Rational else sympy.N(point, 6)
+        return f"{shown} at z = {where}"
+    samples = [a + (b - a) * sympy.Rational(k, 400) for k in range(401)]
+    lowest = min(samples, key=lambda c: float(minor.subs(Z, c)))
     return f"about {float(minor.subs(Z, lowest)):.6g} at z = {float(lowest):g}"
 
 

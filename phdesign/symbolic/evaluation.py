@@ -58,13 +58,15 @@ def _unknown(node: sympy.Basic) -> ExpressionError:
     )
 
 
-def evaluate(expr: sympy.Basic, z: np.ndarray) -> np.ndarray:
-    """Evaluate ``expr`` (in ``z`` only) at the points ``z``; returns an array like ``z``.
+def evaluate(expr: sympy.Basic, z: np.ndarray, variable: sympy.Symbol = Z) -> np.ndarray:
+    """Evaluate ``expr`` (in ``variable``, z by default) at the points ``z``.
+
+    Returns an array shaped like ``z``.
 
     Raises
     ------
     ExpressionError
-        If ``expr`` holds a symbol other than z or an operation outside the grammar.
+        If ``expr`` holds another symbol or an operation outside the grammar.
     """
     points = np.asarray(z, dtype=float)
     memo: dict[sympy.Basic, Any] = {}
@@ -72,7 +74,7 @@ def evaluate(expr: sympy.Basic, z: np.ndarray) -> np.ndarray:
     def value(node: sympy.Basic) -> Any:
         if node in memo:
             return memo[node]
-        if node == Z:
+        if node == variable:
             result: Any = points
         elif node.is_number:
             result = float(sympy.N(node, 17))

@@ -5,8 +5,13 @@ r"""The validated symbolic boundary-controlled port-Hamiltonian system (BC-PHS).
     \partial_t x(z, t) = \sum_{k=0}^{N} P_k \partial_z^k\big(\mathcal H(z) x(z, t)\big),
     \qquad z \in [a, b],
 
-with :math:`P_k^\top = (-1)^{k-1} P_k` for :math:`k \ge 1`, :math:`P_0 + P_0^\top \preceq 0`,
-:math:`P_N` invertible and :math:`\mathcal H(z) = \mathcal H(z)^\top \succeq m I > 0`.
+with constant :math:`P_k^\top = (-1)^{k-1} P_k` for :math:`k \ge 1`,
+:math:`P_0(z) + P_0(z)^\top \preceq 0` on :math:`[a, b]`, :math:`P_N` invertible and
+:math:`\mathcal H(z) = \mathcal H(z)^\top \succeq m I > 0`.  Only :math:`P_0` and
+:math:`\mathcal H` may depend on :math:`z`: the boundary port variables (:math:`Q`,
+:math:`W_B`, :math:`W_C`) and the energy identity are derived for constant
+:math:`P_1, \dots, P_N`, while :math:`P_0` enters the energy balance only through
+:math:`\tfrac12\int e^\top (P_0 + P_0^\top) e\,dz \le 0`, pointwise in :math:`z`.
 Inputs and outputs are linear combinations of the boundary traces
 :math:`\partial_z^k e_i(a)`, :math:`\partial_z^k e_i(b)` of the effort :math:`e = \mathcal H x`
 (:mod:`phdesign.symbolic.expressions`), checked against the port identities of
@@ -35,6 +40,7 @@ import sympy
 
 from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
 from phdesign.limits import check_model_dimensions, check_parameter_count
+from phdesign.symbolic.conjugate import conjugate_outputs
 from phdesign.symbolic.definiteness import check_definite
 from phdesign.symbolic.expressions import (
     Z,
@@ -49,9 +55,16 @@ from phdesign.symbolic.expressions import (
     trace_of,
     vanishes,
 )
+from phdesign.symbolic.feedback import (
+    Feedback,
+    check_feedback,
+    external_indices,
+    feedback_from_mapping,
+)
 from phdesign.symbolic.parser import check_expression
+from phdesign.symbolic.units import check_units
 
-__all__ = ["BCPHS", "Displacement", "Z"]
+__all__ = ["BCPHS", "Displacement", "Feedback", "Z", "parse_matrix"]
 
 
 @dataclass(frozen=True)
@@ -88,19 +101,27 @@ class BCPHS:
     size : int
         The number ``n`` of state components.
     P : tuple of sympy.ImmutableMatrix
-        ``P_0 .. P_N``, constant ``n x n`` matrices (entries may hold parameters).
+        ``P_0 .. P_N``, ``n x n`` (entries may hold parameters); only ``P_0`` may depend
+        on ``z``.
     H : sympy.ImmutableMatrix
         The energy density :math:`\mathcal H(z)`, in ``z`` and the parameters.
     parameters : tuple of (sympy.Symbol, sympy.Expr)
         Parameters and their exact default values.
     inputs, outputs : tuple of sympy.Expr
-        ``N n`` trace expressions each.
+        ``N n`` trace expressions each: the ports of the open plant, before any feedback.
     state_names : tuple of str
         One label per state component.
     description : str
         Free text.
     displacement : Displacement or None
         How to recover a displacement field, when the model has one.
+    feedback : Feedback or None
+        The plant's own boundary feedback :math:`u_c = -K y_c` (``[feedback]``); the
+        external ports are then :attr:`external_inputs` and :attr:`external_outputs`.
+    units : tuple of (str, str)
+        Units stated for parameters, states and ``t``, ``z``, ``energy``, ``displacement``.
+    derived_outputs : bool
+        The outputs were derived from the inputs (``outputs = "conjugate"``).
     checks : tuple of str
         How each condition was verified (exactly, or at the defaults on a grid).
     """
@@ -117,6 +138,9 @@ class BCPHS:
     state_names: tuple[str, ...] = ()
     description: str = ""
     displacement: Displacement | None = None
+    feedback: Feedback | None = None
+    units: tuple[tuple[str, str], ...] = ()
+    derived_outputs: bool = False
     checks: tuple[str, ...] = field(default=(), compare=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -135,11 +159,13 @@ class BCPHS:
         P: Mapping[int, Any] | Sequence[Any],
         H: Any,
         inputs: Sequence[str | sympy.Expr],
-        outputs: Sequence[str | sympy.Expr],
+        outputs: Sequence[str | sympy.Expr] | str | None = None,
         parameters: Mapping[str, object] | None = None,
         state_names: Sequence[str] = (),
         description: str = "",
         displacement: Displacement | None = None,
+        feedback: Feedback | Mapping[str, Any] | None = None,
+        units: Mapping[str, str] | None = None,
     ) -> BCPHS:
         r"""Build a model from numbers, strings and nested lists.
 
@@ -156,8 +182,11 @@ class BCPHS:
             in the parameters.
         H : matrix
             :math:`\mathcal H(z)`; entries are numbers or strings in ``z`` and the parameters.
-        inputs, outputs : sequence of str
-            Trace expressions, ``N n`` of each.
+        inputs : sequence of str
+            Trace expressions, ``N n`` of them.
+        outputs : sequence of str, "conjugate" or None, optional
+            Trace expressions, ``N n`` of them; ``"conjugate"`` or ``None`` derives the
+            power-conjugate outputs of the inputs (:mod:`phdesign.symbolic.conjugate`).
         parameters : mapping {name: default value}, optional
             Parameters that may appear in ``P``, ``H`` and the ports.
         state_names : sequence of str, optional
@@ -166,6 +195,11 @@ class BCPHS:
             Free text.
         displacement : Displacement, optional
             How to recover a displacement field.
+        feedback : Feedback or {"inputs": [...], "gain": [[...]]}, optional
+            Close inputs with :math:`u_c = -K y_c`, :math:`K + K^\top \succeq 0`
+            (:mod:`phdesign.symbolic.feedback`).
+        units : mapping {quantity: unit}, optional
+            Units of parameters, states, ``t``, ``z``, ``energy``, ``displacement``.
         """
         if not isinstance(order, int) or isinstance(order, bool) or order < 1:
             raise ModelError(f"order must be an integer N >= 1; found {order!r}")
@@ -182,7 +216,7 @@ class BCPHS:
             for p, v in (parameters or {}).items()
         )
         endpoints = _interval(interval)
-        H_matrix = _matrix(H, "H", names, allow_z=True)
+        H_matrix = parse_matrix(H, "H", names, allow_z=True)
         size = H_matrix.shape[0]
         P_by_order = dict(P) if isinstance(P, Mapping) else dict(enumerate(P))
         for k in P_by_order:
@@ -191,19 +225,27 @@ class BCPHS:
                     f"P{k} is not a matrix of an order-{order} model; expected P0..P{order}"
                 )
         P_matrices = tuple(
-            _matrix(P_by_order[k], f"P{k}", names, allow_z=False)
+            parse_matrix(P_by_order[k], f"P{k}", names, allow_z=True)
             if k in P_by_order
             else sympy.ImmutableMatrix.zeros(size, size)
             for k in range(order + 1)
         )
+        derived = outputs is None or outputs == "conjugate"
         ports = {}
         for kind, texts in (("inputs", inputs), ("outputs", outputs)):
+            if kind == "outputs" and derived:
+                continue
             if isinstance(texts, str) or not isinstance(texts, Sequence):
-                raise ModelError(f"{kind} must be a list of trace expressions; found {texts!r}")
+                expected = ' or "conjugate"' if kind == "outputs" else ""
+                raise ModelError(
+                    f"{kind} must be a list of trace expressions{expected}; found {texts!r}"
+                )
             ports[kind] = tuple(
                 _port(t, endpoints, order, size, names, what=f"{kind}[{i + 1}]")
                 for i, t in enumerate(texts)
             )
+        if derived:  # derived in validation, once P_1..P_N are known to be valid
+            ports["outputs"] = ()
         return cls(
             name=name,
             interval=endpoints,
@@ -217,9 +259,32 @@ class BCPHS:
             state_names=tuple(state_names),
             description=description,
             displacement=displacement,
+            feedback=None if feedback is None else feedback_from_mapping(feedback, names),
+            units=_unit_pairs(units),
+            derived_outputs=derived,
         )
 
     # ------------------------------------------------------------------ views
+    @property
+    def n_ports(self) -> int:
+        """Number of external inputs (= outputs): ``N n`` less the closed ones."""
+        return len(external_indices(self.order * self.size, self.feedback))
+
+    @property
+    def external_inputs(self) -> tuple[sympy.Expr, ...]:
+        """The inputs left open by :attr:`feedback` (all inputs without feedback)."""
+        return tuple(self.inputs[j] for j in external_indices(len(self.inputs), self.feedback))
+
+    @property
+    def external_outputs(self) -> tuple[sympy.Expr, ...]:
+        """The outputs conjugate to :attr:`external_inputs`."""
+        return tuple(self.outputs[j] for j in external_indices(len(self.outputs), self.feedback))
+
+    @property
+    def unit_map(self) -> dict[str, str]:
+        """The stated units, keyed by quantity."""
+        return dict(self.units)
+
     @property
     def parameter_defaults(self) -> dict[sympy.Symbol, sympy.Expr]:
         """The parameters' default values, keyed by symbol."""
@@ -274,6 +339,16 @@ def _port(
     )
 
 
+def _unit_pairs(units: object) -> tuple[tuple[Any, Any], ...]:
+    if units is None:
+        return ()
+    if not isinstance(units, Mapping):
+        raise ModelError(
+            f"units must be a mapping {{quantity: unit}} such as {{'t': 's'}}; found {units!r}"
+        )
+    return tuple(units.items())
+
+
 def _interval(interval: Sequence[object]) -> tuple[sympy.Expr, sympy.Expr]:
     if isinstance(interval, str) or not isinstance(interval, Sequence) or len(interval) != 2:
         raise ModelError(f"interval must be a pair [a, b]; found {interval!r}")
@@ -283,9 +358,10 @@ def _interval(interval: Sequence[object]) -> tuple[sympy.Expr, sympy.Expr]:
     return a, b
 
 
-def _matrix(
-    value: Any, name: str, parameters: Sequence[str], allow_z: bool
+def parse_matrix(
+    value: Any, name: str, parameters: Sequence[str], allow_z: bool = False
 ) -> sympy.ImmutableMatrix:
+    """Read a square matrix of numbers or expression strings (rows of a list) exactly."""
     if isinstance(value, sympy.MatrixBase):
         rows = value.tolist()
     elif isinstance(value, Sequence) and not isinstance(value, str):
@@ -347,17 +423,18 @@ def _validate(model: BCPHS) -> list[str]:
     for s, value in model.parameters:
         if not value.is_number:
             raise ParameterError(f"default of parameter {s} must be a number; found {value}")
+    _check_constant_P(model.P)
     for k, P_k in enumerate(model.P):
-        _check_symbols(P_k, f"P{k}", symbols)
-    _check_symbols(model.H, "H", symbols | {Z})
+        check_symbols(P_k, f"P{k}", symbols | ({Z} if k == 0 else set()))
+    check_symbols(model.H, "H", symbols | {Z})
     for matrix, label in ((model.H, "H"), *((P_k, f"P{k}") for k, P_k in enumerate(model.P))):
         for (i, j), entry in sympy.ImmutableMatrix(matrix).todok().items():
             check_expression(entry, f"{label}[{i + 1},{j + 1}]")
 
     defaults = model.parameter_defaults
     for k, P_k in enumerate(model.P):
-        _check_finite(P_k, f"P{k}", defaults)
-    _check_finite(model.H, "H", defaults)
+        check_finite(P_k, f"P{k}", defaults)
+    check_finite(model.H, "H", defaults)
     for k in range(1, N + 1):
         sign = (-1) ** (k - 1)
         residual = (model.P[k].T - sign * model.P[k]).applyfunc(canonical)
@@ -368,21 +445,15 @@ def _validate(model: BCPHS) -> list[str]:
                 f"{residual.tolist()}"
             )
     checks.append("P_k symmetry: exact")
+    P0_sym = model.P[0] + model.P[0].T
     checks.append(
-        check_definite(
-            model.P[0] + model.P[0].T,
-            model.interval,
-            name="P0 + P0^T",
-            sign=-1,
-            strict=False,
-            defaults=defaults,
-        )
+        check_definite(P0_sym, "P0 + P0^T", model.interval, defaults, sign=-1, strict=False)
     )
     checks.append(_check_invertible(model.P[N], f"P{N}", defaults))
     residual = (model.H - model.H.T).applyfunc(canonical)
     if not all(vanishes(x) for x in residual):
         raise ModelError(f"H must be symmetric; found H - H^T = {residual.tolist()}")
-    checks.append(check_definite(model.H, model.interval, name="H", defaults=defaults))
+    checks.append(check_definite(model.H, "H", model.interval, defaults))
     if model.displacement is not None:
         d = model.displacement
         if not (1 <= d.component <= n) or d.integrations < 0:
@@ -390,11 +461,21 @@ def _validate(model: BCPHS) -> list[str]:
                 f"displacement must name a component in 1..{n} and integrations >= 0; "
                 f"found component {d.component}, integrations {d.integrations}"
             )
-    _check_ports(model, symbols)
+    object.__setattr__(
+        model, "units", check_units(model.units, model.parameter_names, model.state_names)
+    )
+    _check_ports(model, symbols, ("inputs",))
+    if model.derived_outputs and not model.outputs:
+        outputs = conjugate_outputs(model.P, N, model.inputs, model.interval, defaults)
+        object.__setattr__(model, "outputs", outputs)
+        checks.append("outputs: derived, the least-norm power conjugates of the inputs")
+    _check_ports(model, symbols, ("outputs",))
     from phdesign.symbolic.ports import derive_ports  # ports depend on a built model
 
     derive_ports(model)
     checks.append("port identities: exact")
+    if model.feedback is not None:
+        checks += check_feedback(model, symbols, defaults)
     return checks
 
 
@@ -432,7 +513,21 @@ def _check_state_names(names: Sequence[object], n: int) -> None:
 _COMPONENT_NAME = re.compile(r"([xe])(\d+)")
 
 
-def _check_finite(
+def _check_constant_P(P: Sequence[sympy.MatrixBase]) -> None:
+    """Refuse z in P_1..P_N, saying why (only P_0 and H may vary along the domain)."""
+    for k, P_k in enumerate(P):
+        if k == 0:
+            continue
+        for (i, j), entry in sympy.ImmutableMatrix(P_k).todok().items():
+            if Z in entry.free_symbols:
+                raise ExpressionError(
+                    f"P{k}[{i + 1},{j + 1}] = {entry}: the spatial variable z is not allowed in "
+                    f"P{k}: the boundary port variables (Q, W_B, W_C) and the energy identity "
+                    "are derived for constant P_1..P_N; only P0 and H may depend on z"
+                )
+
+
+def check_finite(
     matrix: sympy.MatrixBase, name: str, defaults: Mapping[sympy.Symbol, sympy.Expr]
 ) -> None:
     """Refuse entries that are infinite or undefined at the parameter defaults (1/rho, rho = 0)."""
@@ -448,15 +543,17 @@ def _check_finite(
             )
 
 
-def _check_symbols(matrix: sympy.MatrixBase, name: str, allowed: set[sympy.Symbol]) -> None:
+def check_symbols(matrix: sympy.MatrixBase, name: str, allowed: set[sympy.Symbol]) -> None:
+    """Refuse symbols other than ``allowed`` (parameters, and z where it may appear)."""
     unknown = sorted(str(s) for s in matrix.free_symbols - allowed)
     if unknown:
         raise ExpressionError(f"{name} holds unknown symbols {', '.join(unknown)}")
 
 
-def _check_ports(model: BCPHS, symbols: set[sympy.Symbol]) -> None:
+def _check_ports(model: BCPHS, symbols: set[sympy.Symbol], kinds: Sequence[str]) -> None:
     expected = model.order * model.size
-    for kind, exprs in (("inputs", model.inputs), ("outputs", model.outputs)):
+    for kind in kinds:
+        exprs = getattr(model, kind)
         if len(exprs) != expected:
             raise ModelError(
                 f"{kind}: an order-{model.order} model of size {model.size} needs "

@@ -29,6 +29,13 @@ parametrized by the error output :math:`\tilde y` itself, for every gain: no ran
 decision on :math:`L` is involved, so a symbolic gain cannot hide a generic-rank
 answer here.  :math:`\dim \mathcal K = Nn` is still checked.
 
+A plant with its own boundary feedback :math:`u_c = -K y_c` (``[feedback]``,
+:mod:`phdesign.symbolic.feedback`) is observed through its external outputs: ``C_m``
+picks among them, and the error boundary condition over all :math:`Nn` open ports is
+:math:`\tilde u = -G\tilde y` with :math:`G = E_c^\top K E_c + E_r^\top C_m^\top L C_m
+E_r`, whose symmetric part (the plant's dampers and the observer's injection) is the
+left-hand side of every proposition.
+
 Examples
 --------
 >>> sensor_matrix([3, 4], n_outputs=4)
@@ -58,6 +65,7 @@ from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.errors import ExpressionError, ObserverError, check_shape
 from phdesign.symbolic.expressions import exact_matrix, exact_number, vanishes
+from phdesign.symbolic.feedback import error_dissipation, plant_feedback
 from phdesign.symbolic.model import BCPHS
 
 __all__ = [
@@ -357,9 +365,15 @@ class ErrorSystem:
     C_m, L : sympy.ImmutableMatrix
         Sensors and gain.
     boundary_matrix : sympy.ImmutableMatrix
-        :math:`U + C_m^\top L C_m Y`, whose kernel is :math:`\mathcal K`.
+        :math:`U + G Y` (:math:`G = C_m^\top L C_m` without plant feedback), whose kernel
+        is :math:`\mathcal K`.
     K : sympy.ImmutableMatrix
         Basis of :math:`\mathcal K`, :math:`2Nn \times Nn`, coordinates :math:`\tilde y`.
+    dissipation_C, dissipation_L : sympy.ImmutableMatrix or None
+        The left-hand side of the propositions as
+        :math:`\tfrac12 (C_d\tilde y)^\top (L_d + L_d^\top) (C_d\tilde y)`
+        (:func:`phdesign.symbolic.feedback.error_dissipation`); ``None`` means
+        :math:`C_d = C_m`, :math:`L_d = L` (no plant feedback).
     """
 
     order: int
@@ -371,11 +385,25 @@ class ErrorSystem:
     L: sympy.ImmutableMatrix
     boundary_matrix: sympy.ImmutableMatrix
     K: sympy.ImmutableMatrix
+    dissipation_C: sympy.ImmutableMatrix | None = None
+    dissipation_L: sympy.ImmutableMatrix | None = None
+
+    @property
+    def dissipation(self) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix]:
+        r"""Return :math:`(C_d, L_d)`, the factor of the propositions' left-hand side.
+
+        LHS :math:`= \tfrac12 (C_d\tilde y)^\top(L_d + L_d^\top)(C_d\tilde y)`, with
+        :math:`C_d` of full row rank and :math:`L_d + L_d^\top \succ 0`.
+        """
+        if self.dissipation_C is None or self.dissipation_L is None:
+            return self.C_m, self.L
+        return self.dissipation_C, self.dissipation_L
 
     @property
     def lhs_matrix(self) -> sympy.ImmutableMatrix:
-        r"""Return :math:`M = C_m^\top \mathrm{sym}(L) C_m` (LHS is its quadratic form in ỹ)."""
-        return sympy.ImmutableMatrix(self.C_m.T * (self.L + self.L.T) / 2 * self.C_m)
+        r"""Return :math:`M = C_d^\top \mathrm{sym}(L_d) C_d` (LHS is its quadratic form in ỹ)."""
+        C_d, L_d = self.dissipation
+        return sympy.ImmutableMatrix(C_d.T * (L_d + L_d.T) / 2 * C_d)
 
 
 def error_system(
@@ -385,8 +413,20 @@ def error_system(
     Y: sympy.MatrixBase,
     C_m: sympy.MatrixBase,
     L: sympy.MatrixBase,
+    feedback: tuple[tuple[int, ...], sympy.ImmutableMatrix] | None = None,
 ) -> ErrorSystem:
     r"""Build the error boundary condition and the admissible traces.
+
+    Parameters
+    ----------
+    order, size : int
+        :math:`N` and :math:`n`.
+    U, Y : sympy matrix
+        The open plant's ports over the traces (``Nn x 2Nn``).
+    C_m, L : sympy matrix
+        Sensors over the external outputs and their gain.
+    feedback : (closed 0-based indices, K), optional
+        The plant's own boundary feedback (:func:`~phdesign.symbolic.feedback.plant_feedback`).
 
     Raises
     ------
@@ -394,12 +434,12 @@ def error_system(
         If ``C_m`` or ``L`` is malformed, or :math:`\dim \mathcal K \ne Nn`.
     """
     nn = order * size
-    C_m = _check_cm(C_m, nn)
+    C_m = _check_cm(C_m, nn - (0 if feedback is None else len(feedback[0])))
     L = _check_gain(L, C_m.rows)
     U = _safe_matrix(U, "U")
     Y = _safe_matrix(Y, "Y")
     T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
-    G = C_m.T * L * C_m
+    G, C_d, L_d = error_dissipation(nn, C_m, L, feedback)
     boundary = sympy.ImmutableMatrix(U + G * Y)
     K = sympy.ImmutableMatrix(T_inv * sympy.Matrix.vstack(-G, sympy.eye(nn)))
     # dim K = Nn: K has Nn columns and its lower part through Y is the identity
@@ -410,7 +450,9 @@ def error_system(
             f"the admissible traces K = ker(U + C_mᵀ L C_m Y) must have dimension Nn = {nn}; "
             "the port matrices are inconsistent"
         )
-    return ErrorSystem(order, size, U, Y, T_inv, C_m, L, boundary, K)
+    if feedback is None:
+        return ErrorSystem(order, size, U, Y, T_inv, C_m, L, boundary, K)
+    return ErrorSystem(order, size, U, Y, T_inv, C_m, L, boundary, K, C_d, L_d)
 
 
 @dataclass(frozen=True)
@@ -420,9 +462,9 @@ class ObserverDesign:
     Parameters
     ----------
     model : BCPHS
-        The plant.
+        The plant (with its own boundary feedback, if any).
     C_m : sympy matrix
-        ``q x Nn``, full row rank.
+        ``q x n_ports`` over the model's external outputs, full row rank.
     L : sympy matrix
         ``q x q`` with :math:`L + L^\top > 0` (checked), or diagonal positive symbols.
     """
@@ -432,8 +474,7 @@ class ObserverDesign:
     L: sympy.ImmutableMatrix
 
     def __post_init__(self) -> None:
-        nn = self.model.order * self.model.size
-        object.__setattr__(self, "C_m", _check_cm(self.C_m, nn))
+        object.__setattr__(self, "C_m", _check_cm(self.C_m, self.model.n_ports))
         object.__setattr__(self, "L", _check_gain(self.L, self.C_m.rows))
 
     @property
@@ -444,4 +485,6 @@ class ObserverDesign:
     def error_system(self) -> ErrorSystem:
         """Return the :class:`ErrorSystem` of this design."""
         U, Y = port_matrices(self.model)
-        return error_system(self.model.order, self.model.size, U, Y, self.C_m, self.L)
+        return error_system(
+            self.model.order, self.model.size, U, Y, self.C_m, self.L, plant_feedback(self.model)
+        )

@@ -84,6 +84,8 @@ class PortedSystem(Protocol):
     def outputs(self) -> tuple[sympy.Expr, ...]: ...
     @property
     def parameter_defaults(self) -> dict[sympy.Symbol, sympy.Expr]: ...
+    @property
+    def interval(self) -> tuple[sympy.Expr, sympy.Expr]: ...
 
 
 __all__ = [
@@ -91,6 +93,7 @@ __all__ = [
     "Ports",
     "coefficient_matrix",
     "derive_ports",
+    "extended_matrices",
     "q_matrix",
     "trace_index",
     "trace_list",
@@ -150,6 +153,25 @@ def q_matrix(P: Sequence[sympy.MatrixBase], order: int) -> sympy.ImmutableMatrix
         ]
         rows.append(sympy.Matrix.hstack(*blocks))
     return sympy.ImmutableMatrix(sympy.Matrix.vstack(*rows))
+
+
+def extended_matrices(
+    P: Sequence[sympy.MatrixBase], order: int
+) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix]:
+    r"""Return :math:`R_{ext} = \tfrac{1}{\sqrt2}[[Q, -Q], [I, I]]` and its inverse."""
+    Q = q_matrix(P, order)
+    (exact,) = _exact_matrices(Q)
+    Q_inv = exact.inv().to_Matrix()
+    eye = sympy.eye(Q.rows)
+    half = sympy.sqrt(2) / 2
+
+    def blocks(top_left: Any, top_right: Any, bottom_left: Any) -> sympy.ImmutableMatrix:
+        M = sympy.Matrix.vstack(
+            sympy.Matrix.hstack(top_left, top_right), sympy.Matrix.hstack(bottom_left, eye)
+        )
+        return sympy.ImmutableMatrix(M.applyfunc(lambda x: half * x))
+
+    return blocks(Q, -Q, eye), blocks(Q_inv, eye, -Q_inv)
 
 
 def coefficient_matrix(
@@ -343,6 +365,12 @@ def derive_ports(model: PortedSystem) -> Ports:
         scale = Qi.domain.to_sympy(scales[key])
         residual = residuals[key].to_Matrix().applyfunc(lambda x, c=scale: canonical(x / c))
         largest = _max_abs(residual, defaults)
+        if key == "WB_Sigma_WBt":  # the inputs alone are wrong: say so, naming them
+            from phdesign.symbolic.conjugate import inadmissible_inputs_message
+
+            raise PortError(
+                inadmissible_inputs_message(residual, model.inputs, model.interval, defaults)
+            )
         at = " at the parameter defaults" if residual.free_symbols else ""
         raise PortError(
             f"port identity {statements[key]} fails: largest residual |entry| = "

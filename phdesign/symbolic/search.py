@@ -19,6 +19,16 @@ exact zero pattern, never from a tolerance.
 
 A set is *minimal* for a verdict when it has that verdict and no proper subset has.
 
+A plant with its own boundary feedback (``[feedback]``) is searched over its external
+outputs.  The closed ports are dissipated by the plant's dampers whatever the sensors,
+so the combinatorial decision stays exact: an unmeasured external output :math:`j` still
+gives the trace vector :math:`t_j = T^{-1}(0; e_j)` (its column of :math:`G` is zero), and
+when :math:`K + K^\top` is singular the directions of its kernel give fixed trace
+vectors that must vanish on :math:`\mathcal S` for the variant to hold at all.  The
+constants then come from :func:`~phdesign.symbolic.certificate.certify` on each
+subset's error system (float path): the closed ports' block :math:`K` is not diagonal
+in general.
+
 Examples
 --------
 >>> from phdesign.models import load_builtin
@@ -42,6 +52,7 @@ import sympy
 from phdesign import limits
 from phdesign.errors import ObserverError
 from phdesign.symbolic.assumption import Partition, check_assumption
+from phdesign.symbolic.feedback import external_indices, plant_feedback
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import _inverse, diagonal_values, port_matrices, vanishes
 from phdesign.symbolic.propositions import VARIANTS, Variant
@@ -64,12 +75,16 @@ class Candidate:
         Indices in :math:`v` of the traces the right-hand side selects.
     required : tuple of int
         1-based outputs that must be measured (:math:`B_{\text{variant}}`).
+    attainable : bool
+        False when no sensor set makes it hold (a direction the plant's own feedback
+        leaves undamped breaks it).
     """
 
     variant: Variant
     partition: Partition | None
     selected: tuple[int, ...]
     required: tuple[int, ...]
+    attainable: bool = True
 
     @property
     def name(self) -> str:
@@ -182,7 +197,9 @@ def candidates(model: BCPHS) -> tuple[Candidate, ...]:
     nn = order * size
     U, Y = port_matrices(model)
     T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
-    support = [{i for i in range(2 * nn) if not vanishes(T_inv[i, nn + j])} for j in range(nn)]
+    external = external_indices(nn, model.feedback)
+    support = [{i for i in range(2 * nn) if not vanishes(T_inv[i, nn + j])} for j in external]
+    undamped = _undamped_directions(model, T_inv)
     partitions: tuple[Partition | None, ...] = (None,)
     found: list[Candidate] = []
     assumption = None
@@ -200,9 +217,32 @@ def candidates(model: BCPHS) -> tuple[Candidate, ...]:
         for partition in partitions:
             blocks = None if partition is None else (partition.x1, partition.x2)
             selected = variant.indices(order, size, blocks)
-            required = tuple(j + 1 for j in range(nn) if support[j] & set(selected))
-            found.append(Candidate(variant, partition, selected, required))
+            required = tuple(j + 1 for j in range(len(external)) if support[j] & set(selected))
+            attainable = not any(set(selected) & s for s in undamped)
+            found.append(Candidate(variant, partition, selected, required, attainable))
     return tuple(found)
+
+
+def _undamped_directions(model: BCPHS, T_inv: sympy.MatrixBase) -> list[set[int]]:
+    r"""Return the supports of the undamped trace vectors of the plant's own feedback.
+
+    :math:`v = T^{-1}(-E_c^\top K w; E_c^\top w)` for :math:`w \in \ker(K + K^\top)`.
+    """
+    feedback = plant_feedback(model)
+    if feedback is None:
+        return []
+    closed, K = feedback
+    nn = model.order * model.size
+    out = []
+    for w in (K + K.T).nullspace():
+        y = sympy.zeros(nn, 1)
+        u = sympy.zeros(nn, 1)
+        Kw = K * w
+        for row, port in enumerate(closed):
+            y[port], u[port] = w[row], -Kw[row]
+        v = T_inv * sympy.Matrix.vstack(u, y)
+        out.append({i for i in range(2 * nn) if not vanishes(v[i])})
+    return out
 
 
 def _gain_vector(gain: Any, nn: int) -> tuple[sympy.Expr, ...] | None:
@@ -255,20 +295,24 @@ def search_sensors(
     """
     limits.check_sensor_outputs(model.order * model.size)
     order, size = model.order, model.size
-    nn = order * size
+    nn = model.n_ports
     gains = _gain_vector(gain, nn)
     cands = candidates(model)
     total = 2**nn - 1
     required = [sum(1 << (j - 1) for j in c.required) for c in cands]
     exponential = [c.variant.convergence == "exponential" for c in cands]
     # decision: exact and combinatorial (module docstring)
-    holds = [[required[c] & ~mask == 0 for c in range(len(cands))] for mask in range(total + 1)]
+    holds = [
+        [required[c] & ~mask == 0 and cands[c].attainable for c in range(len(cands))]
+        for mask in range(total + 1)
+    ]
     kappa: dict[tuple[int, int], float | None] = {}  # (mask, candidate) -> κ*, None = unbounded
     if gains is not None:
         jobs = [
             (mask, c) for mask in range(1, total + 1) for c in range(len(cands)) if holds[mask][c]
         ]
-        kappa = _kappas(model, gains, cands, jobs, progress, total)
+        kappas = _kappas if model.feedback is None else _kappas_with_plant_feedback
+        kappa = kappas(model, gains, cands, jobs, progress, total)
     names = ("exponential", "asymptotic", "inconclusive")
     verdict_code = [2] * (total + 1)
     results = []
@@ -376,6 +420,35 @@ def _kappas(
         done += len(group)
         if progress is not None and total > PROGRESS_THRESHOLD:
             progress(min(total, round(total * done / len(todo))), total)
+    return out
+
+
+def _kappas_with_plant_feedback(
+    model: BCPHS,
+    gains: tuple[sympy.Expr, ...],
+    cands: tuple[Candidate, ...],
+    jobs: list[tuple[int, int]],
+    progress: Callable[[int, int], None] | None,
+    total: int,
+) -> dict[tuple[int, int], float | None]:
+    """κ* per (subset mask, candidate) through each subset's error system (module docstring)."""
+    from phdesign.symbolic.certificate import certify
+    from phdesign.symbolic.observer import error_system, sensor_matrix
+
+    U, Y = port_matrices(model)
+    feedback = plant_feedback(model)
+    out: dict[tuple[int, int], float | None] = {}
+    systems: dict[int, Any] = {}
+    for done, (mask, c) in enumerate(jobs, start=1):
+        if mask not in systems:
+            pick = _members(mask)
+            L = sympy.diag(*[gains[j - 1] for j in pick])
+            C_m = sensor_matrix(pick, model.n_ports)
+            systems[mask] = error_system(model.order, model.size, U, Y, C_m, L, feedback)
+        cert = certify(systems[mask], cands[c].selected, "float")
+        out[mask, c] = None if cert.unbounded else cert.kappa_float
+        if progress is not None and total > PROGRESS_THRESHOLD:
+            progress(round(total * done / len(jobs)), total)
     return out
 
 

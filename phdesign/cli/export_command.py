@@ -1,0 +1,248 @@
+"""Command ``export`` (the observer for a controller) and the sampled-loop flags of ``simulate``.
+
+Argument parsing and printing only: the observer comes from
+:func:`phdesign.numeric.sampled.export_observer`, the files from :mod:`phdesign.codegen`.
+Every check that can fail (the output path, the period, the sampler, the order against the
+verification plant, jinja2 for the rendered formats) runs before any computation, so a bad
+command writes nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import math
+import sys
+from typing import Any
+
+from phdesign.cli.common import (
+    add_json_argument,
+    add_model_argument,
+    add_observer_arguments,
+    emit,
+    emit_json,
+    load_model,
+    observer_matrices,
+)
+from phdesign.errors import NumericError, ObserverError, OutputFileError
+
+__all__ = ["add_sampling_arguments", "register", "sampled_simulation"]
+
+SAMPLER_CHOICES = ("average", "point")  # phdesign.numeric.sampling.SAMPLERS, without numpy
+FORMAT_CHOICES = ("json", "c", "npz", "statespace")  # phdesign.codegen.FORMATS
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Add the ``export`` command."""
+    ex = subparsers.add_parser(
+        "export",
+        help="the observer as a sampled-data system for a controller: JSON, C99, npz or "
+        "python-control, verified against a high-resolution plant",
+    )
+    add_model_argument(ex)
+    add_observer_arguments(ex)
+    ex.add_argument("--dt", type=float, required=True, metavar="DT", help="sampling period (s)")
+    ex.add_argument(
+        "--sampler",
+        choices=SAMPLER_CHOICES,
+        default="average",
+        help="the controller's front end: mean of the outputs over each period (default) "
+        "or point samples",
+    )
+    ex.add_argument(
+        "--order", type=int, metavar="P", help="observer states (default: from the targets)"
+    )
+    ex.add_argument(
+        "--reduce",
+        choices=("none", "modal", "balanced"),
+        default="none",
+        help="drop the unresolved modes (modal) or balance and truncate (balanced, needs "
+        "slycot); default none",
+    )
+    ex.add_argument(
+        "--tol",
+        type=float,
+        default=1e-6,
+        help="relative accuracy of the rightmost error eigenvalues (default 1e-6)",
+    )
+    ex.add_argument(
+        "--output-tol",
+        type=float,
+        default=1e-3,
+        help="error floor of the performance outputs, relative to their peak (default 1e-3)",
+    )
+    ex.add_argument(
+        "--format", choices=FORMAT_CHOICES, required=True, help="what to write to -o PATH"
+    )
+    ex.add_argument(
+        "--output", "-o", required=True, metavar="PATH", help="file (a folder for --format c)"
+    )
+    ex.add_argument("--force", action="store_true", help="replace an existing output")
+    ex.add_argument(
+        "--verify",
+        action="store_true",
+        help="run the exported observer against the high-resolution plant",
+    )
+    ex.add_argument(
+        "--x0",
+        metavar="EXPRS",
+        help="plant initial state of the order selection and verification runs (default "
+        "every x_i = (z-a)/(b-a) - 0.9)",
+    )
+    ex.add_argument(
+        "--t-end", type=float, default=5.0, metavar="T", help="verification time (default 5)"
+    )
+    ex.add_argument(
+        "--plant-resolution",
+        type=int,
+        metavar="Q",
+        help="Galerkin degree of the verification plant (default 48, at least twice the order)",
+    )
+    ex.add_argument(
+        "--at",
+        metavar="Z,..",
+        help="displacement points of the outputs w(z) (default b, for a model with one)",
+    )
+    add_json_argument(ex)
+    ex.set_defaults(handler=_export)
+
+
+def _finite_positive(name: str, value: float) -> float:
+    if not (math.isfinite(value) and value > 0):
+        raise NumericError(f"{name} must be a finite positive number; found {value!r}")
+    return value
+
+
+def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
+    """Parse ``--at``: numbers in the interval, for a model with a displacement."""
+    if text is None:
+        return None
+    if nm.displacement is None:
+        raise NumericError(f"--at: model {nm.name!r} has no displacement")
+    a, b = nm.interval
+    points = []
+    for item in text.split(","):
+        try:
+            z = float(item)
+        except ValueError:
+            raise NumericError(
+                f"--at: expected numbers in [{a:g}, {b:g}]; found {item!r}"
+            ) from None
+        if not (math.isfinite(z) and a <= z <= b):
+            raise NumericError(f"--at: expected numbers in [{a:g}, {b:g}]; found {item!r}")
+        points.append(z)
+    return tuple(points)
+
+
+def _export(args: argparse.Namespace) -> int:
+    from phdesign.codegen import check_export_path
+    from phdesign.numeric.bridge import gain_to_numeric, initial_state_function, to_numeric
+    from phdesign.numeric.sampled import export_observer, verification_plant_degree
+    from phdesign.numeric.sampling import check_sampling
+
+    dt = check_sampling(args.dt, args.sampler, dt_name="--dt")
+    _finite_positive("--t-end", args.t_end)
+    _finite_positive("--tol", args.tol)
+    _finite_positive("--output-tol", args.output_tol)
+    check_export_path(args.output, args.format, args.force)
+    if args.format in ("c", "statespace") and importlib.util.find_spec("jinja2") is None:
+        raise OutputFileError(
+            f"--format {args.format} is rendered with jinja2, which is not installed: "
+            "pip install 'phdesign[codegen]'"
+        )
+    model = load_model(args)
+    nm = to_numeric(model)
+    obs = observer_matrices(args, model)
+    if obs is None:
+        raise ObserverError("export needs --sensors or --cm to say which outputs are measured")
+    C_m, L = gain_to_numeric(obs[0], "C_m"), gain_to_numeric(obs[1], "L")
+    verification_plant_degree(nm, args.order, args.plant_resolution, args.reduce)
+    points = _points(args.at, nm)
+    x0 = initial_state_function(args.x0, nm, model=model) if args.x0 else None
+    result = export_observer(
+        nm,
+        C_m,
+        L,
+        dt=dt,
+        sampler=args.sampler,
+        order=args.order,
+        reduction=args.reduce,
+        tol=args.tol,
+        output_tol=args.output_tol,
+        verify=args.verify,
+        x0=x0,
+        x0_text=args.x0,
+        t_end=args.t_end,
+        plant_resolution=args.plant_resolution,
+        points=points,
+        model_name=model.name,
+    )
+    written = result.write(args.output, args.format, force=args.force)
+    if args.json:
+        emit_json({**result.to_dict(), "files": written})
+        for warning in result.warnings:
+            print(f"phdesign: warning: {warning}", file=sys.stderr)
+    else:
+        emit(str(result) + "".join(f"\nwrote {path}" for path in written))
+    return 0
+
+
+def add_sampling_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``--dt``, ``--sampler`` and ``--observer-resolution`` to ``simulate``."""
+    parser.add_argument(
+        "--dt", type=float, metavar="DT", help="run the observer sampled every DT seconds"
+    )
+    parser.add_argument(
+        "--sampler",
+        choices=SAMPLER_CHOICES,
+        help="front end of the sampled observer: mean over each period (default) or point",
+    )
+    parser.add_argument(
+        "--observer-resolution",
+        type=int,
+        metavar="P",
+        help="Galerkin degree of the observer (default: the plant's --resolution)",
+    )
+
+
+def sampled_simulation(
+    args: argparse.Namespace, nm: Any, C_m: Any, L: Any, x0: Any, xhat0: Any
+) -> Any:
+    """Run ``simulate`` through :func:`simulate_sampled` when a sampling flag is given.
+
+    Returns None when none of ``--dt``, ``--sampler``, ``--observer-resolution`` is set
+    (the continuous simulation then runs as before).
+    """
+    if args.dt is None and args.sampler is None and args.observer_resolution is None:
+        return None
+    from phdesign.numeric.sampled_simulation import simulate_sampled
+    from phdesign.numeric.sampling import check_sampling
+
+    if C_m is None:
+        raise NumericError(
+            "--dt, --sampler and --observer-resolution act on the observer: give --sensors or --cm"
+        )
+    if args.sampler is not None and args.dt is None:
+        raise NumericError("--sampler needs --dt, the sampling period")
+    if args.dt is not None:
+        check_sampling(args.dt, args.sampler or "average", dt_name="--dt")
+    if args.scheme != "expm":
+        raise NumericError("a sampled or lower-order observer is stepped exactly: drop --scheme")
+    if args.observer_resolution is not None and not args.observer_resolution > 0:
+        raise NumericError(
+            f"--observer-resolution must be positive; found {args.observer_resolution}"
+        )
+    return simulate_sampled(
+        nm,
+        C_m,
+        L,
+        x0=x0,
+        xhat0=xhat0,
+        t_end=args.t_end,
+        samples=args.samples,
+        dt=args.dt,
+        sampler=args.sampler or "average",
+        method=args.method,
+        resolution=args.resolution,
+        observer_resolution=args.observer_resolution,
+    )

@@ -1,0 +1,100 @@
+"""The ``export`` command and the sampled-loop flags of ``simulate``."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+
+import numpy as np
+import pytest
+
+from phdesign.cli import main
+
+BEAM = ["euler-bernoulli", "--sensors", "3,4", "--gain", "0.1,1"]
+PAPER_X0 = ["--x0", "x1: 0, x2: z - 0.9"]
+
+
+def run(capsys, *argv):
+    status = main(list(argv))
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_export_json_with_verification(capsys, tmp_path):
+    path = tmp_path / "beam.json"
+    argv = ["export", *BEAM, "--dt", "1e-3", "--order", "34", "--verify", *PAPER_X0]
+    status, out, err = run(capsys, *argv, "--format", "json", "-o", str(path))
+    assert status == 0
+    assert err == ""
+    assert out.startswith("observer for euler-bernoulli: 34 states, dt = 0.001 s, sampler average")
+    assert "verification: plant of degree 48 (98 states)" in out
+    assert out.rstrip().endswith(f"wrote {path}")
+    data = json.loads(path.read_text())
+    v = data["verification"]
+    assert v["plant_order"] == 98
+    assert v["outputs"] == ["w(1)"]
+    assert v["sampler"] == "average"
+    assert v["floor"] <= 2 * v["continuous_floor"]
+    assert v["warnings"] == []
+    assert len(v["t"]) == len(v["error"]) == 501
+    assert v["t"][-1] == 5.0
+
+
+def test_export_point_sampling_warns_in_text_and_json(capsys, tmp_path):
+    argv = ["export", *BEAM, "--dt", "1e-3", "--sampler", "point", "--order", "34", "--verify"]
+    status, out, err = run(capsys, *argv, *PAPER_X0, "--format", "npz", "-o", str(tmp_path / "o"))
+    assert status == 0
+    assert "warning: the sampled observer error floor" in out
+    status, out, err = run(
+        capsys, *argv, *PAPER_X0, "--format", "json", "-o", str(tmp_path / "o.json"), "--json"
+    )
+    assert status == 0
+    assert json.loads(out)["files"] == [str(tmp_path / "o.json")]
+    assert "phdesign: warning: the sampled observer error floor" in err
+
+
+def test_export_c_folder_and_force(capsys, tmp_path):
+    pytest.importorskip("jinja2", reason="the C export needs the codegen extra")
+    folder = tmp_path / "controller"
+    argv = ["export", *BEAM, "--dt", "1e-3", "--order", "16", "--format", "c", "-o", str(folder)]
+    assert run(capsys, *argv)[0] == 0
+    assert sorted(p.name for p in folder.iterdir()) == ["observer.c", "observer.h"]
+    status, _, err = run(capsys, *argv)
+    assert status == 2
+    assert "exists; pass --force" in err
+    (folder / "observer.c").write_text("stale")
+    assert run(capsys, *argv, "--force")[0] == 0
+    assert "phd_observer_step" in (folder / "observer.c").read_text()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["controller"]  # nothing left over
+
+
+def test_export_modal_reduction_from_the_command_line(capsys, tmp_path):
+    argv = ["export", *BEAM, "--dt", "1e-3", "--reduce", "modal", *PAPER_X0]
+    status, out, _ = run(capsys, *argv, "--format", "json", "-o", str(tmp_path / "m.json"))
+    assert status == 0
+    assert "reduction modal" in out
+    assert "unresolved modes" in out
+    data = json.loads((tmp_path / "m.json").read_text())
+    poles = np.linalg.eigvals(np.array(data["A"]))
+    # every pole of the sampled observer is exp(λ dt) of a converged error eigenvalue:
+    # |z| = exp(Re λ dt) <= exp(-2.9106562986 dt), the abscissa of design 2
+    assert np.max(np.abs(poles)) <= np.exp(-2.9106562986 * 1e-3) * (1 + 1e-12)
+
+
+def test_simulate_sampled_flags(capsys):
+    argv = ["simulate", *BEAM, *PAPER_X0, "--resolution", "48", "--observer-resolution", "16"]
+    status, out, err = run(capsys, *argv, "--dt", "1e-3", "--sampler", "point", "--json")
+    assert status == 0
+    data = json.loads(out)
+    assert data["sampler"] == "point"
+    assert data["dt"] == 1e-3
+    assert data["observer_resolution"] == 16
+    assert "phdesign: warning: the sampled observer error floor" in err
+    status, out, err = run(capsys, *argv, "--dt", "1e-3", "--t-end", "1", "--samples", "11")
+    assert status == 0
+    assert err == ""
+    rows = list(csv.reader(io.StringIO(out)))
+    assert rows[0][:4] == ["t", "H", "H_hat", "H_err"]
+    assert len(rows) == 12
+    assert float(rows[-1][0]) == 1.0
