@@ -206,7 +206,15 @@ class OutputFiles:
         missing = [str(t) for t in self._targets if t not in self._staged]
         if missing:
             raise OutputFileError(f"no content was written for {', '.join(missing)}")
-        created: list[Path] = []
+        created: list[tuple[Path, tuple[int, int]]] = []  # targets this commit made
+
+        def undo() -> None:
+            for path, identity in created:
+                with contextlib.suppress(OSError):
+                    info = os.lstat(path)
+                    if (info.st_dev, info.st_ino) == identity:  # ours, not a rival's
+                        path.unlink()
+
         try:
             # new files first (exclusive, undoable), replacements last
             for target, temporary in sorted(
@@ -217,19 +225,18 @@ class OutputFiles:
                     with open(target, "wb") as stream:
                         stream.write(temporary)  # type: ignore[arg-type]
                 elif kind == "new":
+                    info = os.stat(temporary)  # type: ignore[arg-type]
+                    created.append((target, (info.st_dev, info.st_ino)))  # before: a signal
                     _link_exclusively(temporary, target)  # type: ignore[arg-type]
-                    created.append(target)
                 else:
                     if _classify(target, True) != "replace":  # changed since add()
                         raise OutputFileError(f"output file {str(target)!r} changed meanwhile")
                     os.replace(temporary, target)  # type: ignore[arg-type]
         except OSError as error:
-            for path in created:
-                path.unlink(missing_ok=True)
+            undo()
             raise OutputFileError(f"cannot write {str(target)!r}: {_reason(error)}") from None
         except BaseException:
-            for path in created:
-                path.unlink(missing_ok=True)
+            undo()
             raise
         finally:
             self.discard()
