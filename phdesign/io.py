@@ -210,6 +210,8 @@ def _toml_number(value: sympy.Expr) -> int | float | str:
 
 def model_to_dict(model: BCPHS) -> dict[str, Any]:
     """Return the content of the model file of ``model``."""
+    if not isinstance(model, BCPHS):
+        raise ModelFileError(f"expected a model (a BCPHS); found {type(model).__name__}")
     data: dict[str, Any] = {"name": model.name}
     if model.description:
         data["description"] = model.description

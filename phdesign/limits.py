@@ -198,9 +198,11 @@ def check_file_size(size: int, source: str) -> None:
 
 def check_sensor_outputs(n_outputs: int) -> None:
     """Refuse a sensor search over more than :data:`MAX_SENSOR_OUTPUTS` outputs."""
+    n_outputs = _integer(n_outputs, "the number of outputs", ObserverError)
     if n_outputs > MAX_SENSOR_OUTPUTS:
+        count = f" = {2**n_outputs - 1}" if n_outputs <= 64 else ""
         raise ObserverError(
-            f"the sensor search classifies 2^{n_outputs} - 1 = {2**n_outputs - 1} sensor sets "
+            f"the sensor search classifies 2^{n_outputs} - 1{count} sensor sets "
             f"for {n_outputs} outputs; expected at most {MAX_SENSOR_OUTPUTS} outputs "
             f"({_budget('MAX_SENSOR_OUTPUTS')}): classify chosen sets with sensors=... instead"
         )

@@ -73,6 +73,8 @@ def _classify(target: Path, force: bool) -> str:
         info = os.lstat(target)
     except FileNotFoundError:
         return "new"
+    except ValueError as error:  # an embedded NUL byte
+        raise OutputFileError(f"cannot write {shown!r}: {error}") from None
     except OSError as error:
         raise OutputFileError(f"cannot write {shown!r}: {_reason(error)}") from None
     mode = info.st_mode

@@ -44,7 +44,7 @@ eigenvalue touches 0) the grid is refined around its smallest values, and values
 Examples
 --------
 >>> import sympy
->>> from phdesign.symbolic.expressions import Z
+>>> from phdesign.symbolic.expressions import Z, exact_matrix, exact_number
 >>> check_definite(sympy.Matrix([[1 + Z**2]]), "H", (0, 1))
 'H > 0: exact on [a, b] at the parameter defaults (leading principal minors)'
 """
@@ -65,7 +65,7 @@ from phdesign.limits import (
     EXACT_DEFINITENESS_DEGREE,
     EXACT_DEFINITENESS_SIZE,
 )
-from phdesign.symbolic.expressions import Z
+from phdesign.symbolic.expressions import Z, exact_matrix, exact_number
 
 __all__ = ["POSITIVITY_GRID_POINTS", "check_definite"]
 
@@ -128,8 +128,17 @@ def check_definite(
     if (sign, bool(strict)) not in _KINDS:
         raise ValueError(f"sign must be 1 or -1; found {sign!r}")
     kind, relation = _KINDS[sign, bool(strict)]
-    check = _Check(name, kind, sign, bool(strict), (interval[0], interval[1]))
-    M = sympy.ImmutableMatrix(matrix)
+    if isinstance(interval, str) or not isinstance(interval, Sequence) or len(interval) != 2:
+        raise ModelError(f"{name}: the interval must be a pair (a, b); found {interval!r}")
+    a, b = (exact_number(p, "interval endpoint") for p in interval)
+    if not a < b:
+        raise ModelError(f"{name}: the interval must have a < b; found [{a}, {b}]")
+    if defaults is not None and not isinstance(defaults, Mapping):
+        raise ModelError(f"{name}: defaults must map parameters to values; found {defaults!r}")
+    check = _Check(name, kind, sign, bool(strict), (a, b))
+    M = exact_matrix(matrix, name, symbols=True)
+    if M.rows != M.cols:
+        raise ModelError(f"{name} must be square; found {M.rows} x {M.cols}")
     at = " at the parameter defaults" if M.free_symbols - {Z} else ""
     M = M.xreplace(dict(defaults or {}))
     left = M.free_symbols - {Z}

@@ -345,10 +345,21 @@ def parse_scalar(
         The exact expression (decimals become rationals).
     """
     check_text(text, what)
+    names = _names(parameters)
     try:
-        return parse(text, _name_resolver(frozenset(parameters), allow_z))
+        return parse(text, _name_resolver(names, allow_z))
     except ExpressionError as error:
         raise ExpressionError(f"{what}: {error}") from None
+
+
+def _names(parameters: object) -> frozenset[str]:
+    """Return the parameter names a caller allows, refusing anything but text."""
+    if isinstance(parameters, str) or not isinstance(parameters, Iterable):
+        raise ExpressionError(f"parameters must be a list of names; found {_brief(parameters)}")
+    names = list(parameters)
+    if not all(isinstance(name, str) for name in names):
+        raise ExpressionError(f"parameters must be a list of names; found {_brief(names)}")
+    return frozenset(names)
 
 
 def _name_resolver(parameters: frozenset[str], allow_z: bool) -> Callable[[str, str], sympy.Expr]:
@@ -434,7 +445,7 @@ def parse_trace_expression(
         return trace_symbol(component, derivative, _side_of(str(point), a, b, token.text))
 
     try:
-        expr = parse(text, _name_resolver(frozenset(parameters), False), make_trace)
+        expr = parse(text, _name_resolver(_names(parameters), False), make_trace)
     except ExpressionError as error:
         raise ExpressionError(f"{what} {text!r}: {error}") from None
     linear_coefficients(expr, what=f"{what} {text!r}")
@@ -574,6 +585,10 @@ def format_expression(expr: sympy.Basic, interval: Sequence[object] | None = Non
     >>> format_expression(sympy.exp(1) * Z)
     'exp(1)*z'
     """
+    if not isinstance(expr, sympy.Basic):
+        raise ExpressionError(
+            f"format_expression needs a sympy expression; found {type(expr).__name__}"
+        )
     replacements = {}
     for symbol in expr.free_symbols:
         trace = trace_of(symbol)

@@ -218,6 +218,8 @@ class BCPHS:
         endpoints = _interval(interval)
         H_matrix = parse_matrix(H, "H", names, allow_z=True)
         size = H_matrix.shape[0]
+        if isinstance(P, str) or not isinstance(P, Mapping | Sequence):
+            raise ModelError(f"P must map k to P_k (or list P_0..P_N); found {P!r}")
         P_by_order = dict(P) if isinstance(P, Mapping) else dict(enumerate(P))
         for k in P_by_order:
             if not isinstance(k, int) or not 0 <= k <= order:
@@ -303,6 +305,10 @@ class BCPHS:
         ParameterError
             If a name is not a parameter of the model or a value is not a finite number.
         """
+        if not isinstance(values, Mapping):
+            raise ParameterError(
+                f"expected a mapping of parameter names to values; found {values!r}"
+            )
         known = self.parameter_names
         updated = dict(self.parameters)
         for name, value in values.items():

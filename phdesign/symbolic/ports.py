@@ -288,7 +288,6 @@ def _rank(M: sympy.MatrixBase) -> int:
     return int(exact.rank())
 
 
-@lru_cache(maxsize=256)
 def derive_ports(model: PortedSystem) -> Ports:
     r"""Derive and check the port structure of ``model``.
 
@@ -314,6 +313,17 @@ def derive_ports(model: PortedSystem) -> Ports:
                 f"derive_ports needs a model (a BCPHS); found {type(model).__name__} "
                 f"{str(model)[:60]!r}"
             )
+    try:
+        hash(model)
+    except TypeError:
+        raise PortError(
+            f"derive_ports needs a model (a BCPHS); found {type(model).__name__}"
+        ) from None
+    return _derive_ports(model)  # type: ignore[arg-type]
+
+
+@lru_cache(maxsize=256)
+def _derive_ports(model: PortedSystem) -> Ports:
     N, n = model.order, model.size
     nn = N * n
     Q = q_matrix(model.P, N)
