@@ -357,3 +357,25 @@ def test_z_in_every_entry_is_checked_exactly_within_budget():
     )
     assert any("exact on [a, b]" in check for check in model.checks)
     assert model.H[0, 0] == (Z + 1) ** 64
+
+
+def test_the_float_path_holds_huge_gains_without_overflow(capsys):
+    """With L = 1e200 the float pencil overflowed and κ* came out 0 (a 'failing' value).
+
+    Same derivation as above with c = 1: κ* = k / (1 + k²) ≈ 1e-200 for k = 1e200.
+    """
+    from phdesign.symbolic.classify import classify
+    from phdesign.symbolic.observer import parse_gain, sensor_matrix
+
+    result = classify(load_builtin("wave"), sensor_matrix([2], 2), parse_gain("1e200", 1), "float")
+    kappa = result.result("3.1", 2).kappa_float
+    assert kappa == pytest.approx(1e-200, rel=1e-12)  # 15 digits of the float path, and room
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 12 item 9 in search.py (api): the float κ* of the sensor search squares "
+    "gains of 1e200 and raises OverflowError instead of scaling the pencil",
+)
+def test_the_sensor_search_holds_huge_gains(capsys):
+    assert main(["classify", "wave", "--all-sensors", "--gain", "1e200"]) == 0

@@ -187,7 +187,8 @@ def certify(
             )
         if method == "exact":
             raise ObserverError("no exact root available for this pencil; use method='float'")
-    return Certificate(True, None, float_kappa(A_r, B_r), False, None, (), "float", None, pencil)
+    kappa, kappa_float = _scaled_float_kappa(A_r, B_r)
+    return Certificate(True, kappa, kappa_float, False, None, (), "float", None, pencil)
 
 
 def _operations(*matrices: sympy.MatrixBase) -> int:
@@ -201,6 +202,29 @@ def _as_float(value: sympy.Expr) -> float | None:
     if value != 0 and (number == 0.0 or not math.isfinite(number)):
         return None
     return number
+
+
+def _scaled_float_kappa(
+    A_r: sympy.MatrixBase, B_r: sympy.MatrixBase
+) -> tuple[sympy.Expr | None, float | None]:
+    r"""Float :math:`\kappa^*` of a pencil whose entries may lie beyond double range.
+
+    With :math:`\alpha = \max|A_{ij}|`, :math:`\beta = \max|B_{ij}|` (exact), the pencil
+    :math:`(A/\alpha, B/\beta)` has entries of order one and
+    :math:`\kappa^* = \kappa^*(A/\alpha, B/\beta)\, \alpha/\beta`: gains of 1e200 neither
+    overflow nor turn κ* into 0. Returns κ* as a 15-digit sympy number when a double cannot
+    hold it (then the float is ``None``), else ``(None, float)``.
+    """
+    alpha = max((abs(x) for x in A_r), key=lambda x: float(sympy.log(x + 1e-300).evalf(15)))
+    beta = max((abs(x) for x in B_r), key=lambda x: float(sympy.log(x + 1e-300).evalf(15)))
+    if alpha == 0 or beta == 0:
+        return None, float_kappa(A_r, B_r)
+    scaled = float_kappa(A_r / alpha, B_r / beta)
+    if scaled is None:
+        return None, None
+    value = sympy.Float(scaled, 15) * sympy.N(alpha / beta, 15)
+    as_float = _as_float(value)
+    return (None, as_float) if as_float is not None else (value, None)
 
 
 def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | None:
