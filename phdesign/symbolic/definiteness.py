@@ -44,7 +44,7 @@ eigenvalue touches 0) the grid is refined around its smallest values, and values
 Examples
 --------
 >>> import sympy
->>> from phdesign.symbolic.expressions import Z, exact_matrix, exact_number
+>>> from phdesign.symbolic.expressions import Z
 >>> check_definite(sympy.Matrix([[1 + Z**2]]), "H", (0, 1))
 'H > 0: exact on [a, b] at the parameter defaults (leading principal minors)'
 """
@@ -66,6 +66,7 @@ from phdesign.limits import (
     EXACT_DEFINITENESS_SIZE,
 )
 from phdesign.symbolic.expressions import Z, exact_matrix, exact_number
+from phdesign.symbolic.parser import brief
 
 __all__ = ["POSITIVITY_GRID_POINTS", "check_definite"]
 
@@ -455,5 +456,4 @@ def _evaluate(evaluate: Any, entry: sympy.Expr, z: Any, name: str) -> Any:
 
 
 def _brief(value: object) -> str:
-    text = str(value)
-    return text if len(text) <= 80 else f"{text[:77]}..."
+    return brief(value, 80)

@@ -39,7 +39,7 @@ from sympy.printing.str import StrPrinter
 
 from phdesign.errors import ExpressionError
 from phdesign.limits import MAX_NUMBER_OPERATIONS
-from phdesign.symbolic.parser import CONSTANTS, FUNCTIONS, Token, check_text, parse
+from phdesign.symbolic.parser import CONSTANTS, FUNCTIONS, Token, brief, check_text, parse
 
 __all__ = [
     "Trace",
@@ -217,8 +217,7 @@ def _check_range(expr: sympy.Expr, what: str) -> None:
 
 
 def _brief(value: object) -> str:
-    text = repr(value) if isinstance(value, str) else str(value)
-    return text if len(text) <= 60 else f"{text[:57]}..."
+    return brief(value, 60)
 
 
 def exact_matrix(value: object, what: str, symbols: bool = False) -> sympy.ImmutableMatrix:

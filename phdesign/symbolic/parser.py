@@ -51,6 +51,7 @@ __all__ = [
     "CONSTANTS",
     "FUNCTIONS",
     "Token",
+    "brief",
     "check_expression",
     "check_text",
     "degree_bound",
@@ -202,11 +203,11 @@ class _Parser:
         size = _magnitude(value)
         if size is None:
             raise ExpressionError(
-                f"{_brief(value)} in {self.context.text!r} is not a finite real number"
+                f"{brief(value)} in {self.context.text!r} is not a finite real number"
             )
         if size != -math.inf and abs(size) > math.log(MAX_MAGNITUDE):
             raise ExpressionError(
-                f"{_brief(value)} in {self.context.text!r} is out of range; expected magnitudes "
+                f"{brief(value)} in {self.context.text!r} is out of range; expected magnitudes "
                 "between 1e-300 and 1e300"
             )
         return value
@@ -288,7 +289,7 @@ class _Parser:
                 size = _magnitude(argument)
                 if size is None or size > math.log(_LARGEST_EXPONENTIAL_ARGUMENT):
                     raise ExpressionError(
-                        f"{name}({_brief(argument)}) in {self.context.text!r} is out of range; "
+                        f"{name}({brief(argument)}) in {self.context.text!r} is out of range; "
                         f"expected an argument of magnitude at most "
                         f"{_LARGEST_EXPONENTIAL_ARGUMENT:.4g} (values between 1e-300 and 1e300)"
                     )
@@ -298,9 +299,16 @@ class _Parser:
         return self.context.resolve_name(name, self.context.text)
 
 
-def _brief(value: sympy.Expr) -> str:
-    text = str(value)
-    return text if len(text) <= 40 else f"{text[:37]}..."
+def brief(value: object, width: int = 40) -> str:
+    """Return ``value`` as text for a message, cut to ``width`` characters.
+
+    Examples
+    --------
+    >>> brief("x" * 50, 10)
+    "'xxxxxx..."
+    """
+    text = repr(value) if isinstance(value, str) else str(value)
+    return text if len(text) <= width else f"{text[: width - 3]}..."
 
 
 def _magnitude(value: sympy.Expr) -> float | None:
@@ -376,7 +384,7 @@ def check_expression(expr: sympy.Expr, what: str) -> sympy.Expr:
     if not isinstance(expr, sympy.Expr):
         raise ExpressionError(f"{what} must be an expression; found {type(expr).__name__}")
     if expr.has(sympy.I, sympy.zoo, sympy.nan, sympy.oo, -sympy.oo):
-        raise ExpressionError(f"{what} is not a finite real expression; found {_brief(expr)}")
+        raise ExpressionError(f"{what} is not a finite real expression; found {brief(expr)}")
     for function in expr.atoms(sympy.Function):
         name = type(function).__name__
         if name not in FUNCTIONS and name not in _FORMED:
