@@ -443,6 +443,17 @@ COMMAND_ROWS = [
         ObserverError,
         seconds=10,
     ),
+    # a tower of exponentials that overflows floats: nan and 0 (a 'failing' κ*) before
+    row(
+        "classify wave --all-sensors --gain exp(exp(7))",
+        "exp(exp(7)) in 'exp(exp(7))' is out of range",
+        ObserverError,
+    ),
+    row(
+        "classify wave --sensors 2 --gain exp(exp(7))",
+        "exp(exp(7)) in 'exp(exp(7))' is out of range",
+        ObserverError,
+    ),
     row(
         "classify wave --sensors 2 --gain exp(690)*exp(690)",
         "is out of range; expected magnitudes between 1e-300 and 1e300 (or 0); found exp(1380)",
