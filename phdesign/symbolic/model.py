@@ -48,6 +48,7 @@ from phdesign.symbolic.expressions import (
     check_parameter_name,
     exact_number,
     exactify,
+    format_expression,
     linear_coefficients,
     parameter_symbol,
     parse_scalar,
@@ -336,13 +337,17 @@ def _port(
     what: str,
 ) -> sympy.Expr:
     if isinstance(value, str):
-        return parse_trace_expression(value, interval, order, size, parameters, what=what)
-    if isinstance(value, sympy.Expr):
-        return exactify(value)
-    raise ExpressionError(
-        f'{what} must be a trace expression such as "e1(0)"; found {type(value).__name__} '
-        f"{value!r}"
-    )
+        expr = parse_trace_expression(value, interval, order, size, parameters, what=what)
+    elif isinstance(value, sympy.Expr):
+        expr = check_expression(exactify(value), what)
+    else:
+        raise ExpressionError(
+            f'{what} must be a trace expression such as "e1(0)"; found {type(value).__name__} '
+            f"{value!r}"
+        )
+    # the form that reads back as itself (module docstring of phdesign.io: exact round trips)
+    text = format_expression(expr, interval)
+    return parse_trace_expression(text, interval, order, size, parameters, what=what)
 
 
 def _unit_pairs(units: object) -> tuple[tuple[Any, Any], ...]:
@@ -397,10 +402,14 @@ def parse_matrix(
 
 def _entry(value: object, what: str, parameters: Sequence[str], allow_z: bool) -> sympy.Expr:
     if isinstance(value, str):
-        return parse_scalar(value, parameters, allow_z=allow_z, what=what)
-    if isinstance(value, sympy.Expr):
-        return exactify(value)
-    return exact_number(value, what)
+        expr = parse_scalar(value, parameters, allow_z=allow_z, what=what)
+    elif isinstance(value, sympy.Expr):
+        expr = check_expression(exactify(value), what)
+    else:
+        return exact_number(value, what)
+    # sympy builds (z + d)/atan(1) as 4*(d + z)/pi, which reads back as (4*d + 4*z)/pi:
+    # keep the form that reads back as itself, so that written models read back exactly
+    return parse_scalar(format_expression(expr), parameters, allow_z=allow_z, what=what)
 
 
 def _validate(model: BCPHS) -> list[str]:

@@ -178,10 +178,12 @@ class _Parser:
 
     def expr(self) -> sympy.Expr:
         self.enter()
-        value = self.term()
+        terms = [self.term()]
         while (op := self.take("+", "-")) is not None:
             rhs = self.term()
-            value = self.bounded(value + rhs if op.text == "+" else value - rhs)
+            terms.append(rhs if op.text == "+" else -rhs)
+        # one Add of all the terms: adding them one by one re-sorts the sum each time
+        value = terms[0] if len(terms) == 1 else self.bounded(sympy.Add(*terms))
         self.depth -= 1
         return value
 
