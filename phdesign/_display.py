@@ -50,6 +50,17 @@ def _fraction(x: Any) -> tuple[int, int] | None:
     return None
 
 
+#: Longest exact number printed in full; longer ones get six digits in scientific notation.
+LONG_NUMBER = 28
+
+
+def _scientific(p: int, q: int) -> str:
+    """``p/q`` with six significant digits, never underflowing: 1/10**500 is ``1.0e-500``."""
+    import mpmath
+
+    return str(mpmath.nstr(mpmath.mpf(p) / q, 6))
+
+
 def number_text(x: Any) -> str:
     """Return a number as a person writes it.
 
@@ -62,7 +73,7 @@ def number_text(x: Any) -> str:
     if exact is not None:
         p, q = exact
         if q == 1:
-            return str(p)
+            return str(p) if len(str(p)) <= LONG_NUMBER else _scientific(p, 1)
         rest = q
         for prime in (2, 5):
             while rest % prime == 0:
@@ -75,7 +86,12 @@ def number_text(x: Any) -> str:
                 sign = "-" if p < 0 else ""
                 whole, frac = divmod(abs(p) * 10**digits // q, 10**digits)
                 return f"{sign}{whole}.{str(frac).rjust(digits, '0')}"
-        return f"{p}/{q}"
+        text = f"{p}/{q}"
+        return text if len(text) <= LONG_NUMBER else _scientific(p, q)
+    if getattr(x, "is_Float", False) and x != 0 and float(x) in (0.0, float("inf"), -float("inf")):
+        import mpmath  # a sympy Float beyond double range (a kappa* of 1e-500): never 0
+
+        return str(mpmath.nstr(mpmath.mpf(x._mpf_), 6))
     if isinstance(x, float) or getattr(x, "is_Float", False):
         return f"{float(x):.6g}"
     return str(x)

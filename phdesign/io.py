@@ -1,4 +1,4 @@
-"""Model files (TOML) in and out, JSON encoding, and atomic file writes.
+"""Model files (TOML) in and out, and phdesign's one JSON writer (strict JSON).
 
 A model file holds exactly the keys below; ``[matrices]`` entries are numbers or
 expression strings in ``z`` and the parameters, and omitted ``P_k`` are zero::
@@ -41,22 +41,23 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 import tomllib
 from collections.abc import Mapping
-from pathlib import Path
 from typing import Any
 
 import sympy
 import tomli_w
 
-from phdesign.errors import ModelFileError, OutputFileError
+from phdesign.errors import ModelFileError, PhdesignError
+from phdesign.limits import MAX_MODEL_FILE_BYTES, check_file_size
+from phdesign.outputs import atomic_write, check_output_path
 from phdesign.symbolic.expressions import format_expression
 from phdesign.symbolic.model import BCPHS, Displacement
 
 __all__ = [
     "atomic_write",
     "check_output_path",
+    "dumps_json",
     "json_value",
     "model_from_dict",
     "model_from_toml",
@@ -79,11 +80,15 @@ def read_model(path: str | os.PathLike[str]) -> BCPHS:
         If the file cannot be read or is not valid TOML or lacks keys; model errors
         (:class:`~phdesign.errors.ModelError`, ...) propagate with their own messages.
     """
+    source = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        with open(path, "rb") as stream:
+            data = stream.read(MAX_MODEL_FILE_BYTES + 1)
+        check_file_size(len(data), f"model file {source!r}")
+        text = data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as error:
-        raise ModelFileError(f"cannot read model file {str(path)!r}: {_reason(error)}") from None
-    return model_from_toml(text, source=str(path))
+        raise ModelFileError(f"cannot read model file {source!r}: {_reason(error)}") from None
+    return model_from_toml(text, source=source)
 
 
 def _reason(error: Exception) -> str:
@@ -92,6 +97,9 @@ def _reason(error: Exception) -> str:
 
 def model_from_toml(text: str, source: str = "model file") -> BCPHS:
     """Build a model from the text of a TOML model file."""
+    if not isinstance(text, str):
+        raise ModelFileError(f"{source} must be text; found {type(text).__name__}")
+    check_file_size(len(text.encode("utf-8", "surrogatepass")), source)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
@@ -190,18 +198,20 @@ def _table(data: Mapping[str, Any], key: str, source: str) -> Mapping[str, Any]:
 
 
 def _toml_number(value: sympy.Expr) -> int | float | str:
-    """Write exact numbers as TOML ints or floats when that is exact, else as strings."""
-    if value.is_Integer:
+    """Write exact numbers as TOML ints or floats when that is exact, else as text."""
+    if value.is_Integer and abs(int(value)) < 2**63:  # TOML integers are 64-bit
         return int(value)
     if value.is_Rational:
         as_float = float(value)
-        if sympy.Rational(repr(as_float)) == value:
+        if math.isfinite(as_float) and sympy.Rational(repr(as_float)) == value:
             return as_float
-    return str(value)
+    return format_expression(value)
 
 
 def model_to_dict(model: BCPHS) -> dict[str, Any]:
     """Return the content of the model file of ``model``."""
+    if not isinstance(model, BCPHS):
+        raise ModelFileError(f"expected a model (a BCPHS); found {type(model).__name__}")
     data: dict[str, Any] = {"name": model.name}
     if model.description:
         data["description"] = model.description
@@ -214,7 +224,8 @@ def model_to_dict(model: BCPHS) -> dict[str, Any]:
 
     def rows(matrix: sympy.MatrixBase) -> list[list[int | float | str]]:
         return [
-            [_toml_number(x) if x.is_number else str(x) for x in row] for row in matrix.tolist()
+            [_toml_number(x) if x.is_number else format_expression(x) for x in row]
+            for row in matrix.tolist()
         ]
 
     matrices: dict[str, Any] = {}
@@ -245,61 +256,29 @@ def model_to_dict(model: BCPHS) -> dict[str, Any]:
 
 
 def model_to_toml(model: BCPHS) -> str:
-    """Return the text of the TOML model file of ``model``."""
-    return tomli_w.dumps(model_to_dict(model))
+    """Return the text of the TOML model file of ``model``.
+
+    The text is read back before it is returned: phdesign never writes a model file it
+    cannot read, or one that reads as another model.
+
+    Raises
+    ------
+    ModelFileError
+        If the model holds something the file format cannot express exactly.
+    """
+    text = tomli_w.dumps(model_to_dict(model))
+    try:
+        again = model_from_toml(text, source="the written model file")
+    except PhdesignError as error:
+        raise ModelFileError(f"model {model.name!r} cannot be written readably: {error}") from None
+    if again != model:
+        raise ModelFileError(f"model {model.name!r} cannot be written exactly as a model file")
+    return text
 
 
 def write_model(model: BCPHS, path: str | os.PathLike[str], force: bool = False) -> None:
     """Write ``model`` as a TOML file (atomically; refuses to overwrite unless ``force``)."""
     atomic_write(path, model_to_toml(model), force=force)
-
-
-def check_output_path(path: str | os.PathLike[str], force: bool = False) -> Path:
-    """Check, before any work is done, that ``path`` can be written.
-
-    Raises
-    ------
-    OutputFileError
-        If ``path`` is a folder, exists while ``force`` is false, or its folder is missing.
-    """
-    target = Path(path)
-    if target.is_dir():
-        raise OutputFileError(f"output path {str(target)!r} is a folder; expected a file name")
-    if target.exists() and not force:
-        raise OutputFileError(f"output file {str(target)!r} exists; pass --force to overwrite it")
-    if not target.parent.is_dir():
-        raise OutputFileError(
-            f"cannot write {str(target)!r}: folder {str(target.parent)!r} does not exist"
-        )
-    return target
-
-
-def atomic_write(path: str | os.PathLike[str], text: str | bytes, force: bool = False) -> None:
-    """Write a file through a temporary file in the same folder and a rename.
-
-    Raises
-    ------
-    OutputFileError
-        If the file exists and ``force`` is false, or the folder is not writable.
-    """
-    target = check_output_path(path, force)
-    folder = target.parent
-    data = text.encode("utf-8") if isinstance(text, str) else text
-    try:
-        handle, temporary = tempfile.mkstemp(dir=folder, prefix=f".{target.name}.", suffix=".tmp")
-    except OSError as error:
-        raise OutputFileError(f"cannot write {str(target)!r}: {_reason(error)}") from None
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
-        # mkstemp creates 0600; give the file the mode a plain open() would have
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)
-        os.replace(temporary, target)
-    except OSError as error:
-        Path(temporary).unlink(missing_ok=True)
-        raise OutputFileError(f"cannot write {str(target)!r}: {_reason(error)}") from None
 
 
 def json_value(value: Any) -> Any:
@@ -309,9 +288,9 @@ def json_value(value: Any) -> Any:
     ints; floats that are not finite become ``None``.
     """
     if isinstance(value, sympy.MatrixBase):
-        return [[str(x) for x in row] for row in value.tolist()]
+        return [[format_expression(x) for x in row] for row in value.tolist()]
     if isinstance(value, sympy.Basic):
-        return str(value)
+        return format_expression(value)
     if isinstance(value, Mapping):
         return {str(k): json_value(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
@@ -323,6 +302,10 @@ def json_value(value: Any) -> Any:
     return value
 
 
-def dumps_json(value: Any) -> str:
-    """Serialize ``value`` (through :func:`json_value`) as indented JSON."""
-    return json.dumps(json_value(value), indent=2, ensure_ascii=False)
+def dumps_json(value: Any, indent: int | None = 2) -> str:
+    """Serialize ``value`` (through :func:`json_value`) as strict JSON.
+
+    This is phdesign's one JSON writer: non-finite floats become ``null`` and
+    ``allow_nan=False`` guarantees that no bare ``NaN`` or ``Infinity`` is ever printed.
+    """
+    return json.dumps(json_value(value), indent=indent, ensure_ascii=False, allow_nan=False)

@@ -240,4 +240,50 @@ BAD_MODELS = [
         ModelError,
         "'momentum' and 'x1' name the same state",
     ),
+    # ---- issue 12: budgets before the work (each of these ran for minutes or GBs)
+    (
+        {"matrices__H": [["((z+1)**64)**64", 0], [0, 1]]},
+        ExpressionError,
+        r"has degree 4096 once built; expected at most 64",
+    ),
+    (
+        # z*z*...*z is z**101: the exponent limit may not be bypassed by products
+        {"matrices__H": [["1 + " + "*".join(["z"] * 101), 0], [0, 1]]},
+        ExpressionError,
+        r"has degree 101 once built; expected at most 64",
+    ),
+    (
+        {"matrices__H": [["(1+z+z**2+z**3+z**4+z**5+z**6+z**7)**64", 0], [0, 1]]},
+        ExpressionError,
+        r"has degree 448 once built",
+    ),
+    (
+        {"matrices__H": [["exp(1e300)", 0], [0, 1]]},
+        ExpressionError,
+        r"exp\(1000.*\) in 'exp\(1e300\)' is out of range",
+    ),
+    (
+        {"matrices__H": [["exp(exp(exp(5)))", 0], [0, 1]]},
+        ExpressionError,
+        r"out of range; expected an argument of magnitude at most 691.5",
+    ),
+    (
+        {"parameters": {f"p{i}": 1 for i in range(5000)}},
+        ModelError,
+        r"the model has 5000 parameters; expected at most 200",
+    ),
+    ({"interval": [0, "exp(800)"]}, ExpressionError, r"exp\(800\).*out of range"),
+    ({"order": 9}, ModelError, r"order N is 9; expected at most 8"),
+    # ---- issue 12 item 7: a sharp negative dip between grid points (width 1e-4, grid 5e-4)
+    (
+        {"matrices__H": [["1 - 1.5*exp(-100000000*(z - 0.50025)**2)", 0], [0, 1]]},
+        ModelError,
+        # at z = 0.50025 the entry is 1 - 1.5 = -0.5 exactly (the Gaussian's peak)
+        r"found smallest eigenvalue -0.5 at z = 0.50025 \(parameter defaults\)",
+    ),
+    # ---- issue 12 item 9: state labels that --x0 would read as another component
+    ({"states": ["x2", "x1"]}, ModelError, r"state label 'x2' of component 1 is ambiguous"),
+    ({"states": ["e1", "curvature"]}, ModelError, r"'e1' of component 1 is ambiguous"),
+    ({"states": ["w: 1", "curvature"]}, ModelError, r"holds a separator"),
+    ({"states": ["momentum", "momentum"]}, ModelError, r"state labels must be distinct"),
 ]

@@ -8,7 +8,9 @@ The summary test prints the table's size and pass count.
 
 from __future__ import annotations
 
+import os
 import re
+import time
 from dataclasses import dataclass
 
 import pytest
@@ -29,20 +31,46 @@ from phdesign.errors import (
 
 @dataclass(frozen=True)
 class Row:
-    """One bad invocation: ``{tmp}`` in argv stands for a fresh temporary folder."""
+    """One bad invocation: ``{tmp}`` in argv stands for a fresh temporary folder.
+
+    ``seconds``: a resource row, whose refusal must come within that time (issue 12).
+    """
 
     argv: tuple[str, ...]
     message: str
     error: type[Exception] | None  # None: an argument-parser (usage) error
     files: tuple[tuple[str, str], ...] = ()
+    seconds: float | None = None
 
     @property
     def id(self) -> str:
         return " ".join(self.argv)[:70]
 
 
-def row(argv: str, message: str, error: type[Exception] | None, **files: str) -> Row:
-    return Row(tuple(argv.split()), message, error, tuple(files.items()))
+def row(argv: str, message: str, error: type[Exception] | None, seconds=None, **files: str) -> Row:
+    return Row(tuple(argv.split()), message, error, tuple(files.items()), seconds)
+
+
+def beams_toml(count: int) -> str:
+    """``count`` uncoupled Euler-Bernoulli beams (the built-in beam's ports, per beam)."""
+    n = 2 * count
+    P2 = [[0] * n for _ in range(n)]
+    inputs, outputs = [], []
+    for k in range(count):
+        a, b = 2 * k + 1, 2 * k + 2
+        P2[a - 1][b - 1], P2[b - 1][a - 1] = -1, 1
+        inputs += [f"e{a}(0)", f"e{a}'(0)", f"e{b}(1)", f"e{b}'(1)"]
+        outputs += [f"e{b}'(0)", f"-e{b}(0)", f"e{a}'(1)", f"-e{a}(1)"]
+    H = [[int(i == j) for j in range(n)] for i in range(n)]
+    return tomli_w.dumps(
+        {
+            "name": f"{count} beams",
+            "interval": [0, 1],
+            "order": 2,
+            "matrices": {"P2": P2, "H": H},
+            "ports": {"inputs": inputs, "outputs": outputs},
+        }
+    )
 
 
 BEAM_SENSORS = "classify euler-bernoulli --sensors"
@@ -430,6 +458,144 @@ COMMAND_ROWS = [
         r"expected \(q, 3\) but found \(1, 4\)",
         ObserverError,
     ),
+    # ---- issue 12, item 2: every input's cost is bounded, refused before the work
+    row(
+        "spectrum wave --resolution 20000",
+        "about 40,002 states; expected at most 2,000",
+        NumericError,
+        seconds=10,
+    ),
+    row("spectrum wave --resolution 1999", "expected at most 2,000", NumericError, seconds=10),
+    row("simulate wave --resolution 5000", "about 10,002 states", NumericError, seconds=10),
+    row(
+        "simulate wave --method fd --resolution 2000",
+        "fd discretization of a size-2 model about 4,002 states",
+        NumericError,
+        seconds=10,
+    ),
+    row(
+        "simulate wave --samples 100000000",
+        "values; expected at most 20,000,000",
+        NumericError,
+        seconds=10,
+    ),
+    row(
+        f"{SIM} --t-end 1.7e308",
+        "t_end must be a positive number at most 1e+12",
+        NumericError,
+        seconds=10,
+    ),
+    row(f"{SIM} --t-end 1e13", "at most 1e+12; found 1e+13", NumericError, seconds=10),
+    row(
+        "simulate wave --t-end 5e-324 --samples 3",
+        "the time stamps would not be distinct",
+        NumericError,
+    ),
+    row("simulate wave --t-end 1e-320 --samples 2", "below 1e-300", NumericError),
+    row(
+        "tune wave --sensors 2 --starts 1000000000",
+        "starts must be an integer from 1 to 100; found 1000000000",
+        NumericError,
+        seconds=10,
+    ),
+    row(
+        "tune wave --sensors 2 --starts 101", "from 1 to 100; found 101", NumericError, seconds=10
+    ),
+    row(
+        "classify wave --sensors 2 --gain exp(1e300)",
+        "in 'exp(1e300)' is out of range",
+        ObserverError,
+        seconds=10,
+    ),
+    row(
+        "classify wave --sensors 2 --gain exp(exp(exp(5)))",
+        "in 'exp(exp(exp(5)))' is out of range",
+        ObserverError,
+        seconds=10,
+    ),
+    # a tower of exponentials that overflows floats: nan and 0 (a 'failing' κ*) before
+    row(
+        "classify wave --all-sensors --gain exp(exp(7))",
+        "exp(exp(7)) in 'exp(exp(7))' is out of range",
+        ObserverError,
+    ),
+    row(
+        "classify wave --sensors 2 --gain exp(exp(7))",
+        "exp(exp(7)) in 'exp(exp(7))' is out of range",
+        ObserverError,
+    ),
+    row(
+        "classify wave --sensors 2 --gain exp(690)*exp(690)",
+        "is out of range; expected magnitudes between 1e-300 and 1e300 (or 0); found exp(1380)",
+        ObserverError,
+    ),
+    row(
+        "ports wave --param rho=exp(1000)",
+        "exp(1000) in 'exp(1000)' is out of range",
+        ParameterError,
+    ),
+    row(
+        "classify {tmp}/beams.toml --all-sensors",
+        "2^32 - 1 = 4294967295 sensor sets for 32 outputs; expected at most 16",
+        ObserverError,
+        seconds=10,
+        **{"beams.toml": beams_toml(8)},
+    ),
+    row(
+        "show {tmp}/big.toml",
+        "is larger than 1,048,576 bytes",
+        ModelFileError,
+        seconds=10,
+        **{"big.toml": "bytes:2000000"},
+    ),
+    row("show /dev/zero", "is larger than 1,048,576 bytes", ModelFileError, seconds=10),
+    # ---- item 3: an overflow is an error line, never rows of NaN or bare NaN in JSON
+    row(
+        f"{SIM} --x0 x1:1e300*z",
+        "the simulation overflowed: H is not finite from t = 0 on",
+        NumericError,
+    ),
+    row(f"{SIM} --x0 x1:z --json --xhat0 x1:1e300*z", "overflowed: H_hat", NumericError),
+    row("simulate wave --param rho=1e-300 --x0 x1:z", "overflowed", NumericError),
+    row(f"{SIM} --gain 1e200 --x0 x1:z", "simulation overflowed", NumericError),
+    row(f"{SIM} --x0 x1:exp(800)*z", "exp(800) in 'exp(800)*z' is out of range", ExpressionError),
+    # ---- items 4 and 5: outputs checked together before the work; no non-regular targets
+    row(
+        f"{SIM} -o {{tmp}}/same.png --plot {{tmp}}/same.png",
+        "is named twice",
+        OutputFileError,
+    ),
+    row(f"{SIM} -o {{tmp}}/a.png --plot {{tmp}}/./a.png", "is named twice", OutputFileError),
+    row(
+        "show wave --toml -o {tmp}/out.toml --force",
+        "is a symbolic link; phdesign writes regular files only",
+        OutputFileError,
+        **{"out.toml": "symlink:/proc/self/fd/1"},
+    ),
+    row(
+        "show wave --toml -o {tmp}/dangling.toml",
+        "is a symbolic link",
+        OutputFileError,
+        **{"dangling.toml": "symlink:nowhere/at/all"},
+    ),
+    row(
+        "show wave --toml -o {tmp}/pipe --force",
+        "is a FIFO; phdesign writes regular files only",
+        OutputFileError,
+        **{"pipe": "fifo:"},
+    ),
+    row(
+        f"{SIM} -o {{tmp}}/run.csv --plot {{tmp}}/pipe.png --force",
+        "is a FIFO",
+        OutputFileError,
+        **{"pipe.png": "fifo:"},
+    ),
+    # ---- item 9
+    row(
+        "tune wave --sensors 2 --seed -1",
+        "argument --seed: expected a non-negative integer; found -1",
+        None,
+    ),
 ]
 
 
@@ -457,23 +623,37 @@ def _materialize(row: Row, tmp_path) -> list[str]:
         path = tmp_path / name
         if "\udcff" in text:
             path.write_bytes(b"\xff\xfe\x00bad")
+        elif text.startswith("symlink:"):
+            path.symlink_to(text.removeprefix("symlink:"))
+        elif text.startswith("fifo:"):
+            os.mkfifo(path)
+        elif text.startswith("bytes:"):  # a TOML file of that many bytes (comments)
+            path.write_text(("# filler\n" * (int(text[6:]) // 9 + 1))[: int(text[6:])])
         else:
             path.write_text(text)
     return [arg.replace("{tmp}", str(tmp_path)) for arg in row.argv]
 
 
+def _snapshot(folder) -> dict[str, int]:
+    return {p.name: p.lstat().st_mtime_ns for p in folder.iterdir()}
+
+
 @pytest.mark.parametrize("bad", ROWS, ids=[r.id for r in ROWS])
 def test_bad_input(bad: Row, tmp_path, capsys):
     argv = _materialize(bad, tmp_path)
-    before = {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()}
+    before = _snapshot(tmp_path)
+    start = time.perf_counter()
     status = main(argv)
+    elapsed = time.perf_counter() - start
     out, err = capsys.readouterr()
+    if bad.seconds is not None:
+        assert elapsed <= bad.seconds, f"refused after {elapsed:.1f} s; expected <= {bad.seconds}"
     assert status == 2, f"exit status {status}; stderr {err!r}"
     assert err.count("\n") == 1, f"expected one stderr line; found {err!r}"
     assert bad.message in err or re.search(bad.message, err), err
     assert "Traceback" not in err
     assert out == ""
-    after = {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()}
+    after = _snapshot(tmp_path)
     assert after == before, "a bad command must not write or touch any file"
     if bad.error is not None:
         with pytest.raises(bad.error):
@@ -481,6 +661,6 @@ def test_bad_input(bad: Row, tmp_path, capsys):
         capsys.readouterr()
 
 
-def test_table_has_at_least_60_rows():
-    """Issue 7 asks for 60 or more; the summary line of every run prints the pass count."""
-    assert len(ROWS) >= 60
+def test_table_has_more_than_160_rows():
+    """Issue 7 asked for 60, issue 12 for more than 160; the summary prints the pass count."""
+    assert len(ROWS) > 160

@@ -222,7 +222,7 @@ def test_public_functions_name_their_arguments(wave, beam):
                 state_names=[1, 2],
             ),
             ModelError,
-            r"state_names must be non-empty text labels; found 1",
+            r"state label 1 must be non-empty text; found 1",
         ),
         (
             lambda: phd.Observer(wave, sensors=[2], gain=1).statespace("loop"),

@@ -101,7 +101,8 @@ def test_scalar_is_exact():
         ("e1(x)", "point"),
         ("1e999*e1(0)", "out of range"),
         ("((10**64)**64)**64*e1(0)", "out of range"),
-        ("1" * 80 + "*e1(0)", "out of range"),
+        ("1" * 311 + "*e1(0)", "out of range"),  # digits beyond MAX_NUMBER_DIGITS
+        ("2" * 303 + "*e1(0)", "out of range"),  # 303 digits but more than 1000 bits
         ("(" * 300 + "e1(0)" + ")" * 300, "nested"),
     ],
 )

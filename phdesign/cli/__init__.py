@@ -100,7 +100,9 @@ def main(argv: Sequence[str] | None = None, *, reraise: bool = False) -> int:
 
 
 def _fail(message: str) -> int:
-    line = f"phdesign: error: {' '.join(message.split())}"
+    from phdesign.cli.common import printable
+
+    line = f"phdesign: error: {printable(' '.join(message.split()))}"
     print(line, file=sys.stderr)
     return 2
 

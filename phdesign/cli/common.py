@@ -17,7 +17,10 @@ __all__ = [
     "emit",
     "emit_json",
     "load_model",
+    "non_negative_int",
     "parse_parameter_overrides",
+    "printable",
+    "warn",
     "write_output",
 ]
 
@@ -65,13 +68,45 @@ def load_model(args: argparse.Namespace) -> BCPHS:
     return load(args.model, overrides or None)
 
 
+#: Characters that would act on a terminal (escape sequences, bidirectional overrides):
+#: printed escaped, so a model named "\x1b[2J" cannot clear the screen.
+_CONTROL = {
+    c: f"\\x{c:02x}" if c < 0x100 else f"\\u{c:04x}"
+    for c in (
+        *range(0x20),
+        0x7F,
+        *range(0x80, 0xA0),
+        *range(0x202A, 0x202F),
+        *range(0x2066, 0x206A),
+    )
+    if chr(c) not in "\n\t"
+}
+
+
+def printable(text: str) -> str:
+    r"""Return ``text`` with terminal control characters escaped (``\x1b`` for ESC).
+
+    Examples
+    --------
+    >>> printable("beam\x1b[2J")
+    'beam\\x1b[2J'
+    """
+    return text.translate(_CONTROL)
+
+
 def emit(text: str) -> None:
-    """Print ``text`` on stdout."""
+    """Print ``text`` on stdout (terminal control characters escaped)."""
+    text = printable(text)
     sys.stdout.write(text if text.endswith("\n") else text + "\n")
 
 
+def warn(message: str) -> None:
+    """Print one ``phdesign: warning: ...`` line on stderr."""
+    print(f"phdesign: warning: {printable(' '.join(message.split()))}", file=sys.stderr)
+
+
 def emit_json(value: Any) -> None:
-    """Print ``value`` as JSON; sympy values become exact strings."""
+    """Print ``value`` as strict JSON (phdesign's one JSON writer); sympy values are text."""
     from phdesign.io import dumps_json
 
     emit(dumps_json(value))
@@ -82,3 +117,14 @@ def write_output(path: str, text: str | bytes, force: bool) -> None:
     from phdesign.io import atomic_write
 
     atomic_write(path, text, force=force)
+
+
+def non_negative_int(text: str) -> int:
+    """Read an integer >= 0 for argparse (a usage error names the option)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer; found {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a non-negative integer; found {value}")
+    return value

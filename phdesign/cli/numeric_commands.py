@@ -23,7 +23,8 @@ from phdesign.cli.common import (
     emit,
     emit_json,
     load_model,
-    write_output,
+    non_negative_int,
+    warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
 from phdesign.cli.export_command import add_sampling_arguments, sampled_simulation
@@ -133,7 +134,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     tn.add_argument(
         "--seed",
-        type=int,
+        type=non_negative_int,
         default=0,
         help="seed of the random grid (more than 625 points); default: %(default)s",
     )
@@ -196,8 +197,13 @@ def _spectrum(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
+    import warnings
+
+    import numpy as np
+
     from phdesign.design import Plant
     from phdesign.numeric.bridge import input_function
+    from phdesign.outputs import OutputFiles
 
     _check_positive("--resolution", args.resolution)
     _check_positive("--t-end", args.t_end)
@@ -212,69 +218,83 @@ def _simulate(args: argparse.Namespace) -> int:
     plant = (
         observer.plant if observer is not None else Plant(model, {}, args.method, args.resolution)
     )
-    # read the initial states and inputs and refuse unwritable or existing outputs before
-    # the (possibly long) simulation
+    # read the initial states and inputs before the (possibly long) simulation
     x0 = plant.initial_state(args.x0, "x0")
     xhat0 = plant.initial_state(args.xhat0, "xhat0")
     u = input_function(args.u, plant.numeric, model=model)
-    if args.output:
-        from phdesign.io import check_output_path
-
-        check_output_path(args.output, args.force)
-    if args.plot:
-        from phdesign.plots import check_plot_path
-
-        check_plot_path(args.plot, args.force)
     C_m, L = (None, None) if observer is None else observer.numeric_gain("simulate")
     # a sampled or lower-order observer (--dt, --sampler, --observer-resolution), a noisy
     # run (--noise-intensity, --input-noise), else the continuous noiseless one
     noisy = stochastic_simulation(args)
-    res = sampled_simulation(args, plant.numeric, C_m, L, x0, xhat0)
-    if res is None and noisy is not None:
-        res = noisy(
-            plant.numeric,
-            C_m,
-            L,
-            x0=x0,
-            xhat0=xhat0,
-            t_end=args.t_end,
-            samples=args.samples,
-            method=args.method,
-            resolution=args.resolution,
-            scheme=args.scheme,
-            u=u,
-        )
-    if res is not None:
-        res = plant.labelled(res, **({} if observer is None else observer.labels()))
-    else:
-        options = {"t_end": args.t_end, "samples": args.samples, "scheme": args.scheme, "u": u}
-        if observer is not None:
-            res = observer.simulate(x0, xhat0=xhat0, **options)
-        else:
-            res = plant.simulate(x0, **options)
-    if args.json:
-        import json
+    # every output is checked before the simulation and written together at the end: on
+    # any failure or interrupt none is left, and no temporary file
+    with OutputFiles(args.force) as out, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fmt = None
+        if args.output:
+            out.add(args.output)
+        if args.plot:
+            from phdesign.plots import check_plot_path
 
-        text = json.dumps({"model": model.name, **res.to_dict()})
-    else:
-        text = str(res)
-    if args.output:
-        write_output(args.output, text, args.force)
-    else:
+            fmt = check_plot_path(args.plot, args.force)
+            out.add(args.plot)
+        with np.errstate(all="ignore"):  # an overflow is refused below, with one line
+            res = sampled_simulation(args, plant.numeric, C_m, L, x0, xhat0)
+            if res is None and noisy is not None:
+                res = noisy(
+                    plant.numeric,
+                    C_m,
+                    L,
+                    x0=x0,
+                    xhat0=xhat0,
+                    t_end=args.t_end,
+                    samples=args.samples,
+                    method=args.method,
+                    resolution=args.resolution,
+                    scheme=args.scheme,
+                    u=u,
+                )
+            if res is not None:
+                res = plant.labelled(res, **({} if observer is None else observer.labels()))
+            else:
+                options = {
+                    "t_end": args.t_end,
+                    "samples": args.samples,
+                    "scheme": args.scheme,
+                    "u": u,
+                }
+                if observer is not None:
+                    res = observer.simulate(x0, xhat0=xhat0, **options)
+                else:
+                    res = plant.simulate(x0, **options)
+        check_finite_series(res)
+        if args.json:
+            from phdesign.io import dumps_json
+
+            text = dumps_json({"model": model.name, **res.to_dict()}, indent=None)
+        else:
+            text = str(res)
+        if args.plot:
+            import io
+
+            picture = io.BytesIO()
+            res.plot().savefig(picture, format=fmt, dpi=110)
+            out.stage(args.plot, picture.getvalue())
+        if args.output:
+            out.stage(args.output, text)
+        out.commit()
+    if not args.output:
         emit(text)
-    if args.plot:
-        res.plot(args.plot, force=args.force)
-    warnings = list(res.warnings)
-    if observer is not None and args.gain is None:
-        warnings.insert(0, "no --gain given: the observer uses L = I (--gain 1)")
+    notices = []
     if args.x0 is None:
-        warnings.insert(
-            0,
+        notices.append(
             "no --x0 given: the plant starts at rest (x0 = 0), so without an input every "
-            "series is zero",
+            "series is zero"
         )
-    for warning in warnings:
-        print(f"phdesign: warning: {warning}", file=sys.stderr)
+    if observer is not None and args.gain is None:
+        notices.append("no --gain given: the observer uses L = I (--gain 1)")
+    for warning in (*notices, *res.warnings, *dict.fromkeys(str(w.message) for w in caught)):
+        warn(warning)
     return 0
 
 
@@ -320,6 +340,28 @@ class _Progress:
         if self._shown:
             sys.stderr.write("\r" + " " * self._shown + "\r")
             sys.stderr.flush()
+
+
+def check_finite_series(result: Any) -> None:
+    """Refuse a simulation whose series overflowed (NaN or infinity), naming the first one.
+
+    Large initial states, tiny parameters or huge gains can overflow double precision;
+    such a run is an error, never rows of NaN.
+    """
+    import numpy as np
+
+    for name in ("H", "H_hat", "H_err", "y", "y_hat", "w", "w_hat"):
+        series = getattr(result, name, None)
+        if series is None:
+            continue
+        values = np.asarray(series, dtype=float)
+        bad = ~np.isfinite(values.reshape(values.shape[0], -1)).all(axis=1)
+        if bad.any():
+            first = float(result.t[int(np.argmax(bad))])
+            raise NumericError(
+                f"the simulation overflowed: {name} is not finite from t = {first:.6g} on; "
+                "the initial state, parameters or gain are too large for double precision"
+            )
 
 
 def _tune(args: argparse.Namespace) -> int:

@@ -50,9 +50,13 @@ def builtin_toml(name: str) -> str:
     return resources.files(__package__).joinpath(f"{name}.toml").read_text(encoding="utf-8")
 
 
-@cache
 def load_builtin(name: str) -> BCPHS:
     """Return built-in model ``name`` (validated; cached)."""
+    return _load_builtin(builtin_toml(name) and name)  # a bad name is refused first
+
+
+@cache
+def _load_builtin(name: str) -> BCPHS:
     from phdesign.io import model_from_toml
 
     return model_from_toml(builtin_toml(name), source=f"built-in model {name!r}")

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from phdesign import limits
 from phdesign.arguments import choice, positive_int, positive_number, require_numeric_model
 from phdesign.errors import ArgumentError, NumericError, ObserverError
 
@@ -130,12 +131,13 @@ def check_spectrum_arguments(
     rtol_resolved: Any,
     count: Any,
 ) -> None:
-    """Check the arguments of :func:`~phdesign.numeric.spectrum.spectrum`."""
+    """Check the arguments of :func:`~phdesign.numeric.spectrum.spectrum` and its budget."""
     _common(nm, method, resolution, tol, max_resolution)
     if rtol_resolved is not None:
         positive_number(rtol_resolved, "rtol_resolved")
     positive_int(count, "count")
     check_sensors_and_gain(nm, C_m, L, what="the spectrum")
+    limits.check_discretization(nm, method, resolution, max_resolution)
 
 
 def check_simulate_arguments(
@@ -152,8 +154,9 @@ def check_simulate_arguments(
     u: Callable[[float], Any] | None,
     scheme: Any,
     z_w: Any,
+    discrete: Any = None,
 ) -> None:
-    """Check the arguments of :func:`~phdesign.numeric.simulate.simulate`."""
+    """Check the arguments of :func:`~phdesign.numeric.simulate.simulate` and its budget."""
     _common(nm, method, resolution)
     positive_number(t_end, "t_end")
     positive_int(samples, "samples", minimum=2)
@@ -173,6 +176,7 @@ def check_simulate_arguments(
             raise NumericError(f"z_w must be a non-empty list of finite points; found {z_w!r}")
         if points.min() < a or points.max() > b:
             raise NumericError(f"z_w must lie in [{a:g}, {b:g}]; found {points.tolist()}")
+    limits.check_simulation(nm, C_m, t_end, samples, method, resolution, discrete)
 
 
 def check_tune_arguments(
@@ -187,7 +191,7 @@ def check_tune_arguments(
     maxiter: Any,
     method: str = "galerkin",
 ) -> None:
-    """Check the arguments of :func:`~phdesign.numeric.tune.tune`."""
+    """Check the arguments of :func:`~phdesign.numeric.tune.tune` and its budget."""
     _common(nm, method, resolution)
     if C_m is None:
         raise ObserverError("tuning needs the sensors C_m")
@@ -203,3 +207,4 @@ def check_tune_arguments(
         raise NumericError(f"log_range must be a pair (low, high); found {log_range!r}") from None
     if not (np.isfinite(low) and np.isfinite(high) and low < high):
         raise NumericError(f"log_range must hold finite low < high; found {log_range!r}")
+    limits.check_tuning(nm, starts, seed, maxiter, resolution)

@@ -22,11 +22,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import numpy as np
 
-from phdesign.errors import ModelError, NumericError, ParameterError, check_shape
+from phdesign.errors import ExpressionError, ModelError, NumericError, ParameterError, check_shape
 from phdesign.symbolic.ports import trace_index
 
 __all__ = [
@@ -251,9 +252,8 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         When a parameter is unknown or a symbol other than z stays free (the message
         names them).
     """
-    import sympy
-
     from phdesign.arguments import require_model
+    from phdesign.symbolic.expressions import exact_matrix, exact_number
     from phdesign.symbolic.model import Z
 
     require_model(model)
@@ -265,13 +265,13 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
     N, n = int(model.order), int(model.size)
 
     def subs_matrix(name: str, mat: Any, allow_z: bool) -> Any:
-        out = sympy.ImmutableMatrix(mat).subs(values)
+        out = exact_matrix(mat, name, symbols=True).xreplace(values)
         free = set(out.free_symbols) - ({Z} if allow_z else set())
         if free:
             raise ParameterError(_free_symbols_message(name, free))
         return out
 
-    a_s, b_s = (sympy.sympify(s).subs(values) for s in model.interval)
+    a_s, b_s = (exact_number(s, "interval endpoint") for s in model.interval)
     for nm_, s in (("interval start a", a_s), ("interval end b", b_s)):
         if s.free_symbols:
             raise ParameterError(_free_symbols_message(nm_, set(s.free_symbols)))
@@ -350,22 +350,25 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
     return nm
 
 
+def _evaluate_at(expr: Any, variable: Any, t: float) -> Any:
+    """``expr`` at ``variable = t`` (the safe evaluator: no code generation)."""
+    from phdesign.symbolic.evaluation import evaluate
+
+    return evaluate(expr, np.array(t), variable=variable)
+
+
 def _matrix_function(matrix: Any, n: int) -> Callable[[np.ndarray], np.ndarray]:
     """Return a vectorized callable ``f(z) -> (m, n, n)`` of a sympy matrix in z."""
-    import sympy
+    from phdesign.symbolic.evaluation import evaluate
 
-    from phdesign.symbolic.model import Z
+    entries = [matrix[i, j] for i in range(n) for j in range(n)]
 
-    entries = [
-        sympy.lambdify(Z, matrix[i, j], modules="numpy") for i in range(n) for j in range(n)
-    ]
-
-    def evaluate(z: np.ndarray) -> np.ndarray:
+    def values(z: np.ndarray) -> np.ndarray:
         zz = np.atleast_1d(np.asarray(z, dtype=float))
-        vals = [np.broadcast_to(np.asarray(f(zz), dtype=float), zz.shape) for f in entries]
+        vals = [evaluate(entry, zz) for entry in entries]  # no code generation
         return np.stack(vals, axis=-1).reshape(zz.size, n, n)
 
-    return evaluate
+    return values
 
 
 def gain_to_numeric(matrix: Any, name: str = "L") -> np.ndarray:
@@ -411,7 +414,9 @@ def trace_row(text: str, nm: NumericModel, model: Any = None) -> np.ndarray:
 
     values = _parameter_values(model, None) if model is not None else {}
     if model is not None:  # exact endpoints, so that "e1(1)" names the endpoint 1
-        interval = tuple(sympy.sympify(x).subs(values) for x in model.interval)
+        interval = tuple(
+            ex.exact_number(x, "interval endpoint").xreplace(values) for x in model.interval
+        )
     else:
         interval = tuple(sympy.Rational(repr(x)) for x in nm.interval)
     expr = ex.parse_trace_expression(
@@ -468,7 +473,6 @@ def initial_state_function(
     n = nm.size
     if text is None or not text.strip():
         return lambda z: np.zeros((np.atleast_1d(z).size, n))
-    import sympy
 
     names = {s: i for i, s in enumerate(nm.state_names)}
     names.update({f"x{i + 1}": i for i in range(n)})
@@ -495,9 +499,9 @@ def initial_state_function(
         if idx in exprs:
             raise ParameterError(f"{what}: component {key!r} given twice")
         exprs[idx] = _parse_z_expression(expr_text, nm, model, parameters, f"{what} expression")
-    from phdesign.symbolic.model import Z
+    from phdesign.symbolic.evaluation import evaluate
 
-    funcs = {i: sympy.lambdify(Z, e, modules="numpy") for i, e in exprs.items()}
+    funcs = {i: (lambda zz, e=e: evaluate(e, zz)) for i, e in exprs.items()}
 
     def x0(z: np.ndarray) -> np.ndarray:
         zz = np.atleast_1d(np.asarray(z, dtype=float))
@@ -531,9 +535,10 @@ def _split_top_level(text: str) -> list[str]:
 
 
 def _exact_value(value: Any) -> Any:
-    import sympy
+    """Return a parameter value as an exact number (a float by its shortest decimal)."""
+    from phdesign.symbolic.expressions import exact_number
 
-    return sympy.Float(value) if isinstance(value, float) else value
+    return exact_number(value, "parameter value") if isinstance(value, float) else value
 
 
 def _substituted_values(
@@ -618,7 +623,6 @@ def input_function(
         return None
     import sympy
 
-    from phdesign.errors import ExpressionError
     from phdesign.symbolic.parser import check_text, parse
 
     check_text(text, "--u")
@@ -654,7 +658,7 @@ def input_function(
             expr = parse(body, resolve)
         except ExpressionError as error:
             raise ExpressionError(f"--u {key}: {error}") from None
-        funcs[names[key]] = sympy.lambdify(time, expr, modules="math")
+        funcs[names[key]] = partial(_evaluate_at, expr, time)
 
     def u(t: float) -> np.ndarray:
         out = np.zeros(m)

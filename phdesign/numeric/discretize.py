@@ -34,6 +34,7 @@ Methods
 
 from __future__ import annotations
 
+from phdesign import limits
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.feedback import close_plant_feedback
@@ -61,6 +62,7 @@ def discretize(
     -------
     DiscretePHS
     """
+    limits.check_discretization(nm, method, resolution)
     if method == "galerkin":
         from phdesign.numeric.galerkin import galerkin
 

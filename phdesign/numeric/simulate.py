@@ -367,6 +367,7 @@ def simulate(
         u=u,
         scheme=scheme,
         z_w=z_w,
+        discrete=discrete,
     )
     if not (np.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a positive number; found {t_end}")

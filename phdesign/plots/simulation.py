@@ -109,8 +109,8 @@ def plot_simulation(
         _plot_output_error(result, axes[1, 1], measured)
     if title is None:
         title = getattr(result, "title", None)
-    if title:
-        fig.suptitle(title)
+    if title:  # a title, never mathtext: a model named "$\frac{1}{$" must not break it
+        fig.suptitle(title.replace("$", r"\$"))
     if path is not None:
         from phdesign.io import atomic_write
 

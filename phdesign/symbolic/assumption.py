@@ -157,9 +157,9 @@ def check_assumption(
             False, (), f"partition search not attempted for n = {n} > {MAX_SIZE}"
         )
     h = n // 2
-    p1 = [[sympy.sympify(P1[i, j]) for j in range(n)] for i in range(n)]
-    p2 = [[sympy.sympify(P2[i, j]) for j in range(n)] for i in range(n)]
-    hh = [[sympy.sympify(H[i, j]) for j in range(n)] for i in range(n)]
+    p1 = [[sympy.sympify(P1[i, j], strict=True) for j in range(n)] for i in range(n)]
+    p2 = [[sympy.sympify(P2[i, j], strict=True) for j in range(n)] for i in range(n)]
+    hh = [[sympy.sympify(H[i, j], strict=True) for j in range(n)] for i in range(n)]
     zero_cache: dict[sympy.Expr, bool] = {}
 
     def zero(expr: sympy.Expr) -> bool:

@@ -45,6 +45,7 @@ the non-zero root branches.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -53,6 +54,7 @@ import sympy
 from sympy.polys.matrices import DomainMatrix
 
 from phdesign.errors import ObserverError
+from phdesign.limits import EXACT_KAPPA_OPERATIONS
 from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.observer import ErrorSystem
 
@@ -171,18 +173,62 @@ def certify(
     if symbolic:
         kappa, conditions = _symbolic_kappa(A_r, B_r)
         return Certificate(True, kappa, None, False, None, (), "symbolic", conditions, pencil)
-    if method in ("auto", "exact"):
+    affordable = _operations(A_r, B_r) <= EXACT_KAPPA_OPERATIONS
+    if method == "exact" and not affordable:
+        raise ObserverError(
+            f"the exact κ* of this pencil is over budget ({_operations(A_r, B_r)} operations "
+            f"> {EXACT_KAPPA_OPERATIONS}, phdesign.limits.EXACT_KAPPA_OPERATIONS); "
+            "use method='float'"
+        )
+    if method in ("auto", "exact") and affordable:
         exact = _exact_kappa(A_r, B_r)
         if exact is not None:
             return Certificate(
-                True, exact, float(exact.evalf(30)), False, None, (), "exact", None, pencil
+                True, exact, _as_float(exact), False, None, (), "exact", None, pencil
             )
         if method == "exact":
             raise ObserverError(
                 "method='exact': no exact root is available for this pencil; use "
                 "method='float' or 'auto'"
             )
-    return Certificate(True, None, float_kappa(A_r, B_r), False, None, (), "float", None, pencil)
+    kappa, kappa_float = _scaled_float_kappa(A_r, B_r)
+    return Certificate(True, kappa, kappa_float, False, None, (), "float", None, pencil)
+
+
+def _operations(*matrices: sympy.MatrixBase) -> int:
+    """Size of a pencil's entries: the measure of :data:`EXACT_KAPPA_OPERATIONS`."""
+    return sum(sympy.count_ops(x) for M in matrices for x in M)
+
+
+def _as_float(value: sympy.Expr) -> float | None:
+    """``value`` as a float, or ``None`` when a double cannot hold it (1e-500, 1e400)."""
+    number = float(value.evalf(30))
+    if value != 0 and (number == 0.0 or not math.isfinite(number)):
+        return None
+    return number
+
+
+def _scaled_float_kappa(
+    A_r: sympy.MatrixBase, B_r: sympy.MatrixBase
+) -> tuple[sympy.Expr | None, float | None]:
+    r"""Float :math:`\kappa^*` of a pencil whose entries may lie beyond double range.
+
+    With :math:`\alpha = \max|A_{ij}|`, :math:`\beta = \max|B_{ij}|` (exact), the pencil
+    :math:`(A/\alpha, B/\beta)` has entries of order one and
+    :math:`\kappa^* = \kappa^*(A/\alpha, B/\beta)\, \alpha/\beta`: gains of 1e200 neither
+    overflow nor turn κ* into 0. Returns κ* as a 15-digit sympy number when a double cannot
+    hold it (then the float is ``None``), else ``(None, float)``.
+    """
+    alpha = max((abs(x) for x in A_r), key=lambda x: float(sympy.log(x + 1e-300).evalf(15)))
+    beta = max((abs(x) for x in B_r), key=lambda x: float(sympy.log(x + 1e-300).evalf(15)))
+    if alpha == 0 or beta == 0:
+        return None, float_kappa(A_r, B_r)
+    scaled = float_kappa(A_r / alpha, B_r / beta)
+    if scaled is None:
+        return None, None
+    value = sympy.Float(scaled, 15) * sympy.N(alpha / beta, 15)
+    as_float = _as_float(value)
+    return (None, as_float) if as_float is not None else (value, None)
 
 
 def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | None:

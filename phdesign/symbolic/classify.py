@@ -358,7 +358,7 @@ def _number(x: sympy.Expr) -> Any:
 
 
 def _rows(M: sympy.MatrixBase) -> list[list[Any]]:
-    return [[_number(sympy.sympify(x)) for x in row] for row in M.tolist()]
+    return [[_number(sympy.sympify(x, strict=True)) for x in row] for row in M.tolist()]
 
 
 def _strength(r: VariantResult) -> tuple[int, float]:

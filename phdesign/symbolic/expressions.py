@@ -25,6 +25,9 @@ z**2 + 1/rho
 
 from __future__ import annotations
 
+import fractions
+import math
+import numbers
 import re
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
@@ -32,16 +35,20 @@ from functools import lru_cache
 from typing import Literal
 
 import sympy
+from sympy.printing.str import StrPrinter
 
 from phdesign.errors import ExpressionError
-from phdesign.symbolic.parser import CONSTANTS, FUNCTIONS, Token, check_text, parse
+from phdesign.limits import MAX_NUMBER_OPERATIONS
+from phdesign.symbolic.parser import CONSTANTS, FUNCTIONS, Token, brief, check_text, parse
 
 __all__ = [
     "Trace",
     "Z",
     "canonical",
+    "exact_matrix",
     "exact_number",
     "format_expression",
+    "format_number",
     "linear_coefficients",
     "parameter_symbol",
     "parse_scalar",
@@ -86,7 +93,11 @@ class Trace:
         return trace_symbol(self.component, self.derivative, self.side)
 
     def label(self, interval: Sequence[object] | None = None, tilde: bool = False) -> str:
-        """Return the trace in user syntax, e.g. ``e2'(0)``, or ``ẽ2'(0)`` with ``tilde``."""
+        """Return the trace in user syntax, e.g. ``e2'(0)``, or ``ẽ2'(0)`` with ``tilde``.
+
+        ``interval`` gives the endpoints to print (numbers, or text read by the safe
+        parser); without it the point is written ``a`` or ``b``.
+        """
         point = self.side if interval is None else _point_text(interval, self.side)
         head = "ẽ" if tilde else "e"
         return f"{head}{self.component}{chr(39) * self.derivative}({point})"
@@ -140,35 +151,116 @@ def check_parameter_name(name: str) -> None:
 
 
 def exact_number(value: object, what: str) -> sympy.Expr:
-    """Convert an int, float or numeric string to an exact sympy number.
+    """Convert an int, float, fraction, sympy number or numeric string to an exact number.
 
     Floats are read through their shortest decimal representation, so ``0.2``
-    becomes :math:`1/5` exactly. NaN and infinities are refused.
+    becomes :math:`1/5` exactly; strings go through the safe parser. NaN, infinities,
+    non-real values and magnitudes outside 1e-300..1e300 (other than 0) are refused.
 
     Examples
     --------
     >>> exact_number(0.2, "d")
     1/5
+    >>> exact_number("sqrt(2)/2", "gain")
+    sqrt(2)/2
     """
     if isinstance(value, bool):
         raise ExpressionError(f"{what} must be a number; found the boolean {value}")
-    if isinstance(value, int):
-        return sympy.Integer(value)
-    if isinstance(value, float):
-        if value != value or value in (float("inf"), float("-inf")):
-            raise ExpressionError(f"{what} must be a finite number; found {value}")
-        return sympy.Rational(repr(value))
-    if isinstance(value, sympy.Expr):
-        expr = exactify(value)
-        if not expr.is_number or expr.is_real is False:
-            raise ExpressionError(f"{what} must be a real number; found {value}")
-        if expr.has(sympy.nan, sympy.zoo, sympy.oo, -sympy.oo):
-            raise ExpressionError(f"{what} must be a finite number; found {value}")
-        return expr
     if isinstance(value, str):
         expr = parse_scalar(value, parameters=(), allow_z=False, what=what)
-        return exact_number(expr, what)
-    raise ExpressionError(f"{what} must be a number; found {type(value).__name__} {value!r}")
+    elif isinstance(value, numbers.Integral):
+        expr = sympy.Integer(int(value))
+    elif isinstance(value, fractions.Fraction):
+        expr = sympy.Rational(value.numerator, value.denominator)
+    elif isinstance(value, numbers.Real) and not isinstance(value, sympy.Basic):
+        number = float(value)
+        if not math.isfinite(number):
+            raise ExpressionError(f"{what} must be a finite number; found {value}")
+        expr = sympy.Rational(repr(number))
+    elif isinstance(value, sympy.Expr):
+        expr = exactify(value)
+        if expr.has(sympy.nan, sympy.zoo, sympy.oo, -sympy.oo):
+            raise ExpressionError(f"{what} must be a finite number; found {value}")
+        if not expr.is_number or expr.is_real is False or expr.has(sympy.I):
+            raise ExpressionError(f"{what} must be a real number; found {_brief(expr)}")
+    else:
+        raise ExpressionError(
+            f"{what} must be a number; found {type(value).__name__} {_brief(value)}"
+        )
+    _check_range(expr, what)
+    return expr
+
+
+def _check_range(expr: sympy.Expr, what: str) -> None:
+    """Refuse a non-zero number whose magnitude lies outside 1e-300..1e300."""
+    if expr.is_zero:
+        return
+    if not expr.is_Rational and expr.count_ops() > MAX_NUMBER_OPERATIONS:
+        raise ExpressionError(f"{what} has more than {MAX_NUMBER_OPERATIONS} operations")
+    value = expr if expr.is_Rational else sympy.N(expr, 15)  # exact comparison if rational
+    if not value.is_Number:
+        raise ExpressionError(f"{what} must be a real number; found {_brief(expr)}")
+    if sympy.Rational(1, 10**300) <= abs(value) <= 10**300:
+        return
+    raise ExpressionError(
+        f"{what} is out of range; expected magnitudes between 1e-300 and 1e300 (or 0); "
+        f"found {_brief(expr)}"
+    )
+
+
+def _brief(value: object) -> str:
+    return brief(value, 60)
+
+
+def exact_matrix(value: object, what: str, symbols: bool = False) -> sympy.ImmutableMatrix:
+    """Convert a matrix (nested lists, sympy or numpy) to an exact sympy matrix, safely.
+
+    Entries go through :func:`exact_number` (text through the safe parser, never
+    :func:`sympy.sympify`); with ``symbols`` true, sympy expressions holding symbols are
+    kept as they are (e.g. symbolic gains).
+
+    Raises
+    ------
+    ExpressionError
+        If ``value`` is not a non-empty rectangular matrix of finite real numbers.
+
+    Examples
+    --------
+    >>> exact_matrix([[0.5, "1/3"]], "C_m")
+    Matrix([[1/2, 1/3]])
+    """
+    if isinstance(value, sympy.MatrixBase):
+        rows: object = value.tolist()
+    elif hasattr(value, "tolist") and not isinstance(value, str | sympy.Basic):
+        rows = value.tolist()  # numpy arrays, without importing numpy here
+    else:
+        rows = value
+    if isinstance(rows, str | bytes) or not isinstance(rows, Sequence) or not rows:
+        raise ExpressionError(
+            f"{what} must be a non-empty matrix (a list of rows); found {_brief(value)}"
+        )
+    table = [list(r) if isinstance(r, Sequence) and not isinstance(r, str) else r for r in rows]
+    if not all(isinstance(r, list) and r for r in table):
+        raise ExpressionError(
+            f"{what} must be a non-empty list of non-empty rows; found {_brief(value)}"
+        )
+    width = len(table[0])
+    for i, row in enumerate(table):
+        if len(row) != width:
+            raise ExpressionError(
+                f"{what} row {i + 1} has {len(row)} entries; expected {width} like row 1"
+            )
+    entries = []
+    for i, row in enumerate(table):
+        converted = []
+        for j, x in enumerate(row):
+            where = f"{what}[{i + 1},{j + 1}]"
+            if symbols and isinstance(x, sympy.Expr) and x.free_symbols:
+                converted.append(exactify(x))
+            else:
+                converted.append(exact_number(x, where))
+        entries.append(converted)
+    return sympy.ImmutableMatrix(entries)
 
 
 def canonical(expr: sympy.Expr) -> sympy.Expr:
@@ -188,7 +280,12 @@ def vanishes(expr: object) -> bool:
     :func:`canonical`; :func:`sympy.simplify` is the last resort, for transcendental
     entries (it is slow, and imports ``sympy.physics`` on first use).
     """
-    e = sympy.sympify(expr)
+    try:
+        e = sympy.sympify(expr, strict=True)  # strict: text is never parsed here
+    except sympy.SympifyError:
+        raise ExpressionError(
+            f"expected a sympy expression or a number; found {type(expr).__name__}"
+        ) from None
     if e == 0:
         return True
     if e.is_Number:
@@ -208,7 +305,13 @@ def exactify(expr: sympy.Expr) -> sympy.Expr:
     floats = expr.atoms(sympy.Float)
     if not floats:
         return expr
-    return expr.xreplace({f: sympy.Rational(repr(float(f))) for f in floats})
+    exact = {}
+    for f in floats:
+        number = float(f)
+        if not math.isfinite(number):
+            raise ExpressionError(f"a floating-point number in {_brief(expr)} is not finite")
+        exact[f] = sympy.Rational(repr(number))
+    return expr.xreplace(exact)
 
 
 def parse_scalar(
@@ -233,10 +336,21 @@ def parse_scalar(
         The exact expression (decimals become rationals).
     """
     check_text(text, what)
+    names = _names(parameters)
     try:
-        return parse(text, _name_resolver(frozenset(parameters), allow_z))
+        return parse(text, _name_resolver(names, allow_z))
     except ExpressionError as error:
         raise ExpressionError(f"{what}: {error}") from None
+
+
+def _names(parameters: object) -> frozenset[str]:
+    """Return the parameter names a caller allows, refusing anything but text."""
+    if isinstance(parameters, str) or not isinstance(parameters, Iterable):
+        raise ExpressionError(f"parameters must be a list of names; found {_brief(parameters)}")
+    names = list(parameters)
+    if not all(isinstance(name, str) for name in names):
+        raise ExpressionError(f"parameters must be a list of names; found {_brief(names)}")
+    return frozenset(names)
 
 
 def _name_resolver(parameters: frozenset[str], allow_z: bool) -> Callable[[str, str], sympy.Expr]:
@@ -258,8 +372,30 @@ def _name_resolver(parameters: frozenset[str], allow_z: bool) -> Callable[[str, 
     return resolve
 
 
+def _endpoints(interval: object) -> tuple[sympy.Expr, sympy.Expr]:
+    """Return the exact endpoints of a caller's interval (numbers, or text for the parser)."""
+    if isinstance(interval, str) or not isinstance(interval, Sequence) or len(interval) != 2:
+        raise ExpressionError(f"interval must be a pair (a, b); found {_brief(interval)}")
+    a, b = (exact_number(p, "interval endpoint") for p in interval)
+    return a, b
+
+
 def _point_text(interval: Sequence[object], side: Side) -> str:
-    return str(sympy.sympify(interval[0 if side == "a" else 1]))
+    try:  # a model prints every trace at its interval: read the endpoints once
+        return _cached_point_text(tuple(interval), side)
+    except TypeError:  # an unhashable endpoint
+        return format_expression(_endpoints(interval)[0 if side == "a" else 1])
+
+
+#: Longest endpoint text a trace's point may hold (:func:`_side_of` reads no longer one).
+_POINT_TEXT_LIMIT = 40
+
+
+@lru_cache(maxsize=256)
+def _cached_point_text(interval: tuple[object, ...], side: Side) -> str:
+    text = format_expression(_endpoints(interval)[0 if side == "a" else 1])
+    # an endpoint too long to read back as a point (b = 1e300 has 301 digits) is its name
+    return text if len(text) <= _POINT_TEXT_LIMIT and _POINT_NUMBER.match(text) else side
 
 
 def parse_trace_expression(
@@ -293,7 +429,10 @@ def parse_trace_expression(
         A linear form in the symbols of :func:`trace_symbol`, with no constant term.
     """
     check_text(text, what)
-    a, b = (sympy.Rational(str(sympy.sympify(p))) if _is_rational(p) else p for p in interval)
+    a, b = _endpoints(interval)
+    for name, value in (("order", order), ("size", size)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ExpressionError(f"{name} must be a positive integer; found {value!r}")
 
     def make_trace(token: Token) -> sympy.Expr:
         component_text, primes, point = token.groups
@@ -311,18 +450,11 @@ def parse_trace_expression(
         return trace_symbol(component, derivative, _side_of(str(point), a, b, token.text))
 
     try:
-        expr = parse(text, _name_resolver(frozenset(parameters), False), make_trace)
+        expr = parse(text, _name_resolver(_names(parameters), False), make_trace)
     except ExpressionError as error:
         raise ExpressionError(f"{what} {text!r}: {error}") from None
     linear_coefficients(expr, what=f"{what} {text!r}")
     return expr
-
-
-def _is_rational(value: object) -> bool:
-    try:
-        return bool(sympy.sympify(value).is_rational)
-    except (sympy.SympifyError, TypeError):
-        return False
 
 
 _POINT_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?:/\d+)?\Z")
@@ -331,7 +463,7 @@ _POINT_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?:/\d+)?\
 def _side_of(point: str, a: object, b: object, trace_text: str) -> Side:
     if point in ("a", "b"):
         return point  # type: ignore[return-value]
-    if not _POINT_NUMBER.match(point) or len(point) > 40:
+    if not _POINT_NUMBER.match(point) or len(point) > _POINT_TEXT_LIMIT:
         raise ExpressionError(
             f"point of {trace_text!r} must be a, b or an endpoint value; found {point!r}"
         )
@@ -355,43 +487,116 @@ def linear_coefficients(expr: sympy.Expr, what: str = "expression") -> dict[Trac
         If the expression has a constant term, a product or power of traces, a trace
         inside a function, no trace at all, or a coefficient depending on ``z``.
     """
-    symbols = sorted(
-        (s for s in expr.free_symbols if trace_of(s) is not None), key=lambda s: s.name
-    )
+    if not isinstance(expr, sympy.Expr):
+        raise ExpressionError(
+            f"{what} must be a sympy expression; found {type(expr).__name__} {_brief(expr)}"
+        )
+    symbols = {s for s in expr.free_symbols if trace_of(s) is not None}
     if not symbols:
         raise ExpressionError(f"{what} contains no trace; expected a combination like e1(0)")
     if expr.has(Z):
         raise ExpressionError(f"{what} depends on z; coefficients must be constants")
-    try:
-        poly = sympy.Poly(sympy.expand(expr), *symbols)
-    except sympy.PolynomialError:
-        raise ExpressionError(
-            f"{what} is not linear in the traces (a trace appears inside a function)"
-        ) from None
-    if poly.total_degree() > 1:
-        raise ExpressionError(
-            f"{what} is not linear in the traces; found degree {poly.total_degree()}"
-        )
+    sums: dict[sympy.Symbol, list[sympy.Expr]] = {}
+    # one pass over the terms of the expansion (far cheaper than a Poly in 2Nn symbols)
+    for term in sympy.Add.make_args(sympy.expand(expr)):
+        traces, rest = [], []
+        for factor in sympy.Mul.make_args(term):
+            if factor in symbols:
+                traces.append(factor)
+            elif factor.free_symbols & symbols:
+                if factor.is_Pow and factor.base in symbols and factor.exp.is_Integer:
+                    raise ExpressionError(
+                        f"{what} is not linear in the traces; found degree {factor.exp}"
+                    )
+                raise ExpressionError(
+                    f"{what} is not linear in the traces (a trace appears inside a function)"
+                )
+            else:
+                rest.append(factor)
+        if not traces:
+            raise ExpressionError(f"{what} has a constant term {term}; expected none")
+        if len(traces) > 1:
+            raise ExpressionError(
+                f"{what} is not linear in the traces; found degree {len(traces)}"
+            )
+        sums.setdefault(traces[0], []).append(sympy.Mul(*rest))
     coefficients: dict[Trace, sympy.Expr] = {}
-    for monomial, coefficient in poly.terms():
-        if sum(monomial) == 0:
-            raise ExpressionError(f"{what} has a constant term {coefficient}; expected none")
-        symbol = symbols[monomial.index(1)]
-        if coefficient.free_symbols & set(symbols):
-            raise ExpressionError(f"{what} is not linear in the traces")
-        coefficients[trace_of(symbol)] = coefficient  # type: ignore[index]
+    for symbol in sorted(sums, key=lambda s: s.name):
+        coefficient = sympy.Add(*sums[symbol])
+        if coefficient != 0:
+            coefficients[trace_of(symbol)] = coefficient  # type: ignore[index]
+    if not coefficients:
+        raise ExpressionError(f"{what} contains no trace; expected a combination like e1(0)")
     return coefficients
 
 
-def format_expression(expr: sympy.Expr, interval: Sequence[object] | None = None) -> str:
-    """Print an expression in the syntax :func:`parse_trace_expression` reads.
+class _Printer(StrPrinter):
+    """sympy's printer, writing what sympy forms on its own in the parser's syntax.
+
+    Euler's number is ``exp(1)`` (``E`` is an ordinary name); sympy turns ``sqrt(x**2)``
+    into ``Abs(x)`` and ``tan(pi/2 - x)`` into ``cot(x)``: both are written back in the
+    form that builds them again, so reading the text gives the same expression.
+    """
+
+    def _print_Exp1(self, expr: sympy.Expr) -> str:
+        return "exp(1)"
+
+    def _print_Abs(self, expr: sympy.Expr) -> str:
+        return f"sqrt(({self._print(expr.args[0])})**2)"
+
+    def _print_cot(self, expr: sympy.Expr) -> str:
+        return f"tan(pi/2 - ({self._print(expr.args[0])}))"
+
+
+_PRINTER = _Printer()
+
+
+def format_number(value: object, width: int = 28) -> str:
+    """Print a number exactly when it is short, else with 6 digits in scientific notation.
+
+    Unlike a float, the scientific form never underflows or overflows: a κ* of 1e-500
+    prints as ``1.0e-500``, not ``0``.
+
+    Examples
+    --------
+    >>> format_number(sympy.Rational(1, 4))
+    '1/4'
+    >>> format_number(sympy.Rational(1, 10**500))
+    '1.0e-500'
+    """
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if not isinstance(value, sympy.Expr):
+        return str(value)
+    text = format_expression(value)
+    if len(text) <= width or not value.is_number:
+        return text
+    import mpmath
+
+    approximation = sympy.N(value, 15)
+    if not approximation.is_Number:
+        return text
+    return str(mpmath.nstr(approximation._to_mpmath(53), 6))
+
+
+def format_expression(expr: sympy.Basic, interval: Sequence[object] | None = None) -> str:
+    """Print an expression in the syntax the parser reads, so that reading it gives it back.
 
     Traces are written at the numeric endpoints of ``interval`` (or as ``a``/``b``
     when no interval is given).
+
+    Examples
+    --------
+    >>> format_expression(sympy.exp(1) * Z)
+    'exp(1)*z'
     """
+    if not isinstance(expr, sympy.Basic):
+        raise ExpressionError(
+            f"format_expression needs a sympy expression; found {type(expr).__name__}"
+        )
     replacements = {}
     for symbol in expr.free_symbols:
         trace = trace_of(symbol)
         if trace is not None:
             replacements[symbol] = sympy.Symbol(trace.label(interval), real=True)
-    return str(expr.xreplace(replacements))
+    return str(_PRINTER.doprint(expr.xreplace(replacements)))

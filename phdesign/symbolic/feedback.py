@@ -183,8 +183,8 @@ def check_feedback(
     Called by the model's validation; returns how each condition was checked.
     """
     from phdesign.symbolic import model as model_module
+    from phdesign.symbolic.definiteness import check_definite
     from phdesign.symbolic.expressions import Z
-    from phdesign.symbolic.signs import check_definite
 
     feedback = model.feedback
     if feedback is None:

@@ -31,6 +31,7 @@ Examples
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -39,7 +40,9 @@ from typing import TYPE_CHECKING, Any
 import sympy
 
 from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
+from phdesign.limits import check_model_dimensions, check_parameter_count
 from phdesign.symbolic.conjugate import conjugate_outputs
+from phdesign.symbolic.definiteness import check_definite
 from phdesign.symbolic.display import ModelDisplay
 from phdesign.symbolic.expressions import (
     Z,
@@ -47,6 +50,7 @@ from phdesign.symbolic.expressions import (
     check_parameter_name,
     exact_number,
     exactify,
+    format_expression,
     linear_coefficients,
     parameter_symbol,
     parse_scalar,
@@ -60,7 +64,7 @@ from phdesign.symbolic.feedback import (
     external_indices,
     feedback_from_mapping,
 )
-from phdesign.symbolic.signs import check_definite
+from phdesign.symbolic.parser import check_expression
 from phdesign.symbolic.units import check_units
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
@@ -205,6 +209,11 @@ class BCPHS(ModelDisplay):
         """
         if not isinstance(order, int) or isinstance(order, bool) or order < 1:
             raise ModelError(f"order must be an integer N >= 1; found {order!r}")
+        if parameters is not None and not isinstance(parameters, Mapping):
+            raise ModelError(f"parameters must be a table of name = value; found {parameters!r}")
+        check_parameter_count(len(parameters or {}))
+        if isinstance(H, Sequence) and not isinstance(H, str):
+            check_model_dimensions(order, len(H))  # before any entry is parsed
         names = list(parameters or {})
         for parameter in names:
             check_parameter_name(parameter)
@@ -215,6 +224,8 @@ class BCPHS(ModelDisplay):
         endpoints = _interval(interval)
         H_matrix = parse_matrix(H, "H", names, allow_z=True)
         size = H_matrix.shape[0]
+        if isinstance(P, str) or not isinstance(P, Mapping | Sequence):
+            raise ModelError(f"P must map k to P_k (or list P_0..P_N); found {P!r}")
         P_by_order = dict(P) if isinstance(P, Mapping) else dict(enumerate(P))
         for k in P_by_order:
             if not isinstance(k, int) or not 0 <= k <= order:
@@ -307,6 +318,10 @@ class BCPHS(ModelDisplay):
         ParameterError
             If a name is not a parameter of the model or a value is not a finite number.
         """
+        if not isinstance(values, Mapping):
+            raise ParameterError(
+                f"expected a mapping of parameter names to values; found {values!r}"
+            )
         known = self.parameter_names
         updated = dict(self.parameters)
         for name, value in values.items():
@@ -334,13 +349,17 @@ def _port(
     what: str,
 ) -> sympy.Expr:
     if isinstance(value, str):
-        return parse_trace_expression(value, interval, order, size, parameters, what=what)
-    if isinstance(value, sympy.Expr):
-        return exactify(value)
-    raise ExpressionError(
-        f'{what} must be a trace expression such as "e1(0)"; found {type(value).__name__} '
-        f"{value!r}"
-    )
+        expr = parse_trace_expression(value, interval, order, size, parameters, what=what)
+    elif isinstance(value, sympy.Expr):
+        expr = check_expression(exactify(value), what)
+    else:
+        raise ExpressionError(
+            f'{what} must be a trace expression such as "e1(0)"; found {type(value).__name__} '
+            f"{value!r}"
+        )
+    # the form that reads back as itself (module docstring of phdesign.io: exact round trips)
+    text = format_expression(expr, interval)
+    return parse_trace_expression(text, interval, order, size, parameters, what=what)
 
 
 def _unit_pairs(units: object) -> tuple[tuple[Any, Any], ...]:
@@ -395,10 +414,14 @@ def parse_matrix(
 
 def _entry(value: object, what: str, parameters: Sequence[str], allow_z: bool) -> sympy.Expr:
     if isinstance(value, str):
-        return parse_scalar(value, parameters, allow_z=allow_z, what=what)
-    if isinstance(value, sympy.Expr):
-        return exactify(value)
-    return exact_number(value, what)
+        expr = parse_scalar(value, parameters, allow_z=allow_z, what=what)
+    elif isinstance(value, sympy.Expr):
+        expr = check_expression(exactify(value), what)
+    else:
+        return exact_number(value, what)
+    # sympy builds (z + d)/atan(1) as 4*(d + z)/pi, which reads back as (4*d + 4*z)/pi:
+    # keep the form that reads back as itself, so that written models read back exactly
+    return parse_scalar(format_expression(expr), parameters, allow_z=allow_z, what=what)
 
 
 def _validate(model: BCPHS) -> list[str]:
@@ -419,11 +442,9 @@ def _validate(model: BCPHS) -> list[str]:
     check_shape("H", model.H, (n, n))
     for k, P_k in enumerate(model.P):
         check_shape(f"P{k}", P_k, (n, n))
-    if len(model.state_names) != n:
-        raise ModelError(f"state_names must hold {n} labels; found {len(model.state_names)}")
-    for label in model.state_names:
-        if not isinstance(label, str) or not label.strip():
-            raise ModelError(f"state_names must be non-empty text labels; found {label!r}")
+    check_model_dimensions(N, n)
+    check_parameter_count(len(model.parameters))
+    _check_state_names(model.state_names, n)
 
     symbols = {s for s, _ in model.parameters}
     for s, value in model.parameters:
@@ -433,6 +454,9 @@ def _validate(model: BCPHS) -> list[str]:
     for k, P_k in enumerate(model.P):
         check_symbols(P_k, f"P{k}", symbols | ({Z} if k == 0 else set()))
     check_symbols(model.H, "H", symbols | {Z})
+    for matrix, label in ((model.H, "H"), *((P_k, f"P{k}") for k, P_k in enumerate(model.P))):
+        for (i, j), entry in sympy.ImmutableMatrix(matrix).todok().items():
+            check_expression(entry, f"{label}[{i + 1},{j + 1}]")
 
     defaults = model.parameter_defaults
     for k, P_k in enumerate(model.P):
@@ -478,6 +502,40 @@ def _validate(model: BCPHS) -> list[str]:
     if model.feedback is not None:
         checks += check_feedback(model, symbols, defaults)
     return checks
+
+
+#: Characters a state label may not hold: they separate the items of an initial state.
+_LABEL_SEPARATORS = frozenset(":,()[]")
+
+
+def _check_state_names(names: Sequence[object], n: int) -> None:
+    """Refuse labels that are not text, repeat, or could be read as another component.
+
+    ``--x0 'x2: ...'`` and ``'e2: ...'`` address components by position; a label ``x2``
+    on component 1, or any label ``e<i>``, would make such an item ambiguous.
+    """
+    if len(names) != n:
+        raise ModelError(f"state_names must hold {n} labels; found {len(names)}")
+    for i, label in enumerate(names):
+        if not isinstance(label, str) or not label.strip():
+            raise ModelError(f"state label {i + 1} must be non-empty text; found {label!r}")
+        if any(c in _LABEL_SEPARATORS or not c.isprintable() for c in label):
+            raise ModelError(
+                f"state label {label!r} holds a separator or control character; expected "
+                "none of : , ( ) [ ] and no control characters"
+            )
+        match = _COMPONENT_NAME.fullmatch(label.strip())
+        if match is not None and (match[1] == "e" or int(match[2]) != i + 1):
+            raise ModelError(
+                f"state label {label!r} of component {i + 1} is ambiguous: it names "
+                f"{'the effort' if match[1] == 'e' else 'state component'} {match[2]}; "
+                f"expected a label other than x<j> (j != {i + 1}) and e<j>"
+            )
+    if len({str(label).strip() for label in names}) != n:
+        raise ModelError(f"state labels must be distinct; found {list(names)}")
+
+
+_COMPONENT_NAME = re.compile(r"([xe])(\d+)")
 
 
 def _check_constant_P(P: Sequence[sympy.MatrixBase]) -> None:

@@ -72,7 +72,7 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.errors import ExpressionError, ObserverError, check_shape
-from phdesign.symbolic.expressions import exact_number, vanishes
+from phdesign.symbolic.expressions import exact_matrix, exact_number, vanishes
 from phdesign.symbolic.feedback import error_dissipation, plant_feedback
 from phdesign.symbolic.model import BCPHS
 
@@ -272,8 +272,21 @@ def _diagonal(entries: list[Any], count: int, per: str) -> list[sympy.Expr]:
     return values
 
 
+def _safe_matrix(value: object, what: str) -> sympy.ImmutableMatrix:
+    """Return a caller's matrix as sympy, its text read by the safe parser (no sympify)."""
+    if (
+        isinstance(value, sympy.MatrixBase)
+        or getattr(getattr(value, "dtype", None), "kind", "O") in "biuf"
+    ):
+        return sympy.ImmutableMatrix(value)  # sympy or numeric numpy: no text to parse
+    try:
+        return exact_matrix(value, what, symbols=True)
+    except ExpressionError as error:
+        raise ObserverError(str(error)) from None
+
+
 def _check_gain(L: sympy.MatrixBase, q: int) -> sympy.ImmutableMatrix:
-    L = sympy.ImmutableMatrix(L)
+    L = _safe_matrix(L, "L")
     check_shape("L", L, (q, q), error=ObserverError)
     sym = (L + L.T) / 2
     if L.free_symbols:
@@ -298,8 +311,13 @@ def _check_gain(L: sympy.MatrixBase, q: int) -> sympy.ImmutableMatrix:
 
 # --------------------------------------------------------------------------- entries
 def _check_count(value: object, what: str) -> None:
+    """Refuse a count that is not a positive integer, or more ports than any model has."""
+    from phdesign.limits import MAX_PORTS
+
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise ObserverError(f"{what} must be a positive integer; found {value!r}")
+    if value > MAX_PORTS:  # before any q x q or q x n_outputs matrix is allocated
+        raise ObserverError(f"{what} must be at most {MAX_PORTS} (N n ports); found {value}")
 
 
 def _is_scalar(x: object) -> bool:
@@ -500,8 +518,8 @@ def error_system(
     nn = order * size
     C_m = measurement_matrix(C_m, nn - (0 if feedback is None else len(feedback[0])))
     L = gain_matrix(L, C_m.rows)
-    U = sympy.ImmutableMatrix(U)
-    Y = sympy.ImmutableMatrix(Y)
+    U = _safe_matrix(U, "U")
+    Y = _safe_matrix(Y, "Y")
     T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
     G, C_d, L_d = error_dissipation(nn, C_m, L, feedback)
     boundary = sympy.ImmutableMatrix(U + G * Y)

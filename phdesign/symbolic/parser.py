@@ -2,9 +2,15 @@
 
 A small recursive-descent parser over whitelisted tokens: user text is never evaluated as
 Python (no :func:`eval`, no :func:`sympy.sympify` on raw text). Names other than the
-functions and constants below are resolved by the caller (parameters, ``z``), and traces
-``e<i><primes>(<point>)`` by a caller-supplied factory. Sizes are bounded so hostile text
-cannot exhaust time or memory: length, nesting depth, exponents and number magnitudes.
+functions and the constant ``pi`` are resolved by the caller (parameters, ``z``), and
+traces ``e<i><primes>(<point>)`` by a caller-supplied factory. Euler's number is written
+``exp(1)``: ``E`` is an ordinary name (Young's modulus is a parameter like any other).
+
+Sizes are bounded so that hostile text cannot exhaust time or memory (the budgets of
+:mod:`phdesign.limits`): length, nesting depth, exponents as written, the degree of the
+built expression (``z*z*…*z`` is ``z**k``), the bits of exact numbers, and the magnitude of
+constants (``exp(exp(exp(5)))`` and ``exp(1e300)`` are refused before they are evaluated).
+The result is real: ``sqrt(-1)``, ``log(0)`` and ``tan(pi/2)`` are refused.
 
 Grammar (``**`` and ``^`` are both powers)::
 
@@ -23,6 +29,7 @@ Examples
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -30,14 +37,31 @@ from dataclasses import dataclass
 import sympy
 
 from phdesign.errors import ExpressionError
+from phdesign.limits import (
+    MAX_DEGREE,
+    MAX_DEPTH,
+    MAX_EXPONENT,
+    MAX_EXPRESSION_LENGTH,
+    MAX_MAGNITUDE,
+    MAX_NUMBER_BITS,
+    MAX_NUMBER_DIGITS,
+)
 
-__all__ = ["CONSTANTS", "FUNCTIONS", "MAX_LENGTH", "Token", "check_text", "parse", "tokenize"]
+__all__ = [
+    "CONSTANTS",
+    "FUNCTIONS",
+    "Token",
+    "brief",
+    "check_expression",
+    "check_text",
+    "degree_bound",
+    "parse",
+    "tokenize",
+]
 
-MAX_LENGTH = 10_000
-MAX_DEPTH = 100
-MAX_EXPONENT = 64
-#: Largest bit length of the numerator or denominator of an exact number (about 1e300).
-MAX_NUMBER_BITS = 1000
+#: The largest argument of exp, sinh and cosh whose value stays within MAX_MAGNITUDE.
+_LARGEST_EXPONENTIAL_ARGUMENT = math.log(MAX_MAGNITUDE) + math.log(2)
+_GROWING = frozenset({"exp", "sinh", "cosh"})
 
 FUNCTIONS: dict[str, Callable[[sympy.Expr], sympy.Expr]] = {
     "sqrt": sympy.sqrt,
@@ -51,7 +75,7 @@ FUNCTIONS: dict[str, Callable[[sympy.Expr], sympy.Expr]] = {
     "tanh": sympy.tanh,
     "atan": sympy.atan,
 }
-CONSTANTS: dict[str, sympy.Expr] = {"pi": sympy.pi, "E": sympy.E}
+CONSTANTS: dict[str, sympy.Expr] = {"pi": sympy.pi}
 
 # --------------------------------------------------------------------------- tokenizer
 
@@ -127,7 +151,7 @@ class _Parser:
                 f"cannot read {self.context.text!r}: unexpected {token.text!r} "
                 f"at position {token.position}"
             )
-        return expr
+        return check_expression(expr, repr(self.context.text))
 
     def peek(self) -> Token | None:
         return self.tokens[self.index] if self.index < len(self.tokens) else None
@@ -154,21 +178,40 @@ class _Parser:
 
     def expr(self) -> sympy.Expr:
         self.enter()
-        value = self.term()
+        terms = [self.term()]
         while (op := self.take("+", "-")) is not None:
             rhs = self.term()
-            value = self.bounded(value + rhs if op.text == "+" else value - rhs)
+            terms.append(rhs if op.text == "+" else -rhs)
+        # one Add of all the terms: adding them one by one re-sorts the sum each time
+        value = terms[0] if len(terms) == 1 else self.bounded(sympy.Add(*terms))
         self.depth -= 1
         return value
 
     def bounded(self, value: sympy.Expr) -> sympy.Expr:
         """Refuse exact numbers too large to print or compute with (about 1e300)."""
-        for number in value.atoms(sympy.Rational):
+        numbers = (value,) if value.is_Rational else value.atoms(sympy.Rational)
+        for number in numbers:
             if max(abs(number.p).bit_length(), number.q.bit_length()) > MAX_NUMBER_BITS:
                 raise ExpressionError(
                     f"a number in {self.context.text!r} is out of range; "
                     "expected magnitudes between 1e-300 and 1e300"
                 )
+        return value
+
+    def constant(self, value: sympy.Expr) -> sympy.Expr:
+        """Refuse a constant function value or power outside 1e-300..1e300, or not real."""
+        if not value.is_number or value.is_Rational:
+            return value
+        size = _magnitude(value)
+        if size is None:
+            raise ExpressionError(
+                f"{brief(value)} in {self.context.text!r} is not a finite real number"
+            )
+        if size != -math.inf and abs(size) > math.log(MAX_MAGNITUDE):
+            raise ExpressionError(
+                f"{brief(value)} in {self.context.text!r} is out of range; expected magnitudes "
+                "between 1e-300 and 1e300"
+            )
         return value
 
     def term(self) -> sympy.Expr:
@@ -204,7 +247,7 @@ class _Parser:
                 )
             if base == 0 and exponent.is_number and exponent.is_nonpositive:
                 raise ExpressionError(f"division by zero in {self.context.text!r}")
-            return self.bounded(base**exponent)
+            return self.constant(self.bounded(base**exponent))
         return base
 
     def atom(self) -> sympy.Expr:
@@ -214,12 +257,12 @@ class _Parser:
         self.index += 1
         if token.kind == "number":
             mantissa, _, exponent = token.text.lower().partition("e")
-            if len(mantissa) > 60 or (exponent and abs(int(exponent)) > 300):
+            if len(mantissa) > MAX_NUMBER_DIGITS or (exponent and abs(int(exponent)) > 300):
                 raise ExpressionError(
                     f"number {token.text!r} is out of range; expected magnitudes between "
-                    "1e-300 and 1e300 with at most 60 digits"
+                    f"1e-300 and 1e300 with at most {MAX_NUMBER_DIGITS} digits"
                 )
-            return sympy.Rational(token.text)
+            return self.bounded(sympy.Rational(token.text))
         if token.kind == "trace":
             if self.context.trace_factory is None:
                 raise ExpressionError(
@@ -244,19 +287,135 @@ class _Parser:
             self.expect("(")
             argument = self.expr()
             self.expect(")")
-            return FUNCTIONS[name](argument)
+            if name in _GROWING and argument.is_number:
+                size = _magnitude(argument)
+                if size is None or size > math.log(_LARGEST_EXPONENTIAL_ARGUMENT):
+                    raise ExpressionError(
+                        f"{name}({brief(argument)}) in {self.context.text!r} is out of range; "
+                        f"expected an argument of magnitude at most "
+                        f"{_LARGEST_EXPONENTIAL_ARGUMENT:.4g} (values between 1e-300 and 1e300)"
+                    )
+            return self.constant(FUNCTIONS[name](argument))
         if name in CONSTANTS:
             return CONSTANTS[name]
         return self.context.resolve_name(name, self.context.text)
 
 
+def brief(value: object, width: int = 40) -> str:
+    """Return ``value`` as text for a message, cut to ``width`` characters.
+
+    Examples
+    --------
+    >>> brief("x" * 50, 10)
+    "'xxxxxx..."
+    """
+    text = repr(value) if isinstance(value, str) else str(value)
+    return text if len(text) <= width else f"{text[: width - 3]}..."
+
+
+def _magnitude(value: sympy.Expr) -> float | None:
+    """Natural log of ``|value|`` for a constant (``-inf`` for zero); ``None`` if not real.
+
+    The constant's own parts were checked when they were built, so evaluating it to 15
+    digits is cheap (mpmath has no exponent range to overflow).
+    """
+    if value.is_zero:
+        return -math.inf
+    approximation = sympy.N(value, 15)
+    if approximation.has(sympy.I, sympy.zoo, sympy.nan, sympy.oo, -sympy.oo):
+        return None
+    if not approximation.is_Number:
+        return None
+    if approximation == 0:
+        return -math.inf
+    return float(sympy.log(abs(approximation)).evalf(15))
+
+
+def degree_bound(expr: sympy.Basic) -> int:
+    """Bound the total degree of ``expr`` in its symbols once every power is expanded.
+
+    Sums take the largest degree of their terms, products the sum, integer powers the
+    multiple; a function or a symbolic exponent counts as the degree of its arguments.
+
+    Examples
+    --------
+    >>> z = sympy.Symbol("z")
+    >>> degree_bound((1 + z + z**2)**3 / (z + 1))
+    7
+    """
+    memo: dict[sympy.Basic, int] = {}
+
+    def bound(node: sympy.Basic) -> int:
+        if node in memo:
+            return memo[node]
+        if node.is_Symbol:
+            result = 1
+        elif node.is_Atom or not node.args:
+            result = 0
+        elif node.is_Add:
+            result = max(bound(a) for a in node.args)
+        elif node.is_Mul:
+            result = sum(bound(a) for a in node.args)
+        elif node.is_Pow and node.exp.is_Rational:
+            result = math.ceil(bound(node.base) * abs(node.exp))
+        else:
+            result = max(bound(a) for a in node.args)
+        memo[node] = result
+        return result
+
+    return bound(expr)
+
+
+#: Functions sympy forms by itself from the grammar (``sqrt(z**2)`` is ``Abs(z)``,
+#: ``tan(pi/2 - z)`` is ``cot(z)``); the printer writes them back in the grammar.
+_FORMED = frozenset({"Abs", "cot"})
+
+
+def check_expression(expr: sympy.Expr, what: str) -> sympy.Expr:
+    """Return ``expr`` if it is what the parser could have built, within the budgets.
+
+    The same checks apply to expressions a caller builds with sympy: finite and real,
+    only the grammar's functions, exact numbers within ``MAX_NUMBER_BITS`` and a degree
+    within ``MAX_DEGREE`` (:mod:`phdesign.limits`).
+
+    Raises
+    ------
+    ExpressionError
+        Naming ``what`` and what was found.
+    """
+    if not isinstance(expr, sympy.Expr):
+        raise ExpressionError(f"{what} must be an expression; found {type(expr).__name__}")
+    if expr.has(sympy.I, sympy.zoo, sympy.nan, sympy.oo, -sympy.oo):
+        raise ExpressionError(f"{what} is not a finite real expression; found {brief(expr)}")
+    for function in expr.atoms(sympy.Function):
+        name = type(function).__name__
+        if name not in FUNCTIONS and name not in _FORMED:
+            raise ExpressionError(
+                f"{what} uses the function {name}; expected only {', '.join(sorted(FUNCTIONS))}"
+            )
+    for number in expr.atoms(sympy.Rational):
+        if max(abs(number.p).bit_length(), number.q.bit_length()) > MAX_NUMBER_BITS:
+            raise ExpressionError(
+                f"a number in {what} is out of range; expected magnitudes between 1e-300 and 1e300"
+            )
+    if expr.atoms(sympy.Float):
+        raise ExpressionError(f"{what} holds a floating-point number; expected exact numbers")
+    degree = degree_bound(expr)
+    if degree > MAX_DEGREE:
+        raise ExpressionError(
+            f"{what} has degree {degree} once built; expected at most "
+            f"{MAX_DEGREE} (the budget phdesign.limits.MAX_DEGREE)"
+        )
+    return expr
+
+
 def check_text(text: object, what: str) -> str:
-    """Return ``text`` if it is a string of at most :data:`MAX_LENGTH` characters."""
+    """Return ``text`` if it is a string of at most ``MAX_EXPRESSION_LENGTH`` characters."""
     if not isinstance(text, str):
         raise ExpressionError(f"{what} must be text; found {type(text).__name__} {text!r}")
-    if len(text) > MAX_LENGTH:
+    if len(text) > MAX_EXPRESSION_LENGTH:
         raise ExpressionError(
-            f"{what} is {len(text)} characters long; expected at most {MAX_LENGTH}"
+            f"{what} is {len(text)} characters long; expected at most {MAX_EXPRESSION_LENGTH}"
         )
     return text
 

@@ -48,9 +48,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Protocol
+from typing import Any, Protocol
 
 import sympy
+from sympy.polys.constructor import construct_domain
+from sympy.polys.matrices import DomainMatrix
+from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.arguments import require_model
 from phdesign.errors import PortError
@@ -58,6 +61,7 @@ from phdesign.symbolic.display import PortsDisplay
 from phdesign.symbolic.expressions import (
     Trace,
     canonical,
+    exact_matrix,
     linear_coefficients,
     trace_symbol,
     vanishes,
@@ -142,16 +146,16 @@ def q_matrix(P: Sequence[sympy.MatrixBase], order: int) -> sympy.ImmutableMatrix
         ``N``.
     """
     n = P[order].shape[0]
-    blocks = [
-        [
-            (-1) ** (i - 1) * sympy.Matrix(P[i + j - 1])
+    rows = []
+    for i in range(1, order + 1):
+        blocks = [
+            (-1) ** (i - 1) * exact_matrix(P[i + j - 1], f"P{i + j - 1}", symbols=True)
             if i + j - 1 <= order
             else sympy.zeros(n, n)
             for j in range(1, order + 1)
         ]
-        for i in range(1, order + 1)
-    ]
-    return sympy.ImmutableMatrix(sympy.BlockMatrix(blocks).as_explicit())
+        rows.append(sympy.Matrix.hstack(*blocks))
+    return sympy.ImmutableMatrix(sympy.Matrix.vstack(*rows))
 
 
 def extended_matrices(
@@ -159,15 +163,18 @@ def extended_matrices(
 ) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix]:
     r"""Return :math:`R_{ext} = \tfrac{1}{\sqrt2}[[Q, -Q], [I, I]]` and its inverse."""
     Q = q_matrix(P, order)
+    (exact,) = _exact_matrices(Q)
+    Q_inv = exact.inv().to_Matrix()
     eye = sympy.eye(Q.rows)
-    R_ext = sympy.ImmutableMatrix(
-        sympy.BlockMatrix([[Q, -Q], [eye, eye]]).as_explicit() / sympy.sqrt(2)
-    )
-    Q_inv = Q.inv()
-    R_inv = sympy.ImmutableMatrix(
-        sympy.BlockMatrix([[Q_inv, eye], [-Q_inv, eye]]).as_explicit() / sympy.sqrt(2)
-    )
-    return R_ext, R_inv
+    half = sympy.sqrt(2) / 2
+
+    def blocks(top_left: Any, top_right: Any, bottom_left: Any) -> sympy.ImmutableMatrix:
+        M = sympy.Matrix.vstack(
+            sympy.Matrix.hstack(top_left, top_right), sympy.Matrix.hstack(bottom_left, eye)
+        )
+        return sympy.ImmutableMatrix(M.applyfunc(lambda x: half * x))
+
+    return blocks(Q, -Q, eye), blocks(Q_inv, eye, -Q_inv)
 
 
 def coefficient_matrix(
@@ -228,12 +235,77 @@ class Ports(PortsDisplay):
 
 def sigma_matrix(dimension: int) -> sympy.ImmutableMatrix:
     r"""Return :math:`\Sigma = [[0, I], [I, 0]]` with ``I`` of size ``dimension``."""
-    eye, zero = sympy.eye(dimension), sympy.zeros(dimension)
-    return sympy.ImmutableMatrix(sympy.BlockMatrix([[zero, eye], [eye, zero]]).as_explicit())
+    return sympy.ImmutableMatrix(
+        2 * dimension, 2 * dimension, lambda i, j: 1 if abs(i - j) == dimension else 0
+    )
+
+
+def _exact_matrices(*matrices: sympy.MatrixBase) -> tuple[DomainMatrix, ...]:
+    """Return the matrices over one exact domain (rationals, algebraic, rational functions).
+
+    Products and inverses cost far less there than in sympy's generic matrices, and
+    zero is recognized exactly.
+    """
+    entries = [x for M in matrices for x in M]
+    try:
+        domain, elements = construct_domain(entries, extension=True, field=True)
+    except (sympy.PolynomialError, NotImplementedError, ValueError):
+        domain, elements = construct_domain(entries, field=True)
+    out = []
+    offset = 0
+    for M in matrices:
+        rows, cols = M.shape
+        block = elements[offset : offset + rows * cols]
+        offset += rows * cols
+        dense = DomainMatrix(
+            [block[i * cols : (i + 1) * cols] for i in range(rows)], (rows, cols), domain
+        )
+        out.append(dense)
+    zeros = sum(1 for x in elements if not x)
+    if zeros > 0.8 * len(elements):  # mostly zeros (most models): products skip them
+        return tuple(M.to_sparse() for M in out)
+    return tuple(out)
+
+
+def _integral(M: DomainMatrix) -> tuple[Any, DomainMatrix]:
+    """``(s, N)`` with ``M = N / s``: ``N`` over the integers when ``M`` is rational."""
+    if M.domain == sympy.QQ:
+        scale, integral = M.clear_denoms(convert=True)
+        return scale.element, integral
+    return M.domain.one, M
+
+
+def _identity(size: int, like: DomainMatrix) -> DomainMatrix:
+    eye = DomainMatrix.eye(size, like.domain)
+    return eye.to_sparse() if like.rep.fmt == "sparse" else eye.to_dense()
+
+
+def _exact_zero(M: DomainMatrix) -> bool:
+    """Whether ``M`` vanishes identically (decided by the domain, or by :func:`vanishes`)."""
+    if not M.domain.is_EX:
+        return bool(M.is_zero_matrix)
+    return all(vanishes(x) for x in M.to_Matrix())
+
+
+def _rank(M: sympy.MatrixBase) -> int:
+    (exact,) = _exact_matrices(M)
+    if exact.domain.is_EX:
+        return int(M.rank(iszerofunc=vanishes))
+    return int(exact.rank())
 
 
 def derive_ports(model: PortedSystem) -> Ports:
-    """Derive and check the port structure of ``model`` (a model caches it as ``model.ports``).
+    r"""Derive and check the port structure of ``model`` (a model caches it as ``model.ports``).
+
+    With :math:`u = U v`, :math:`U = (U_b\ U_a)` split by the halves
+    :math:`\phi(b), \phi(a)` of :math:`v`, :math:`R_{ext}^{-1} = \tfrac{1}{\sqrt2}
+    \begin{pmatrix} Q^{-1} & I \\ -Q^{-1} & I \end{pmatrix}` gives
+    :math:`W_B = \tfrac{1}{\sqrt 2}\big((U_b - U_a) Q^{-1} \;\; U_b + U_a\big)`, and
+    (with :math:`Q` symmetric) :math:`W_B \Sigma W_B^\top = U_b Q^{-1} U_b^\top -
+    U_a Q^{-1} U_a^\top`, likewise :math:`W_C \Sigma W_C^\top` and
+    :math:`W_C \Sigma W_B^\top = Y_b Q^{-1} U_b^\top - Y_a Q^{-1} U_a^\top`: the
+    identities are checked in exact rational (or algebraic) arithmetic, without the
+    :math:`\sqrt 2` of :math:`R_{ext}`.
 
     Raises
     ------
@@ -245,27 +317,42 @@ def derive_ports(model: PortedSystem) -> Ports:
     """
     require_model(model)
     N, n = model.order, model.size
+    nn = N * n
     Q = q_matrix(model.P, N)
-    eye = sympy.eye(N * n)
-    R_ext, R_inv = extended_matrices(model.P, N)
     U = coefficient_matrix(model.inputs, N, n, "inputs")
     Y = coefficient_matrix(model.outputs, N, n, "outputs")
     defaults = model.parameter_defaults
     for name, M in (("inputs", U), ("outputs", Y)):
-        rank = M.xreplace(defaults).rank(iszerofunc=vanishes)
-        if rank != N * n:
+        rank = _rank(M.xreplace(defaults))
+        if rank != nn:
             raise PortError(
                 f"the {name} are linearly dependent: rank of "
                 f"{'W_B' if name == 'inputs' else 'W_C'} "
-                f"is {rank}, expected N*n = {N * n}"
+                f"is {rank}, expected N*n = {nn}"
             )
-    W_B = (U * R_inv).applyfunc(canonical)
-    W_C = (Y * R_inv).applyfunc(canonical)
-    Sigma = sigma_matrix(N * n)
+    dQ, dU, dY = _exact_matrices(Q, U, Y)
+    try:
+        Q_inv = dQ.inv()
+    except (DMNonInvertibleMatrixError, ZeroDivisionError):
+        raise PortError(f"Q is singular: P{N} must be invertible") from None
+    # over the rationals, clear the denominators: integer products are far cheaper, and
+    # each residual below is the true one times a positive constant (same zero test)
+    s_Q, Qi = _integral(Q_inv)
+    s_U, Ui = _integral(dU)
+    s_Y, Yi = _integral(dY)
+    U_b, U_a, Y_b, Y_a = Ui[:, :nn], Ui[:, nn:], Yi[:, :nn], Yi[:, nn:]
+    UQ_b, UQ_a, YQ_b, YQ_a = (M * Qi for M in (U_b, U_a, Y_b, Y_a))
     residuals = {
-        "WB_Sigma_WBt": W_B * Sigma * W_B.T,
-        "WC_Sigma_WCt": W_C * Sigma * W_C.T,
-        "WC_Sigma_WBt_minus_I": W_C * Sigma * W_B.T - eye,
+        "WB_Sigma_WBt": UQ_b * U_b.transpose() - UQ_a * U_a.transpose(),
+        "WC_Sigma_WCt": YQ_b * Y_b.transpose() - YQ_a * Y_a.transpose(),
+        "WC_Sigma_WBt_minus_I": YQ_b * U_b.transpose()
+        - YQ_a * U_a.transpose()
+        - _identity(nn, Qi) * (s_Y * s_U * s_Q),
+    }
+    scales = {
+        "WB_Sigma_WBt": s_U * s_U * s_Q,
+        "WC_Sigma_WCt": s_Y * s_Y * s_Q,
+        "WC_Sigma_WBt_minus_I": s_Y * s_U * s_Q,
     }
     statements = {
         "WB_Sigma_WBt": "W_B Σ W_Bᵀ = 0",
@@ -274,30 +361,50 @@ def derive_ports(model: PortedSystem) -> Ports:
     }
     identities: dict[str, sympy.Expr] = {}
     for key in IDENTITY_NAMES:
-        residual = residuals[key].applyfunc(canonical)
+        if _exact_zero(residuals[key]):
+            identities[key] = sympy.Integer(0)
+            continue
+        scale = Qi.domain.to_sympy(scales[key])
+        residual = residuals[key].to_Matrix().applyfunc(lambda x, c=scale: canonical(x / c))
         largest = _max_abs(residual, defaults)
-        identities[key] = largest
-        if not all(vanishes(x) for x in residual):
-            if key == "WB_Sigma_WBt":  # the inputs alone are wrong: say so, naming them
-                from phdesign.symbolic.conjugate import inadmissible_inputs_message
+        if key == "WB_Sigma_WBt":  # the inputs alone are wrong: say so, naming them
+            from phdesign.symbolic.conjugate import inadmissible_inputs_message
 
-                raise PortError(
-                    inadmissible_inputs_message(residual, model.inputs, model.interval, defaults)
-                )
-            at = " at the parameter defaults" if residual.free_symbols else ""
             raise PortError(
-                f"port identity {statements[key]} fails: largest residual |entry| = "
-                f"{_short(largest)}{at}; the outputs must be the power conjugates of the inputs"
+                inadmissible_inputs_message(residual, model.inputs, model.interval, defaults)
             )
+        at = " at the parameter defaults" if residual.free_symbols else ""
+        raise PortError(
+            f"port identity {statements[key]} fails: largest residual |entry| = "
+            f"{_short(largest)}{at}; the outputs must be the power conjugates of the inputs"
+        )
+    half = sympy.sqrt(2) / 2
+
+    def port_map(
+        b_half: DomainMatrix, a_half: DomainMatrix, bq: DomainMatrix, aq: DomainMatrix, s: Any
+    ) -> sympy.ImmutableMatrix:
+        # W = (1/sqrt 2) ((M_b - M_a) Q^-1, M_b + M_a) with M = (b_half, a_half) / s
+        c_left = half / Qi.domain.to_sympy(s * s_Q)
+        c_right = half / Qi.domain.to_sympy(s)
+        left = (bq - aq).to_Matrix().applyfunc(lambda x: c_left * x)
+        right = (b_half + a_half).to_Matrix().applyfunc(lambda x: c_right * x)
+        return sympy.ImmutableMatrix(sympy.Matrix.hstack(left, right))
+
+    eye = sympy.eye(nn)
+    R_ext = sympy.ImmutableMatrix(
+        sympy.Matrix.vstack(sympy.Matrix.hstack(Q, -Q), sympy.Matrix.hstack(eye, eye)).applyfunc(
+            lambda x: half * x
+        )
+    )
     return Ports(
         trace_vector=trace_vector(N, n),
         Q=Q,
         R_ext=R_ext,
         U=U,
         Y=Y,
-        W_B=sympy.ImmutableMatrix(W_B),
-        W_C=sympy.ImmutableMatrix(W_C),
-        Sigma=Sigma,
+        W_B=port_map(U_b, U_a, UQ_b, UQ_a, s_U),
+        W_C=port_map(Y_b, Y_a, YQ_b, YQ_a, s_Y),
+        Sigma=sigma_matrix(nn),
         identities=identities,
         model=model,
     )

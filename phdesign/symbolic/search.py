@@ -55,6 +55,7 @@ from typing import Any
 
 import sympy
 
+from phdesign import limits
 from phdesign._display import (
     REPR_LIMIT,
     html_table,
@@ -356,6 +357,7 @@ def search_sensors(
     require_model(model)
     if progress is not None and not callable(progress):
         raise ObserverError(f"progress must be callable(done, total); found {progress!r}")
+    limits.check_sensor_outputs(model.n_ports)
     order, size = model.order, model.size
     nn = model.n_ports
     gains = _gain_vector(gain, nn)
