@@ -73,6 +73,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument("--t-end", type=float, default=5.0, metavar="T", help="final time")
     sim.add_argument("--samples", type=int, default=501, help="output samples on [0, T]")
     sim.add_argument("--scheme", choices=("expm", "midpoint"), default="expm")
+    sim.add_argument(
+        "--tol",
+        type=float,
+        default=1e-6,
+        help="midpoint: largest estimated error of the states, relative to their largest "
+        "energy norm (default 1e-6); the substeps are chosen to meet it",
+    )
     fmt = sim.add_mutually_exclusive_group()
     fmt.add_argument("--csv", action="store_true", help="CSV output (the default)")
     fmt.add_argument("--json", action="store_true", help="JSON output")
@@ -151,6 +158,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
     _check_positive("--resolution", args.resolution)
     _check_positive("--t-end", args.t_end)
+    _check_positive("--tol", args.tol)
     if args.samples < 2:
         raise NumericError(f"--samples must be at least 2; found {args.samples}")
     model, nm, C_m, L = _numeric_setup(args)
@@ -178,6 +186,7 @@ def _simulate(args: argparse.Namespace) -> int:
         method=args.method,
         resolution=args.resolution,
         scheme=args.scheme,
+        tol=args.tol,
     )
     if args.json:
         import json

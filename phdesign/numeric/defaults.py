@@ -82,6 +82,11 @@ class MethodDefaults:
     legendre_max : int or None
         Largest refinement resolution when the plain Legendre basis is forced on this
         order (round-off grows with the degree); None when no cap applies.
+    resolved_rtol : float
+        Relative drift under which an eigenvalue counts as resolved between two
+        resolutions (spectral Galerkin 1e-6; second-order finite differences 1e-2).
+    abscissa_tol : float
+        Agreement of the spectral abscissa that counts as converged (1e-10; 1e-3).
     """
 
     method: str
@@ -91,6 +96,8 @@ class MethodDefaults:
     tune_fallback: int
     basis: str | None = None
     legendre_max: int | None = None
+    resolved_rtol: float = 1e-6
+    abscissa_tol: float = 1e-10
 
 
 GALERKIN: Mapping[int, MethodDefaults] = MappingProxyType(
@@ -102,8 +109,8 @@ GALERKIN: Mapping[int, MethodDefaults] = MappingProxyType(
 )
 FD: Mapping[int, MethodDefaults] = MappingProxyType(
     {
-        1: MethodDefaults("fd", 70, 70, 240, 70),
-        2: MethodDefaults("fd", 70, 70, 240, 70),
+        1: MethodDefaults("fd", 70, 70, 240, 70, resolved_rtol=1e-2, abscissa_tol=1e-3),
+        2: MethodDefaults("fd", 70, 70, 240, 70, resolved_rtol=1e-2, abscissa_tol=1e-3),
     }
 )
 METHODS: Mapping[str, Mapping[int, MethodDefaults]] = MappingProxyType(

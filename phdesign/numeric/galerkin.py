@@ -266,8 +266,9 @@ def galerkin(
     DiscretePHS
         ``E = M``, ``J``, ``R``, ``B = (YT)^T``, ``D = 0`` as in the module docstring;
         ``info["spurious"]`` holds the removed :class:`~phdesign.numeric.spurious.SpuriousModes`
-        and ``info["trial_map"]`` the matrix W from the kept coordinates to the full
-        polynomial coordinates (None when nothing was removed).
+        ``info["trial_map"]`` the matrix W from the kept coordinates to the full
+        polynomial coordinates (None when nothing was removed) and
+        ``info["coordinates"]`` the (component, degree) behind each kept coordinate.
 
     Examples
     --------
@@ -309,9 +310,10 @@ def galerkin(
         else SpuriousModes(np.zeros((n * nb, 0)))
     )
     W: np.ndarray | None = None
+    keep = np.arange(n * nb)
     if spurious.count:
-        W, keep = e_orthogonal_complement(spurious.basis / scale_all[:, None], M)
-        if keep is not None:  # a plain selection of coordinates: exact sub-blocks
+        W, keep, selection = e_orthogonal_complement(spurious.basis / scale_all[:, None], M)
+        if selection:  # a plain selection of coordinates: exact sub-blocks
             ix = np.ix_(keep, keep)
             M, J, R, A, B, T = M[ix], J[ix], R[ix], A[ix], B[keep], T[:, keep]
         else:
@@ -329,6 +331,7 @@ def galerkin(
         "spurious": spurious,
         "spurious_removed": spurious.count,
         "trial_map": W,
+        "coordinates": tuple((int(j) // nb, int(j) % nb) for j in keep),
     }
     space = _TrialSpace(nm, p, s, W, M)
     return DiscretePHS(

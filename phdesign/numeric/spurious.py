@@ -248,7 +248,7 @@ def _is_orthonormal(V: np.ndarray) -> bool:
     return bool(np.max(np.abs(V.T @ V - np.eye(V.shape[1]))) < 1e-12)
 
 
-def e_orthogonal_complement(V: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+def e_orthogonal_complement(V: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
     r"""Basis W of :math:`\{w : V^\top E w = 0\}`, built from coordinate vectors.
 
     The r coordinates where V is best conditioned in the energy norm (column-pivoted QR
@@ -258,9 +258,11 @@ def e_orthogonal_complement(V: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, n
     Returns
     -------
     W : ndarray (dim, dim - r)
-    keep : ndarray of int or None
-        The kept coordinates when W is exactly ``I[:, keep]`` (no correction needed),
-        so that restricted matrices are exact sub-blocks; None otherwise.
+    keep : ndarray of int
+        The coordinate j behind each column of W.
+    selection : bool
+        True when no correction was needed: W is exactly ``I[:, keep]``, so that
+        restricted matrices are exact sub-blocks.
     """
     dim, r = V.shape
     weighted = V * np.sqrt(np.diag(E))[:, None]
@@ -271,6 +273,6 @@ def e_orthogonal_complement(V: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, n
     W = np.zeros((dim, keep.size))
     W[keep, np.arange(keep.size)] = 1.0
     if not np.any(coupling):
-        return W, keep
+        return W, keep, True
     W -= V @ np.linalg.solve(V.T @ EV, coupling.T)
-    return W, None
+    return W, keep, False
