@@ -24,9 +24,13 @@ python-control refuses '.' in signal names), ``"effort"`` (``e1_hat(z=1)``),
 eigenvalues resolved under refinement (:mod:`phdesign.numeric.modal`: eigenvalues at p
 against :math:`\lceil 1.5p \rceil`, the spectrum's drift rule); its states are modal
 coordinates ``mode1..`` and the record of what was removed is attached as the attribute
-``truncation`` (:class:`~phdesign.numeric.modal.ModalTruncation`).  ``modes="all"``
-(default) keeps every discrete mode, including the unresolved high frequencies whose real
-parts are artefacts.
+``truncation`` (:class:`~phdesign.numeric.modal.ModalTruncation`).  The removed modes'
+static gain is kept as a feedthrough, so the DC gain is exact; at low frequency the
+input-output map then moves by a few percent for boundary inputs (beam, degree 24: 1.2 %
+at s = 0.3i), the price of poles that can be trusted.  ``modes="all"`` (default) keeps
+every discrete mode, including the unresolved high frequencies whose real parts are
+artefacts (error system of a graded string at degree 30: max Re -0.012 against the
+resolved abscissa -0.36).
 
 ``control`` is imported lazily, inside the functions, so importing phdesign never pays
 for it.
