@@ -198,7 +198,13 @@ def _left_null(M: np.ndarray) -> np.ndarray:
     return Z
 
 
-def spurious_modes(nm: NumericModel, degree: int, T_legendre: np.ndarray) -> SpuriousModes:
+def spurious_modes(
+    nm: NumericModel,
+    degree: int,
+    T_legendre: np.ndarray,
+    zeroth_order: np.ndarray | None = None,
+    frozen: tuple[np.ndarray, np.ndarray] | None = None,
+) -> SpuriousModes:
     """Return the unobservable subspace of the degree-``degree`` Galerkin discretization.
 
     Parameters
@@ -208,6 +214,12 @@ def spurious_modes(nm: NumericModel, degree: int, T_legendre: np.ndarray) -> Spu
         Polynomial degree p.
     T_legendre : ndarray (2 N n, n (p + 1))
         Trace map in orthonormal-Legendre coordinates.
+    zeroth_order : ndarray (n (p + 1), n (p + 1)), optional
+        Galerkin matrix of the zeroth-order term, ∫ Ψᵀ P_0 Ψ in the same coordinates;
+        default ``P_0 ⊗ I`` (constant P_0).  A z-dependent P_0 passes its quadrature.
+    frozen : (H, P0), optional
+        The constant H and P_0 that give the candidate eigenvalues; default both at the
+        midpoint of the interval (exact when they are constant).
 
     Returns
     -------
@@ -217,18 +229,22 @@ def spurious_modes(nm: NumericModel, degree: int, T_legendre: np.ndarray) -> Spu
     a, b = nm.interval
     X = integrated_trial_derivatives(p, N, float(b - a))
     AD = sum(np.kron(nm.P[k], X[k]) for k in range(1, N + 1) if np.any(nm.P[k]))
-    base = np.asarray(AD) - np.kron(nm.P[0].T, X[0])
+    if zeroth_order is None:
+        base = np.asarray(AD) - np.kron(nm.P[0].T, X[0])
+    else:
+        base = np.asarray(AD) - zeroth_order.T @ np.kron(np.eye(n), X[0])
     YT = nm.Y @ T_legendre
-    H = nm.H_at(np.array([0.5 * (a + b)]))[0]
+    H, P0 = frozen if frozen is not None else (nm.H_at(np.array([0.5 * (a + b)]))[0], nm.P[0])
+    exact = nm.H_constant and zeroth_order is None
     columns: list[np.ndarray] = []
     eigenvalues: list[complex] = []
-    frozen = False
-    for lam in _candidates(H, nm.P[0]):
+    was_frozen = False
+    for lam in _candidates(H, P0):
         M = base if lam == 0 else base + lam * np.kron(np.linalg.inv(H), X[0])
         Z = _left_null(np.hstack([M, YT.T.astype(M.dtype)]))
         if not Z.shape[1]:
             continue
-        frozen = frozen or (lam != 0 and not nm.H_constant)
+        was_frozen = was_frozen or (lam != 0 and not exact)
         if lam.imag:
             columns += [Z.real, Z.imag]
             eigenvalues += [lam, lam.conjugate()] * Z.shape[1]
@@ -241,7 +257,7 @@ def spurious_modes(nm: NumericModel, degree: int, T_legendre: np.ndarray) -> Spu
     U, s, _ = np.linalg.svd(V, full_matrices=False)
     rank = int(np.sum(s > 1e-8 * s[0]))
     basis = V if rank == V.shape[1] and _is_orthonormal(V) else U[:, :rank]
-    return SpuriousModes(basis, tuple(eigenvalues[:rank]), frozen)
+    return SpuriousModes(basis, tuple(eigenvalues[:rank]), was_frozen)
 
 
 def _is_orthonormal(V: np.ndarray) -> bool:
