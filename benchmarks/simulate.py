@@ -51,6 +51,16 @@ def best_of(fn, repeat):
     return out, min(walls), min(cpus)
 
 
+def paper_setup(method, resolution):
+    """The paper's beam, initial state, sensors y3, y4 and design 2, discretized."""
+    model = load_builtin("euler-bernoulli")
+    nm = to_numeric(model)
+    x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=model)
+    C_m = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+    L = np.diag([0.1, 1.0])
+    return nm, x0, C_m, L, discretize(nm, method, resolution)
+
+
 def timed(fn, repeat=5):
     return best_of(fn, repeat)[1]
 
@@ -63,12 +73,7 @@ def changes() -> bool:
     from phdesign.numeric.export import error_statespace
     from phdesign.numeric.stepping import integrate
 
-    model = load_builtin("euler-bernoulli")
-    nm = to_numeric(model)
-    x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=model)
-    C_m = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
-    L = np.diag([0.1, 1.0])
-    d = discretize(nm, "galerkin", 40)
+    nm, x0, C_m, L, d = paper_setup("galerkin", 40)
     K = feedback_matrix(C_m, L, 4)
     t = np.linspace(0.0, 4.5, 46)
     ok = True
@@ -159,12 +164,7 @@ def main(argv: list[str]) -> int:
         return 0 if changes() else 1
     ok_changes = changes()
     t_end, samples = (0.5, 51) if "--short" in argv else (5.0, 501)
-    model = load_builtin("euler-bernoulli")
-    nm = to_numeric(model)
-    x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=model)
-    C_m = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
-    L = np.diag([0.1, 1.0])
-    d = discretize(nm, "fd", 70)
+    nm, x0, C_m, L, d = paper_setup("fd", 70)
     E2, A2, B2 = coupled_system(d, feedback_matrix(C_m, L, 4))
     X0 = np.concatenate([d.project(x0), np.zeros(d.dim)])
     t = np.linspace(0.0, t_end, samples)
