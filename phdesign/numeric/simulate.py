@@ -465,6 +465,7 @@ def simulate(
         "scheme": scheme,
         "states": int(d.dim),
         "spurious_removed": d.spurious_removed,
+        **({"spurious_modes": str(d.info["spurious"])} if d.spurious_removed else {}),
         **{f"energy_balance_residual_{k.replace(' ', '_')}": v for k, v in audits.items()},
     }
     if scheme == "midpoint":

@@ -81,7 +81,7 @@ __all__ = ["RANK_TOL", "SpuriousModes", "e_orthogonal_complement", "spurious_mod
 RANK_TOL = 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SpuriousModes:
     """The unobservable subspace of a Galerkin discretization (module docstring).
 
@@ -103,6 +103,24 @@ class SpuriousModes:
     def count(self) -> int:
         """Number of removed dimensions."""
         return int(self.basis.shape[1])
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready summary: count, distinct eigenvalues as ``[re, im]``, frozen."""
+        return {
+            "count": self.count,
+            "eigenvalues": [[z.real, z.imag] for z in _distinct(self.eigenvalues)],
+            "frozen": self.frozen,
+        }
+
+    def __repr__(self) -> str:
+        values = ", ".join(_format_eigenvalue(z) for z in _distinct(self.eigenvalues)[:4])
+        return f"SpuriousModes(count={self.count}, eigenvalues=[{values}])"
+
+    def __str__(self) -> str:
+        return self.describe()
+
+    def _repr_html_(self) -> str:
+        return f"<table><tr><th>spurious modes</th><td>{self.describe()}</td></tr></table>"
 
     def describe(self) -> str:
         """One sentence for reports: how many modes were removed and why."""

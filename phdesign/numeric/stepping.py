@@ -22,7 +22,7 @@ Never a generic explicit ODE solver: these systems are linear and time invariant
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sl
@@ -62,8 +62,8 @@ class Trajectory:
         The tolerance the midpoint control aimed at (None: fixed substeps).
     """
 
-    X: np.ndarray
-    scheme: str
+    X: np.ndarray = field(repr=False)
+    scheme: str = "expm"
     substeps: int = 1
     error_estimate: float | None = None
     tol: float | None = None
