@@ -148,7 +148,8 @@ assert attained < wkb
 # ## Export to python-control
 #
 # Plant, observer and error system of the discretization, as `control.StateSpace`
-# objects. The observer takes $(u, y_m)$ and returns $(\hat y, \hat e)$; the error system
+# objects. The observer takes $(u, y_m)$ and returns $\hat y$ and the estimated state
+# $\hat x$ at both ends and the midpoint (`quantity`, `z` choose others); the error system
 # $E \dot{\tilde e} = (J - R - B K B^\top) \tilde e$, $K = C_m^\top L C_m$, has no input.
 # Its poles contain the resolved eigenvalues above.
 

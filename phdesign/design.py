@@ -198,9 +198,14 @@ class Plant:
         samples: int = 501,
         u: Callable[[float], Any] | None = None,
         scheme: str = "expm",
+        tol: float = 1e-6,
     ) -> SimulationResult:
-        """Simulate the plant alone from ``x0`` (text or a function of z; zero by default)."""
-        return self.run(None, None, x0, t_end=t_end, samples=samples, u=u, scheme=scheme)
+        """Simulate the plant alone from ``x0`` (text or a function of z; zero by default).
+
+        ``tol`` bounds the error of ``scheme="midpoint"`` (its substeps are chosen to meet
+        it; :func:`phdesign.numeric.simulate.simulate`).
+        """
+        return self.run(None, None, x0, t_end=t_end, samples=samples, u=u, scheme=scheme, tol=tol)
 
     def run(
         self,
@@ -407,6 +412,7 @@ class Observer:
         u: Callable[[float], Any] | None = None,
         scheme: str = "expm",
         z_w: Any = None,
+        tol: float = 1e-6,
     ) -> SimulationResult:
         """Simulate plant and observer together.
 
@@ -417,7 +423,7 @@ class Observer:
             (state names or efforts ``e1``, expressions in ``z`` and the parameters) or a
             function ``f(z) -> (len(z), n)``.  Both default to zero: without ``x0`` and
             ``u`` every series is zero.
-        t_end, samples, u, scheme, z_w
+        t_end, samples, u, scheme, z_w, tol
             See :func:`phdesign.numeric.simulate.simulate`.
         """
         C, L = self.numeric_gain("simulate")
@@ -432,6 +438,7 @@ class Observer:
             u=u,
             scheme=scheme,
             z_w=z_w,
+            tol=tol,
         )
 
     def tune(

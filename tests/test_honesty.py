@@ -68,25 +68,34 @@ def _airy_run(resolution):
 
 
 def test_healthy_simulation_balances_energy_to_round_off():
-    """The paper's setting (FD, 140 states): the exact flow leaves only round-off."""
+    """The paper's setting (FD, 140 states): the exact flow leaves only round-off.
+
+    Its error energy is resolved only down to ~3e-9 of H_err(0) (t ~ 3.5 s): beyond, FD
+    with 70 and 105 nodes per group disagree by more than 5 % (at t = 5: FD-105 is 3.3x
+    and Galerkin-45 6x lower), and the run says so."""
     beam = load_builtin("euler-bernoulli")
     nm = to_numeric(beam)
     x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=beam)
     result = simulate(nm, TIP_SENSORS, np.diag([0.1, 1.0]), x0=x0, method="fd")
-    assert result.warnings == ()
+    assert not any("energy balance" in w for w in result.warnings)
     assert result.info["energy_balance_residual_plant"] < 1e-12
     assert result.info["energy_balance_residual_error_system"] < 1e-12
+    assert any("resolved only down to" in w for w in result.warnings)
+    assert 1e-10 < result.resolved_floor < 1e-8
 
 
 def test_drifting_energy_balance_warns():
     """Airy (N = 3) at Galerkin degree 40: the weakly imposed second-derivative feedback
-    makes the operator's norm grow like p^8 (about 1e13 here), so the matrix exponential
-    loses digits and the balance ΔH = -∫ xᵀPx drifts (measured 2e-5 of max H)."""
+    makes the error system's norm grow like p^8 (about 1e13 here), so the matrix
+    exponential loses digits and the balance ΔH = -∫ xᵀPx drifts (measured 5.3e-5 of max
+    H; H_err itself is then off by 1.3e-3).  The plant alone (no feedback) keeps 1.5e-9."""
     result = _airy_run(40)
-    assert result.info["energy_balance_residual_plant"] > ENERGY_BALANCE_RTOL
-    assert any("energy balance drifts" in w for w in result.warnings)
+    assert result.info["energy_balance_residual_error_system"] > ENERGY_BALANCE_RTOL
+    assert result.info["energy_balance_residual_plant"] < ENERGY_BALANCE_RTOL
+    warning = next(w for w in result.warnings if "energy balance drifts" in w)
+    assert "scheme 'midpoint'" in warning
     # ... while a modest degree stays within tolerance
-    assert _airy_run(12).warnings == ()
+    assert not any("energy balance" in w for w in _airy_run(12).warnings)
 
 
 def test_simulate_cli_prints_the_drift_warning_on_stderr(capsys):

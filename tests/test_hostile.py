@@ -262,14 +262,14 @@ def _forked_run(argv: list[str], kill: str, signum: int) -> int:
             os.kill(os.getpid(), signum)
             time.sleep(1)  # the handler runs here
 
-        if kill == "simulate":
-            original = simulate_module.step_lti
+        if kill == "simulate":  # during the time stepping, the simulation's longest part
+            original = simulate_module.integrate
 
             def step(*args, **kwargs):
                 self_signal()
                 return original(*args, **kwargs)
 
-            simulate_module.step_lti = step
+            simulate_module.integrate = step
         elif kill == "stage":
             original_stage = outputs.OutputFiles.stage
 

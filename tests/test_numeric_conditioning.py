@@ -16,11 +16,11 @@ import scipy.linalg as sl
 from numeric_models import BUILTINS, PAPER_SENSORS, VARYING, numeric
 
 from phdesign.errors import NumericError
-from phdesign.numeric import galerkin as galerkin_module
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretize import discretize, feedback_matrix
-from phdesign.numeric.galerkin import galerkin, trace_scaling
-from phdesign.numeric.spectrum import default_resolutions, eigen, spectrum
+from phdesign.numeric.defaults import spectrum_resolutions
+from phdesign.numeric.discretize import feedback_matrix
+from phdesign.numeric.galerkin import galerkin, resolve_basis, trace_scaling
+from phdesign.numeric.spectrum import default_resolutions, eigen, match_resolved, spectrum
 
 
 def _airy_exact_rightmost() -> float:
@@ -92,8 +92,9 @@ def test_closed_matrix_norm_and_mass_condition_at_degree_40():
     assert relative_gap.max() < 1e-10, relative_gap  # measured 1.3e-11
 
 
-def test_spectrum_of_airy_converges_to_11_digits_with_the_scaled_basis(monkeypatch):
-    monkeypatch.setattr(galerkin_module, "DEFAULT_BASIS", "scaled")
+def test_spectrum_of_airy_converges_to_11_digits_with_the_scaled_basis():
+    # the registry's basis for N >= 3 is the scaled one
+    assert resolve_basis(None, 3) == "scaled"
     rep = spectrum(numeric("airy"), np.eye(3), np.eye(3))
     assert rep.converged
     assert rep.digits > 11
@@ -124,28 +125,29 @@ def test_scaled_basis_is_port_hamiltonian_with_exact_energy_balance(name, degree
         assert abs(dH - (-e @ d.R @ e + u @ d.output(e, u))) <= 1e-12 * scale
 
 
-def test_beam_and_wave_spectra_do_not_change(monkeypatch):
-    # Exact damped wave (DESIGN.md) and the paper's beam (13 digits, test_numeric_spectrum).
-    monkeypatch.setattr(galerkin_module, "DEFAULT_BASIS", "scaled")
-    rep = spectrum(numeric("wave"), np.array([[0.0, 1.0]]), np.array([[0.5]]))
-    assert rep.converged
-    assert abs(rep.spectral_abscissa - 0.5 * np.log(1 / 3)) < 1e-10
+def test_beam_and_wave_spectra_do_not_change_with_the_scaled_basis():
+    # Exact damped wave (DESIGN.md) and the paper's beam (13 digits, test_numeric_spectrum),
+    # with the scaled basis forced on these N <= 2 models (the registry's is Legendre).
+    K = feedback_matrix(np.array([[0.0, 1.0]]), np.array([[0.5]]), 2)
+    coarse, fine = (eigen(galerkin(numeric("wave"), p, "scaled"), K)[0] for p in (40, 60))
+    idx, _ = match_resolved(fine, coarse, 1e-6)
+    assert abs(np.max(fine[idx].real) - 0.5 * np.log(1 / 3)) < 1e-10
     beam = numeric("euler-bernoulli")
-    d = discretize(beam, "galerkin", 40)
+    d = galerkin(beam, 40, "scaled")
     lam = eigen(d, feedback_matrix(PAPER_SENSORS, np.diag([0.1, 1.0]), 4))[0]
     assert np.min(np.abs(lam - (-2.9106562986317006 + 2.51438586374747j))) < 1e-11
 
 
-def test_an_agreed_eigenvalue_is_kept_when_round_off_spoils_a_finer_pair(monkeypatch):
+def test_an_agreed_eigenvalue_is_kept_when_round_off_spoils_a_finer_pair():
     """The rule of test_numeric_spectrum.py's regression, pinned to the Legendre basis
     whose round-off at degree 27 (airy, sensors y1, y3, L = I) triggers it; with the
     scaled basis the eigenvalue -9.250156 simply converges at the first pair."""
     C = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
-    monkeypatch.setattr(galerkin_module, "DEFAULT_BASIS", "legendre")
-    rep = spectrum(numeric("airy"), C, np.eye(2))
+    # the Legendre basis, with the defaults table's cap for that basis on N >= 3
+    assert spectrum_resolutions(3, "galerkin", "legendre")[1] == 48
+    rep = spectrum(numeric("airy"), C, np.eye(2), basis="legendre")
     assert abs(rep.spectral_abscissa + 9.250156) < 1e-6
     assert any("an eigenvalue that once agreed is real" in w for w in rep.warnings)
-    monkeypatch.setattr(galerkin_module, "DEFAULT_BASIS", "scaled")
     rep = spectrum(numeric("airy"), C, np.eye(2))
     assert rep.converged
     assert abs(rep.spectral_abscissa + 9.250156111211) < 1e-11

@@ -110,6 +110,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument(
         "--u", metavar="EXPRS", help="plant inputs in t, e.g. 'u2: sin(2*t)'; default zero"
     )
+    sim.add_argument(
+        "--tol",
+        type=float,
+        default=1e-6,
+        help="midpoint: largest estimated error of the states, relative to their largest "
+        "energy norm; the substeps are chosen to meet it; default: %(default)s",
+    )
     fmt = sim.add_mutually_exclusive_group()
     fmt.add_argument("--csv", action="store_true", help="CSV output (the default)")
     fmt.add_argument(
@@ -207,6 +214,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
     _check_positive("--resolution", args.resolution)
     _check_positive("--t-end", args.t_end)
+    _check_positive("--tol", args.tol)
     if args.samples < 2:
         raise NumericError(f"--samples must be at least 2; found {args.samples}")
     model = load_model(args)
@@ -262,6 +270,7 @@ def _simulate(args: argparse.Namespace) -> int:
                     "samples": args.samples,
                     "scheme": args.scheme,
                     "u": u,
+                    "tol": args.tol,
                 }
                 if observer is not None:
                     res = observer.simulate(x0, xhat0=xhat0, **options)

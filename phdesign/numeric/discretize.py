@@ -37,16 +37,21 @@ from __future__ import annotations
 from phdesign import limits
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.defaults import defaults_for
 from phdesign.numeric.feedback import close_plant_feedback
-from phdesign.numeric.phs import DiscretePHS, feedback_matrix
+from phdesign.numeric.phs import ClosedLoop, DiscretePHS, feedback_matrix
 
-__all__ = ["METHODS", "DiscretePHS", "discretize", "feedback_matrix"]
+__all__ = ["METHODS", "ClosedLoop", "DiscretePHS", "discretize", "feedback_matrix"]
 
 METHODS = ("galerkin", "fd")
 
 
 def discretize(
-    nm: NumericModel, method: str = "galerkin", resolution: int | None = None
+    nm: NumericModel,
+    method: str = "galerkin",
+    resolution: int | None = None,
+    *,
+    basis: str | None = None,
 ) -> DiscretePHS:
     """Discretize ``nm`` with ``method`` at ``resolution``.
 
@@ -55,29 +60,27 @@ def discretize(
     nm : NumericModel
     method : {"galerkin", "fd"}
     resolution : int, optional
-        Degree (Galerkin, default 40, or 16 for N >= 3) or nodes per state group (FD,
-        default 70: the paper's 140 states for the beam).
+        Degree (Galerkin) or nodes per state group (FD); default from the registry
+        :mod:`phdesign.numeric.defaults` (Galerkin 40, or 16 for N >= 3; FD 70: the
+        paper's 140 states for the beam).
+    basis : {"scaled", "legendre"}, optional
+        Galerkin basis (default: the registry's); not accepted by ``"fd"``.
 
     Returns
     -------
     DiscretePHS
     """
     limits.check_discretization(nm, method, resolution)
+    if method not in METHODS:
+        raise NumericError(f"unknown discretization method {method!r}; expected one of {METHODS}")
+    res = defaults_for(method, nm.order).resolution if resolution is None else int(resolution)
+    # the model's own [feedback] closes the open discretization (numeric.feedback)
     if method == "galerkin":
         from phdesign.numeric.galerkin import galerkin
 
-        # N >= 3: the weakly imposed feedback on high derivative traces makes E^-1 A grow
-        # like p^(4N-3); degree 16 already resolves airy's slow modes to 1e-5 while the
-        # time stepping keeps its energy balance (degree 40 loses it: tests/test_honesty.py)
-        default = 40 if nm.order <= 2 else 16
-        # the model's own [feedback] closes the open discretization (numeric.feedback)
-        return close_plant_feedback(
-            galerkin(nm, default if resolution is None else int(resolution))
-        )
-    if method == "fd":
-        from phdesign.numeric.staggered import staggered_fd
+        return close_plant_feedback(galerkin(nm, res, basis))
+    if basis is not None:
+        raise NumericError(f"basis applies to method='galerkin' only; found basis={basis!r}")
+    from phdesign.numeric.staggered import staggered_fd
 
-        return close_plant_feedback(
-            staggered_fd(nm, 70 if resolution is None else int(resolution))
-        )
-    raise NumericError(f"unknown discretization method {method!r}; expected one of {METHODS}")
+    return close_plant_feedback(staggered_fd(nm, res))

@@ -57,6 +57,9 @@ class SimulationDisplay:
             rows.append(
                 ("H̃/H̃(0) < 1e-2 after", "not reached" if below is None else f"{below:.4g}")
             )
+            floor = getattr(self, "resolved_floor", None)
+            if floor is not None:  # below it, H̃ is made of modes the resolution does not hold
+                rows.append(("H̃/H̃(0) resolved down to", f"{floor:.3g}"))
         return rows
 
     def __str__(self) -> str:

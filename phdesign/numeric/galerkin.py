@@ -71,51 +71,64 @@ boundary conditions strongly creates spurious real eigenvalues drifting to 0.  P
 1.8e-7, 5.8e-12, 1.3e-12, 1e-14, 6e-15 at p = 40; :func:`trace_scaling` is α = 2N − 3/2
 with the exact constants.
 
-``DEFAULT_BASIS`` selects the basis when none is given: ``"auto"`` (the default) takes
-the trace-scaled basis for N >= 3, where it turns 9 digits into 15 on the airy error
-abscissa, and the plain Legendre basis for N <= 2, where both agree to round-off and
-the Legendre basis keeps E well conditioned for any H(z). The choice also sets the
-N >= 3 degree cap of :func:`phdesign.numeric.spectrum.default_resolutions`.
+The basis used when none is given comes from the registry
+:data:`phdesign.numeric.defaults.GALERKIN`: the trace-scaled basis for N >= 3, where it
+turns 9 digits into 15 on the airy error abscissa, and the plain Legendre basis for
+N <= 2, where both agree to round-off and the Legendre basis keeps E well conditioned for
+any H(z).
+
+Spurious modes.  When a component has all its boundary traces among the inputs, the
+weak form cannot see its top modes; they form an unobservable subspace whose
+eigenvalues no feedback moves (a spurious eigenvalue 0 for the string with velocity
+inputs at both ends, and also for the built-in airy model at odd degree).
+:func:`galerkin` removes it by default: the method then works on the E-orthogonal
+complement of that subspace, still port-Hamiltonian, with an unchanged input-output
+map and the spectrum of the full discretization less the artefacts
+(:mod:`phdesign.numeric.spurious`); ``info["spurious"]`` says how many modes went and
+why.
 """
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cached_property, lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.polynomial import legendre as leg
 
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel, trace_index
+from phdesign.numeric.defaults import defaults_for
 from phdesign.numeric.distributed import galerkin_p0
 from phdesign.numeric.phs import DiscretePHS
+from phdesign.numeric.spurious import SpuriousModes, e_orthogonal_complement, spurious_modes
 
 __all__ = [
     "BASES",
-    "DEFAULT_BASIS",
     "galerkin",
+    "gauss_rule",
     "legendre_basis",
     "resolve_basis",
     "trace_scaling",
 ]
 
 BASES = ("scaled", "legendre")
-#: Basis used by :func:`galerkin` (and so by :func:`phdesign.numeric.discretize.discretize`
-#: and the spectrum) when none is given: "auto", "scaled" or "legendre".
-DEFAULT_BASIS = "auto"
 
 
 def resolve_basis(basis: str | None, order: int) -> str:
     """Return the basis :func:`galerkin` uses for a model of order ``order``.
+
+    ``None`` means the registry's choice (:data:`phdesign.numeric.defaults.GALERKIN`).
 
     Examples
     --------
     >>> resolve_basis(None, 3), resolve_basis(None, 2), resolve_basis("scaled", 1)
     ('scaled', 'legendre', 'scaled')
     """
-    chosen = DEFAULT_BASIS if basis is None else basis
-    if chosen == "auto":
-        return "scaled" if order >= 3 else "legendre"
+    if basis is not None:
+        return basis
+    chosen = defaults_for("galerkin", order).basis
+    assert chosen is not None  # every Galerkin row names its basis
     return chosen
 
 
@@ -128,6 +141,7 @@ def _derivative_coefficients(p: int, k: int) -> np.ndarray:
     Dk = leg.legder(C, k, axis=0)
     out = np.zeros((p + 1, p + 1))
     out[: Dk.shape[0], :] = Dk
+    out.setflags(write=False)
     return out
 
 
@@ -169,30 +183,101 @@ def trace_scaling(p: int, order: int, interval: tuple[float, float]) -> np.ndarr
     return 1.0 / peak
 
 
-def _gauss(nq: int, interval: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+@lru_cache(maxsize=64)
+def gauss_rule(points: int, interval: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on ``interval`` (cached, read-only arrays).
+
+    Examples
+    --------
+    >>> z, w = gauss_rule(2, (0.0, 1.0))
+    >>> float(w.sum()), bool(np.allclose(z, [0.5 - 0.5 / 3**0.5, 0.5 + 0.5 / 3**0.5]))
+    (1.0, True)
+    """
     a, b = interval
-    t, w = leg.leggauss(nq)
-    return 0.5 * (a + b) + 0.5 * (b - a) * t, 0.5 * (b - a) * w
+    t, w = leg.leggauss(points)
+    nodes, weights = 0.5 * (a + b) + 0.5 * (b - a) * t, 0.5 * (b - a) * w
+    nodes.setflags(write=False)
+    weights.setflags(write=False)
+    return nodes, weights
 
 
-def galerkin(nm: NumericModel, degree: int, basis: str | None = None) -> DiscretePHS:
+@lru_cache(maxsize=64)
+def _basis_at_gauss(p: int, k: int, points: int, interval: tuple[float, float]) -> np.ndarray:
+    """``legendre_basis`` at the nodes of ``gauss_rule(points, interval)`` (cached)."""
+    values = legendre_basis(gauss_rule(points, interval)[0], p, k, interval)
+    values.setflags(write=False)
+    return values
+
+
+def _trace_map(nm: NumericModel, p: int) -> np.ndarray:
+    """T over orthonormal-Legendre coordinates: row trace_index(i, k, side) = e_i^T phi^(k)."""
+    N, n, nb = nm.order, nm.size, p + 1
+    T = np.zeros((2 * N * n, n * nb))
+    for side, zs in (("b", nm.interval[1]), ("a", nm.interval[0])):
+        for k in range(N):
+            row = legendre_basis(np.array([zs]), p, k, nm.interval)[0]
+            for i in range(n):
+                T[trace_index(i + 1, k, side, N, n), i * nb : (i + 1) * nb] = row
+    return T
+
+
+def _mass(nm: NumericModel, p: int, s: np.ndarray) -> np.ndarray:
+    """M = ∫ Ψᵀ H⁻¹ Ψ: exact for constant H, Gauss rule with extra points otherwise."""
+    n, nb, iv = nm.size, p + 1, nm.interval
+    if nm.H_constant:
+        Hinv = np.linalg.inv(nm.H_at(np.array([iv[0]]))[0])
+        return np.kron(Hinv, np.diag(s * s))
+    points = 2 * nb + 20
+    zm, wm = gauss_rule(points, iv)
+    Vm = _basis_at_gauss(p, 0, points, iv) * s
+    Hinv = np.linalg.inv(nm.H_at(zm))  # (q, n, n)
+    M = np.empty((n * nb, n * nb))
+    for i in range(n):
+        for k in range(i, n):
+            block = (Vm * (wm * Hinv[:, i, k])[:, None]).T @ Vm
+            M[i * nb : (i + 1) * nb, k * nb : (k + 1) * nb] = block
+            M[k * nb : (k + 1) * nb, i * nb : (i + 1) * nb] = block.T
+    return 0.5 * (M + M.T)
+
+
+def galerkin(
+    nm: NumericModel, degree: int, basis: str | None = None, *, remove_spurious: bool = True
+) -> DiscretePHS:
     """Discretize ``nm`` with polynomials of degree ``degree`` in every effort.
 
     Parameters
     ----------
     nm : NumericModel
     degree : int
-        Polynomial degree p >= N + 1; the system has n (p + 1) states.
+        Polynomial degree p >= N + 1; the system has n (p + 1) states, less the spurious
+        modes removed.
     basis : {"scaled", "legendre"}, optional
         ``"scaled"``: the orthonormal Legendre polynomials divided by their largest
         boundary trace (module docstring); ``"legendre"``: unscaled (E = I for H = I).
-        Default :data:`DEFAULT_BASIS`.  The two discrete systems are congruent by a diagonal
-        matrix: same eigenvalues in exact arithmetic, not in floating point.
+        Default: the registry's (:data:`phdesign.numeric.defaults.GALERKIN`).  The two
+        discrete systems are congruent by a diagonal matrix: same eigenvalues in exact
+        arithmetic, not in floating point.
+    remove_spurious : bool
+        Work on the E-orthogonal complement of the unobservable subspace created by the
+        weakly imposed inputs (:mod:`phdesign.numeric.spurious`); default True.  False
+        keeps the full polynomial space (for comparisons).
 
     Returns
     -------
     DiscretePHS
-        ``E = M``, ``J``, ``R``, ``B = (YT)^T``, ``D = 0`` as in the module docstring.
+        ``E = M``, ``J``, ``R``, ``B = (YT)^T``, ``D = 0`` as in the module docstring;
+        ``info["spurious"]`` holds the removed :class:`~phdesign.numeric.spurious.SpuriousModes`
+        ``info["trial_map"]`` the matrix W from the kept coordinates to the full
+        polynomial coordinates (None when nothing was removed) and
+        ``info["coordinates"]`` the (component, degree) behind each kept coordinate.
+
+    Examples
+    --------
+    >>> from phdesign.models import load_builtin
+    >>> from phdesign.numeric.bridge import to_numeric
+    >>> d = galerkin(to_numeric(load_builtin("airy")), 9)  # odd degree: one artefact
+    >>> d.dim, d.info["spurious"].count
+    (9, 1)
     """
     N, n, p = nm.order, nm.size, int(degree)
     if p < N + 1:
@@ -200,81 +285,68 @@ def galerkin(nm: NumericModel, degree: int, basis: str | None = None) -> Discret
     basis = resolve_basis(basis, nm.order)
     if basis not in BASES:
         raise NumericError(f"unknown Galerkin basis {basis!r}; expected one of {BASES}")
-    iv = nm.interval
-    nb = p + 1
+    iv, nb = nm.interval, p + 1
     s = trace_scaling(p, N, iv) if basis == "scaled" else np.ones(nb)
     # Exact Gauss rule for the polynomial products psi_j psi_l^(k) (degree <= 2p).
-    zq, wq = _gauss(nb + 1, iv)
-    V0 = legendre_basis(zq, p, 0, iv) * s
+    wq = gauss_rule(nb + 1, iv)[1]
+    V0 = _basis_at_gauss(p, 0, nb + 1, iv) * s
     A = np.zeros((n * nb, n * nb))
     for k, Pk in enumerate(nm.P):
-        if not np.any(Pk) or (k == 0 and not nm.P0_constant):  # P0(z): quadrature below
+        if k == 0 and not nm.P0_constant:  # P0(z): by quadrature below
             continue
-        Dk = (V0 * wq[:, None]).T @ (legendre_basis(zq, p, k, iv) * s)
-        A += np.kron(Pk, Dk)
-    if not nm.P0_constant:  # P0(z): its weak form by Gauss quadrature (numeric.distributed)
-        zd, wd = _gauss(2 * nb + 20, iv)
-        A0 = galerkin_p0(nm, zd, wd, legendre_basis(zd, p, 0, iv) * s)
+        if np.any(Pk):
+            A += np.kron(Pk, (V0 * wq[:, None]).T @ (_basis_at_gauss(p, k, nb + 1, iv) * s))
+    scale_all = np.tile(s, n)
+    zeroth_order = None  # P0(z): its weak form in Legendre coordinates (numeric.distributed)
+    if not nm.P0_constant:
+        points = 2 * nb + 20
+        zd, wd = gauss_rule(points, iv)
+        zeroth_order = galerkin_p0(nm, zd, wd, _basis_at_gauss(p, 0, points, iv))
+        A0 = zeroth_order * np.outer(scale_all, scale_all)
         A += A0
-    # Gram matrix of the working basis: diag(s^2), exactly.
-    G = np.diag(s * s)
-    # Mass matrix: exact for constant H, Gauss rule with extra points else.
-    M: np.ndarray
-    if nm.H_constant:
-        Hinv = np.linalg.inv(nm.H_at(np.array([iv[0]]))[0])
-        M = np.kron(Hinv, G)
-    else:
-        zm, wm = _gauss(2 * nb + 20, iv)
-        Vm = legendre_basis(zm, p, 0, iv) * s
-        Hinv = np.linalg.inv(nm.H_at(zm))  # (q, n, n)
-        M = np.einsum("q,qj,qik,ql->ijkl", wm, Vm, Hinv, Vm).reshape(n * nb, n * nb)
-    M = 0.5 * (M + M.T)
-    # Trace map T: row trace_index(i, k, side) = e_i^T kron phi^(k)(side).
-    T = np.zeros((2 * N * n, n * nb))
-    for side, zs in (("b", iv[1]), ("a", iv[0])):
-        for k in range(N):
-            row = legendre_basis(np.array([zs]), p, k, iv)[0] * s
-            for i in range(n):
-                T[trace_index(i + 1, k, side, N, n), i * nb : (i + 1) * nb] = row
+    M = _mass(nm, p, s)
+    T_legendre = _trace_map(nm, p)
+    T = T_legendre * scale_all
     UT, YT = nm.U @ T, nm.Y @ T
     JR = A - YT.T @ UT
     J = 0.5 * (JR - JR.T)
-    if nm.P0_constant:
+    if zeroth_order is None:
         sym0 = 0.5 * (nm.P[0] + nm.P[0].T)
-        R = -np.kron(sym0, G)
+        R = -np.kron(sym0, np.diag(s * s))
     else:
         R = -0.5 * (A0 + A0.T)
     B = YT.T.copy()
-    sym_defect = 0.5 * (JR + JR.T) + R
-    info = {
+    defect = float(np.max(np.abs(0.5 * (JR + JR.T) + R)) / max(np.max(np.abs(A)), 1.0))
+    spurious = (
+        spurious_modes(nm, p, T_legendre, zeroth_order, _frozen(nm, zeroth_order))
+        if remove_spurious
+        else SpuriousModes(np.zeros((n * nb, 0)))
+    )
+    W: np.ndarray | None = None
+    keep = np.arange(n * nb)
+    if spurious.count:
+        W, keep, selection = e_orthogonal_complement(spurious.basis / scale_all[:, None], M)
+        if selection:  # a plain selection of coordinates: exact sub-blocks
+            ix = np.ix_(keep, keep)
+            M, J, R, A, B, T = M[ix], J[ix], R[ix], A[ix], B[keep], T[:, keep]
+        else:
+            M = 0.5 * (W.T @ M @ W + (W.T @ M @ W).T)
+            J = W.T @ J @ W
+            J = 0.5 * (J - J.T)
+            R = W.T @ R @ W
+            R = 0.5 * (R + R.T)
+            A, B, T = W.T @ A @ W, W.T @ B, T @ W
+    info: dict[str, Any] = {
         "T": T,
         "A": A,
         "basis": basis,
-        "weak_form_symmetry_defect": float(
-            np.max(np.abs(sym_defect)) / max(np.max(np.abs(A)), 1.0)
-        ),
+        "weak_form_symmetry_defect": defect,
+        "spurious": spurious,
+        "spurious_removed": spurious.count,
+        "trial_map": W,
+        "coordinates": tuple((int(j) // nb, int(j) % nb) for j in keep),
     }
-
-    def effort_basis(z: np.ndarray) -> np.ndarray:
-        zz = np.atleast_1d(np.asarray(z, dtype=float))
-        V = legendre_basis(zz, p, 0, iv) * s
-        out = np.zeros((zz.size, n, n * nb))
-        for i in range(n):
-            out[:, i, i * nb : (i + 1) * nb] = V
-        return out
-
-    zp, wp = _gauss(2 * nb + 40, iv)
-    Vp = legendre_basis(zp, p, 0, iv) * s
-
-    def project(x0) -> np.ndarray:  # type: ignore[no-untyped-def]
-        # L2 projection in the energy pairing: M ê = ∫ Ψᵀ x0 dz.
-        X = np.asarray(x0(zp), dtype=float).reshape(zp.size, n)
-        rhs = np.concatenate([(Vp * wp[:, None]).T @ X[:, i] for i in range(n)])
-        return np.linalg.solve(M, rhs)
-
-    disp_basis = None
-    if nm.displacement is not None:
-        disp_basis = _displacement_basis(nm, effort_basis, iv)
+    space = _TrialSpace(nm, p, s, W, M)
     return DiscretePHS(
         model=nm,
         method="galerkin",
@@ -284,11 +356,70 @@ def galerkin(nm: NumericModel, degree: int, basis: str | None = None) -> Discret
         R=R,
         B=B,
         D=np.zeros((N * n, N * n)),
-        effort_basis=effort_basis,
-        project=project,
-        displacement_basis=disp_basis,
+        effort_basis=space.effort_basis,
+        project=space.project,
+        displacement_basis=None if nm.displacement is None else space.displacement,
         info=info,
     )
+
+
+def _frozen(nm: NumericModel, zeroth_order: np.ndarray | None) -> tuple[Any, Any] | None:
+    """H and P0 at the midpoint, the candidates' model, when P0 depends on z (else None)."""
+    if zeroth_order is None:
+        return None
+    middle = np.array([0.5 * (nm.interval[0] + nm.interval[1])])
+    return nm.H_at(middle)[0], nm.P0_at(middle)[0]
+
+
+class _TrialSpace:
+    """Evaluation, projection and displacement of the trial space Ψ W (built lazily)."""
+
+    def __init__(
+        self,
+        nm: NumericModel,
+        p: int,
+        s: np.ndarray,
+        W: np.ndarray | None,
+        mass: np.ndarray,
+    ) -> None:
+        self.nm, self.p, self.s, self.W, self.mass = nm, p, s, W, mass
+
+    def _full_to_kept(self, coefficients: np.ndarray) -> np.ndarray:
+        return coefficients if self.W is None else coefficients @ self.W
+
+    def effort_basis(self, z: np.ndarray) -> np.ndarray:
+        """``(m, n, dim)`` values: e(z) = effort_basis(z) @ ê."""
+        zz = np.atleast_1d(np.asarray(z, dtype=float))
+        n, nb = self.nm.size, self.p + 1
+        V = legendre_basis(zz, self.p, 0, self.nm.interval) * self.s
+        out = np.zeros((zz.size, n, n * nb))
+        for i in range(n):
+            out[:, i, i * nb : (i + 1) * nb] = V
+        return self._full_to_kept(out)
+
+    @cached_property
+    def _projection_rule(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        points = 2 * (self.p + 1) + 40
+        zp, wp = gauss_rule(points, self.nm.interval)
+        Vp = _basis_at_gauss(self.p, 0, points, self.nm.interval) * self.s
+        return zp, wp, Vp
+
+    def project(self, x0: Any) -> np.ndarray:
+        """L² projection in the energy pairing: M ê = Wᵀ ∫ Ψᵀ x0 dz."""
+        zp, wp, Vp = self._projection_rule
+        X = np.asarray(x0(zp), dtype=float).reshape(zp.size, self.nm.size)
+        rhs = ((Vp * wp[:, None]).T @ X).T.reshape(-1)
+        if self.W is not None:
+            rhs = self.W.T @ rhs
+        return np.linalg.solve(self.mass, rhs)
+
+    @cached_property
+    def _displacement(self) -> Any:
+        return _displacement_basis(self.nm, self.effort_basis, self.nm.interval)
+
+    def displacement(self, z: np.ndarray) -> np.ndarray:
+        """``(m, dim)`` values: w(z) = displacement(z) @ ê (built on first use)."""
+        return np.asarray(self._displacement(z))
 
 
 def _displacement_basis(nm: NumericModel, effort_basis, iv):  # type: ignore[no-untyped-def]
@@ -301,7 +432,7 @@ def _displacement_basis(nm: NumericModel, effort_basis, iv):  # type: ignore[no-
     assert spec is not None
     c = spec.component - 1
     nq = 160
-    zq, wq = _gauss(nq, iv)
+    zq, wq = gauss_rule(nq, iv)
     Eq = effort_basis(zq)  # (nq, n, dim)
     Hinv = np.linalg.inv(nm.H_at(zq))
     X = np.einsum("qk,qkd->qd", Hinv[:, c, :], Eq)  # x_c at Gauss points

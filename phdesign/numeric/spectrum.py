@@ -61,6 +61,7 @@ from phdesign.errors import NumericError
 from phdesign.numeric.abscissa import estimate_abscissa
 from phdesign.numeric.arguments import check_spectrum_arguments
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.defaults import spectrum_resolutions
 from phdesign.numeric.discretize import feedback_matrix
 from phdesign.numeric.drift import in_band_unresolved, match_resolved, pair_spectrum
 from phdesign.numeric.eigen import prepare
@@ -134,18 +135,11 @@ def resolved_abscissa(
 
 
 def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
-    """Return the starting and maximal resolution for ``method`` (degree or nodes per group)."""
-    if method == "fd":
-        return 70, 240
-    from phdesign.numeric import galerkin
+    """Return the starting and maximal resolution for ``method`` (degree or nodes per group).
 
-    if nm.order >= 3:
-        # Unscaled Legendre basis: the weakly imposed feedback on derivative traces puts
-        # entries of order p^(4N-3) into the closed matrix and round-off grows with p:
-        # start low, cap low, and let the best-agreeing pair win.  The trace-scaled basis
-        # keeps the airy abscissa to ~1e-14 up to degree 140 (galerkin module docstring).
-        return (8, 110) if galerkin.resolve_basis(None, nm.order) == "scaled" else (8, 48)
-    return 20, {1: 100, 2: 110}[nm.order]
+    The values live in one table, :func:`phdesign.numeric.defaults.spectrum_resolutions`.
+    """
+    return spectrum_resolutions(nm.order, method)
 
 
 def _rightmost_order(lam: np.ndarray) -> np.ndarray:
@@ -295,6 +289,7 @@ def spectrum(
     tol: float | None = None,
     rtol_resolved: float | None = None,
     count: int = 6,
+    basis: str | None = None,
 ) -> SpectrumReport:
     """Converged spectral abscissa and rightmost eigenvalues (module docstring).
 
@@ -316,6 +311,10 @@ def spectrum(
         Galerkin, 1e-2 for finite differences.
     count : int
         How many rightmost eigenvalues to report.
+    basis : {"scaled", "legendre"}, optional
+        The Galerkin basis (default: the defaults table's for the model's order,
+        :mod:`phdesign.numeric.defaults`); the plain Legendre basis lowers the largest
+        resolution for N >= 3, where its round-off grows with the degree.
 
     Returns
     -------
@@ -338,13 +337,22 @@ def spectrum(
     default_tol, default_rtol = default_tolerances(method)
     tol = default_tol if tol is None else float(tol)
     rtol_resolved = default_rtol if rtol_resolved is None else float(rtol_resolved)
-    p0, pmax = default_resolutions(nm, method)
+    if basis is not None and method != "galerkin":
+        raise NumericError(f"basis applies to method='galerkin' only; found basis={basis!r}")
+    p0, pmax = spectrum_resolutions(nm.order, method, basis)
     p = int(resolution) if resolution is not None else p0
     pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
     system = "plant (u = 0)" if K is None else "observer error system"
     with small_dense_threads():
         trail, scales = refine(
-            nm, K, method=method, start=p, stop=pmax, tol=tol, rtol_resolved=rtol_resolved
+            nm,
+            K,
+            method=method,
+            start=p,
+            stop=pmax,
+            tol=tol,
+            rtol_resolved=rtol_resolved,
+            basis=basis,
         )
     sensors = None if C_m is None else np.atleast_2d(np.asarray(C_m, float)).tolist()
     gain = None if L is None else np.atleast_2d(np.asarray(L, float)).tolist()

@@ -114,15 +114,18 @@ def convergence_rule(pair: PairSpectrum, a: Abscissa, tol: float) -> str:
 class _Resolutions:
     """Eigenvalues (with condition numbers) of the closed loop, once per resolution."""
 
-    def __init__(self, nm: NumericModel, method: str, K: np.ndarray | None) -> None:
+    def __init__(
+        self, nm: NumericModel, method: str, K: np.ndarray | None, basis: str | None = None
+    ) -> None:
         self.dimensionless, self.scales = dimensionless_model(nm)
-        self.method, self.K = method, K
+        self.method, self.K, self.basis = method, K, basis
         self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     def solve(self, p: int) -> tuple[np.ndarray, np.ndarray]:
         if p not in self._cache:
             # QZ, not the whitened Hessenberg QR: a report keeps every digit it can
-            system = prepare(discretize(self.dimensionless, self.method, p), whitened=False)
+            discrete = discretize(self.dimensionless, self.method, p, basis=self.basis)
+            system = prepare(discrete, whitened=False)
             lam, kappa = system.eigen_condition(self.K)
             self._cache[p] = (rescaled(lam, self.scales.rate), kappa)
         return self._cache[p]
@@ -137,9 +140,13 @@ def refine(
     stop: int,
     tol: float,
     rtol_resolved: float,
+    basis: str | None = None,
 ) -> tuple[list[PairResult], ProblemScales]:
-    """Stage 1: pairs (p, ⌈1.5 p⌉) from ``start`` until one converges or p_fine >= ``stop``."""
-    solver = _Resolutions(nm, method, K)
+    """Stage 1: pairs (p, ⌈1.5 p⌉) from ``start`` until one converges or p_fine >= ``stop``.
+
+    ``basis`` is the Galerkin basis (default: the defaults table's, for the order).
+    """
+    solver = _Resolutions(nm, method, K, basis)
     trail: list[PairResult] = []
     p = int(start)
     while True:

@@ -50,12 +50,8 @@ from phdesign.errors import NumericError, ObserverError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.noise import noise_intensities
-from phdesign.numeric.simulate import (
-    SimulationResult,
-    _dissipation_integral,
-    coupled_system,
-    simulate,
-)
+from phdesign.numeric.simulate import SimulationResult, coupled_system, simulate
+from phdesign.numeric.stepping import dissipation_integral
 
 __all__ = ["SampledNoise", "noisy_coupled_system", "sampled_noise", "simulate_noisy"]
 
@@ -121,7 +117,7 @@ def sampled_noise(E: np.ndarray, A: np.ndarray, N: np.ndarray, dt: float) -> Sam
     F = np.linalg.solve(E, A)
     G = np.linalg.solve(E, N)
     Phi = sl.expm(F * dt)
-    Qd = _dissipation_integral(F.T, G @ G.T, dt)  # ∫ e^{Fs} G Gᵀ e^{Fᵀs} ds
+    Qd = dissipation_integral(F.T, G @ G.T, dt)  # ∫ e^{Fs} G Gᵀ e^{Fᵀs} ds
     lam, V = np.linalg.eigh(0.5 * (Qd + Qd.T))
     keep = lam > 1e-14 * max(float(lam[-1]), 1e-300) if lam.size else lam > 0
     factor = V[:, keep] * np.sqrt(lam[keep])
