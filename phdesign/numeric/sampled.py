@@ -45,7 +45,6 @@ from phdesign.numeric.sampling import (
     ContinuousObserver,
     check_sampling,
     default_initial_state,
-    hold_discretization,
     run_against_continuous,
 )
 
@@ -524,7 +523,7 @@ def export_observer(
         tol=tol,
         output_tol=output_tol,
     )
-    A_d, B_d = hold_discretization(continuous.A, continuous.B, dt)
+    discrete = continuous.sampled(dt, sampler)
     verification = None
     if verify:
         verification = verify_observer(
@@ -534,10 +533,10 @@ def export_observer(
         model=model_name or nm.name,
         dt=dt,
         sampler=sampler,
-        A=A_d,
-        B=B_d,
-        C=continuous.C.copy(),
-        D=continuous.D.copy(),
+        A=discrete.A,
+        B=discrete.B,
+        C=discrete.C,
+        D=discrete.D,
         inputs=continuous.inputs,
         outputs=continuous.outputs,
         energy_matrix=continuous.energy_matrix,
