@@ -92,18 +92,28 @@ def test_averaged_observer_is_exact_against_an_independent_integrator(case, rng)
         x = end
 
 
-@pytest.mark.parametrize("case", list(CASES))
-def test_error_energy_never_increases_whatever_the_period(case, rng):
-    # plant = the observer's own model: H̃_{k+1} - H̃_k = -∫ẽᵀRẽ - Δt (C_m ȳ̃)ᵀ L (C_m ȳ̃) <= 0
-    # for every Δt (module docstring); random efforts excite every mode, random inputs must
-    # cancel. Round-off: the exponentials are exact to ~1e-15 of the energy's scale.
+def _runs_on_the_observers_own_model(case, rng, periods, *, perfect_start):
+    """Averaged loops whose plant is the observer's model: random efforts and inputs."""
     d, C_m, L = CASES[case](rng, 8)
     observer = ContinuousObserver.from_discretization(d, C_m, L)
     x0 = rng.standard_normal(d.dim)
     n_steps = 60
     U = rng.standard_normal((n_steps + 1, d.n_ports))
-    for dt in (1e-3, 1e-2, 0.1, 1.0, 10.0):
-        run = run_loop(d, observer, C_m, x0=x0, dt=dt, n_steps=n_steps, sampler="average", u=U)
+    xhat0 = x0 if perfect_start else None
+    for dt in periods:
+        run = run_loop(
+            d, observer, C_m, x0=x0, xhat0=xhat0, dt=dt, n_steps=n_steps, sampler="average", u=U
+        )
+        yield dt, d, run
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_error_energy_never_increases_whatever_the_period(case, rng):
+    # plant = the observer's own model: H̃_{k+1} - H̃_k = -∫ẽᵀRẽ - Δt (C_m ȳ̃)ᵀ L (C_m ȳ̃) <= 0
+    # for every Δt (module docstring); random efforts excite every mode, random inputs must
+    # cancel. Round-off: the exponentials are exact to ~1e-15 of the energy's scale.
+    periods = (1e-3, 1e-2, 0.1, 1.0, 10.0)
+    for dt, d, run in _runs_on_the_observers_own_model(case, rng, periods, perfect_start=False):
         energy = d.hamiltonian(run.x - run.xhat)
         increase = float(np.max(np.diff(energy)))
         assert increase <= 1e-12 * energy[0], (dt, increase / energy[0])
@@ -114,15 +124,8 @@ def test_error_energy_never_increases_whatever_the_period(case, rng):
 def test_a_perfect_estimate_stays_perfect(case, rng):
     # the error obeys ẽ_{k+1} = (Φ - ΓMKC_s) ẽ_k with no trace of the plant's state or
     # input: from ẽ_0 = 0 it stays at round-off (the held-mean update drifts by O(1) here)
-    d, C_m, L = CASES[case](rng, 8)
-    observer = ContinuousObserver.from_discretization(d, C_m, L)
-    x0 = rng.standard_normal(d.dim)
-    n_steps = 50
-    U = rng.standard_normal((n_steps + 1, d.n_ports))
-    for dt in (1e-3, 1e-2, 0.1):
-        run = run_loop(
-            d, observer, C_m, x0=x0, xhat0=x0, dt=dt, n_steps=n_steps, sampler="average", u=U
-        )
+    periods = (1e-3, 1e-2, 0.1)
+    for dt, d, run in _runs_on_the_observers_own_model(case, rng, periods, perfect_start=True):
         drift = np.max(np.abs(run.x - run.xhat)) / np.max(np.abs(run.x))
         assert drift <= 1e-10, (dt, drift)
         model_outputs = run.yhat[:, : d.n_ports]

@@ -243,7 +243,8 @@ class SampledObserver:
         How the order was chosen and what was dropped.
     verification : Verification or None
     continuous : ContinuousObserver
-        The continuous observer it discretizes.
+        The continuous observer of the same design and order (``point`` steps it with
+        its input held; ``average`` runs its model as a sampled-data observer).
     """
 
     model: str

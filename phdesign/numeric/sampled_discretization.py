@@ -9,7 +9,8 @@ Three exact one-period maps, each read off one matrix exponential of an augmente
 * :meth:`ObserverModel.averaged`: the observer of the ``average`` sampler, the exact
   sampled-data observer below.
 
-**The averaged observer.** The observer runs a copy of the model, :math:`E\dot{\hat e} = (J - R)\hat e + B\hat u`,
+**The averaged observer.** The observer runs a copy of the model,
+:math:`E\dot{\hat e} = (J - R)\hat e + B\hat u`,
 :math:`\hat y = B^\top\hat e + D\hat u`; in its coordinates
 :math:`\dot{\hat x} = F\hat x + G\hat u`, :math:`\hat y = H\hat x + D\hat u`
 (:class:`ObserverModel`: :math:`F = E^{-1}(J - R)`, :math:`G = E^{-1}B`,
