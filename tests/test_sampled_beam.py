@@ -74,7 +74,7 @@ def test_averaged_samples_at_10_ms_do_not_alias(runs):
 
 @pytest.mark.xfail(
     strict=True,
-    reason="measured 2.04x (2.0x to 2.7x over each later second of a 10 s run), not the "
+    reason="measured 2.04x (1.5x to 2.7x over each later second of a 10 s run), not the "
     "issue's 2x; the held-mean update gave 3.0x. At 10 ms the plant's modes 9 to 13 "
     "(713 to 1542 rad/s), which the degree-16 model mispredicts by 1 to 17 %, fold into "
     "49 to 285 rad/s attenuated only by |sinc(ω dt / 2)| = 0.04 to 0.22; the sampled floor "
