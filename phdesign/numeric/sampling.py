@@ -11,9 +11,10 @@ holds its own inputs u over each period (zero-order hold). Two samplers are mode
     sampled-data observer of :meth:`ObserverModel.averaged
     <phdesign.numeric.sampled_discretization.ObserverModel.averaged>`: its model runs with
     the correction held over the period, and the correction compares the measured mean
-    with the exact mean of the model's own outputs over the same period. For a Galerkin
-    observer its error energy never increases, whatever the period (the proof is in
-    :mod:`phdesign.numeric.sampled_discretization`), and a perfect estimate stays perfect.
+    with the exact mean of the model's own outputs over the same period. On a plant equal
+    to a Galerkin observer's model the error energy never increases, whatever the period
+    (the proof is in :mod:`phdesign.numeric.sampled_discretization`), and a perfect
+    estimate stays perfect.
 ``"point"``
     :math:`y_m(t_k)`, held over :math:`[t_k, t_{k+1})` (zero-order hold). The continuous
     observer :math:`\dot{\hat x} = A_o \hat x + B_o v`, :math:`v = (u; y_m)`, with v held,
