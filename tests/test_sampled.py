@@ -105,11 +105,14 @@ def test_sampled_plant_against_a_fine_step_reference(rng):
         assert np.max(np.abs(measured - expected)) <= 1e-9 * np.max(np.abs(expected))
 
 
-def test_discrete_observer_is_the_continuous_one_with_held_input(rng):
+def test_point_sampled_observer_is_the_continuous_one_with_held_input(rng):
     # 20 periods of the wave observer with a random held input v_k, integrated
-    # independently period by period; the exported outputs are C x_k + D v_k
+    # independently period by period; the exported outputs are C x_k + D v_k (the averaged
+    # sampler's observer is checked in tests/test_sampled_averaged.py)
     nm = to_numeric(load_builtin("wave"))
-    obs = export_observer(nm, np.array([[0.0, 1.0]]), np.array([[0.5]]), dt=0.02, order=12)
+    obs = export_observer(
+        nm, np.array([[0.0, 1.0]]), np.array([[0.5]]), dt=0.02, sampler="point", order=12
+    )
     cont = obs.continuous
     V = rng.standard_normal((20, 3))
     x = np.zeros(obs.order)

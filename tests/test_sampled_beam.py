@@ -74,14 +74,36 @@ def test_averaged_samples_at_10_ms_do_not_alias(runs):
 
 @pytest.mark.xfail(
     strict=True,
-    reason="measured 3.0x, not the issue's 2x: beam modes above the 50 Hz Nyquist frequency "
-    "(the 6th, near 300 rad/s, and up) reach the observer attenuated only by "
-    "|sinc(ω dt / 2)|; the floor scales like dt (7.7e-5 at 10 ms, 4e-5 at 5 ms, within 2x "
-    "at 5 ms) and does not change with the observer's degree (12 to 24)",
+    reason="measured 2.04x (1.5x to 2.7x over each later second of a 10 s run), not the "
+    "issue's 2x; the held-mean update gave 3.0x. Two causes, both of the 10 ms average "
+    "itself: error modes above the 314 rad/s Nyquist frequency are damped only through "
+    "their means, which nearly vanish near 2πj/dt (six pole pairs of the sampled error "
+    "system decay at 0.14 to 0.82 1/s, where the continuous one has three Galerkin "
+    "artefacts right of -2.5): 1.7x already on a plant equal to the observer's model; and "
+    "the plant's modes the degree-16 model does not reproduce fold into the band, "
+    "attenuated only by |sinc(ω dt / 2)|. The ratio grows with the observer's degree "
+    "(1.30x at 12, 2.36x at 20, 2.65x at 24)",
 )
 def test_averaged_samples_at_10_ms_within_2x_of_the_continuous_observer(runs):
     v = runs["average 10 ms"]
     assert v.floor <= 2 * v.continuous_floor, (v.floor, v.continuous_floor)
+
+
+def test_averaged_samples_at_10_ms_keep_the_continuous_accuracy_on_resolved_content(beam):
+    # The paper's x0 restricted to the plant's first three modes (|λ| < 100 rad/s, below
+    # the Nyquist frequency π/dt = 314 rad/s, and resolved by the degree-16 observer to
+    # 1e-13): the observer's model predicts their means over each period exactly, so the
+    # sampled error follows the model's error recursion, whose rightmost pole at 10 ms is
+    # exp(λ dt) of the continuous one (λ = -2.911 ± 2.514i, the converged abscissa) to
+    # 1e-5. The floors then agree: within 1.2x (measured 1.07x; comparing the held mean
+    # with the observer's evolving output instead gave 8.6x).
+    _, plant, observer, e0 = beam
+    lam, modes = np.linalg.eig(np.linalg.solve(plant.E, plant.J - plant.R))
+    keep = np.abs(lam) < 100.0
+    assert np.count_nonzero(keep) == 6  # three conjugate pairs
+    x0 = np.real(modes[:, keep] @ np.linalg.solve(modes, e0)[keep])
+    v = verify_observer(plant, observer, SENSORS, dt=1e-2, sampler="average", x0=x0, t_end=5.0)
+    assert v.floor <= 1.2 * v.continuous_floor, (v.floor, v.continuous_floor)
 
 
 def test_point_samples_at_1_ms_trigger_the_aliasing_warning(runs):

@@ -45,7 +45,6 @@ from phdesign.numeric.sampling import (
     ContinuousObserver,
     check_sampling,
     default_initial_state,
-    hold_discretization,
     run_against_continuous,
 )
 
@@ -244,7 +243,8 @@ class SampledObserver:
         How the order was chosen and what was dropped.
     verification : Verification or None
     continuous : ContinuousObserver
-        The continuous observer it discretizes.
+        The continuous observer of the same design and order (``point`` steps it with
+        its input held; ``average`` runs its model as a sampled-data observer).
     """
 
     model: str
@@ -524,7 +524,7 @@ def export_observer(
         tol=tol,
         output_tol=output_tol,
     )
-    A_d, B_d = hold_discretization(continuous.A, continuous.B, dt)
+    discrete = continuous.sampled(dt, sampler)
     verification = None
     if verify:
         verification = verify_observer(
@@ -534,10 +534,10 @@ def export_observer(
         model=model_name or nm.name,
         dt=dt,
         sampler=sampler,
-        A=A_d,
-        B=B_d,
-        C=continuous.C.copy(),
-        D=continuous.D.copy(),
+        A=discrete.A,
+        B=discrete.B,
+        C=discrete.C,
+        D=discrete.D,
         inputs=continuous.inputs,
         outputs=continuous.outputs,
         energy_matrix=continuous.energy_matrix,

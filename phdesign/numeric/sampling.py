@@ -1,4 +1,4 @@
-r"""Sampled-data observers: exact discretization for a declared sampler, and sampled loops.
+r"""Sampled-data observers: samplers, the continuous observer, and sampled loops.
 
 A controller sees the plant's outputs through a sampler at period :math:`\Delta t`, and
 holds its own inputs u over each period (zero-order hold). Two samplers are modelled:
@@ -7,59 +7,41 @@ holds its own inputs u over each period (zero-order hold). Two samplers are mode
     anti-aliasing filter approximates)
     :math:`\bar y_k = \frac{1}{\Delta t}\int_{t_k}^{t_k + \Delta t} y_m(t)\,dt`, known at
     :math:`t_{k+1}`. The observer step from :math:`t_k` to :math:`t_{k+1}` is computed at
-    :math:`t_{k+1}`, when :math:`\bar y_k` has arrived, with :math:`\bar y_k` held over the
-    period.
+    :math:`t_{k+1}`, when :math:`\bar y_k` has arrived. The observer is the exact
+    sampled-data observer of :meth:`ObserverModel.averaged
+    <phdesign.numeric.sampled_discretization.ObserverModel.averaged>`: its model runs with
+    the correction held over the period, and the correction compares the measured mean
+    with the exact mean of the model's own outputs over the same period. On a plant equal
+    to a Galerkin observer's model the error energy never increases, whatever the period
+    (the proof is in :mod:`phdesign.numeric.sampled_discretization`), and a perfect
+    estimate stays perfect.
 ``"point"``
-    :math:`y_m(t_k)`, held over :math:`[t_k, t_{k+1})` (zero-order hold).
+    :math:`y_m(t_k)`, held over :math:`[t_k, t_{k+1})` (zero-order hold). The continuous
+    observer :math:`\dot{\hat x} = A_o \hat x + B_o v`, :math:`v = (u; y_m)`, with v held,
+    is advanced exactly by :math:`\hat x_{k+1} = A_d \hat x_k + B_d v_k`,
+    :math:`[A_d\ B_d]` the top block row of
+    :math:`\exp\left(\begin{smallmatrix} A_o & B_o \\ 0 & 0\end{smallmatrix}\right)\Delta t`
+    (:func:`hold_discretization`).
 
-Observer. With :math:`v = (u; y_m)` the continuous observer
-:math:`\dot{\hat x} = A_o \hat x + B_o v`, :math:`\hat y = C_o \hat x + D_o v`
-(:class:`ContinuousObserver`) driven by an input held constant over each period is
-advanced exactly by
-
-.. math::
-
-    \hat x_{k+1} = A_d \hat x_k + B_d v_k, \qquad
-    \begin{bmatrix} A_d & B_d \\ 0 & I \end{bmatrix}
-    = \exp\left(\begin{bmatrix} A_o & B_o \\ 0 & 0 \end{bmatrix} \Delta t\right),
-
-because on :math:`[t_k, t_{k+1}]` the pair :math:`(\hat x, v)` solves the linear ODE with
-the block matrix and :math:`\dot v = 0`; hence :math:`A_d = e^{A_o\Delta t}` and
-:math:`B_d = \int_0^{\Delta t} e^{A_o s}\,ds\,B_o` (:func:`hold_discretization`). The
-outputs of step k are :math:`\hat y_k = C_o \hat x_k + D_o v_k`: the estimate at
-:math:`t_k`.
+:meth:`ContinuousObserver.sampled` returns either discrete observer; the outputs of step
+k are the estimate at :math:`t_k`.
 
 Plant measured by the sampler (for verification runs and sampled loops). The plant
 :math:`\dot x = F x + G u`, :math:`y = C x + D u` with u held at :math:`u_k` gives
 :math:`x_{k+1} = \Phi x_k + \Gamma u_k` and, for the averaged sampler, the exact mean
-
-.. math::
-
-    \bar y_k = \tfrac{1}{\Delta t}\big(C (S_x x_k + S_u u_k)\big) + D u_k, \qquad
-    S_x = \int_0^{\Delta t} e^{F s} ds, \quad
-    S_u = \int_0^{\Delta t}\!\!\int_0^{s} e^{F r} dr\, ds\; G,
-
-read off one augmented exponential (Van Loan): the state :math:`(x, \xi, u)` with the
-running integral :math:`\dot\xi = x` obeys
-
-.. math::
-
-    \frac{d}{ds}\begin{bmatrix} x \\ \xi \\ u \end{bmatrix} =
-    \begin{bmatrix} F & 0 & G \\ I & 0 & 0 \\ 0 & 0 & 0 \end{bmatrix}
-    \begin{bmatrix} x \\ \xi \\ u \end{bmatrix}, \qquad
-    \exp(\cdot\,\Delta t) = \begin{bmatrix} \Phi & 0 & \Gamma \\ S_x & I & S_u \\
-    0 & 0 & I \end{bmatrix},
-
-so that :math:`\xi(\Delta t) = \int_{t_k}^{t_{k+1}} x = S_x x_k + S_u u_k` exactly
-(:func:`sample_plant`). The point sampler reads :math:`y(t_k) = C x_k + D u_k`.
+:math:`\bar y_k = \frac{1}{\Delta t} C (S_x x_k + S_u u_k) + D u_k` with
+:math:`S_x = \int_0^{\Delta t} e^{F s} ds`,
+:math:`S_u = \int_0^{\Delta t}\!\int_0^{s} e^{F r} dr\, ds\; G`, read off one augmented
+exponential (:func:`sample_plant`). The point sampler reads :math:`y(t_k) = C x_k + D u_k`.
 
 Why averaging matters (the paper's beam, a degree-16 observer against a degree-48 plant):
 point samples of the boundary velocity every 1 ms carry the plant's unresolved high
 frequencies, which alias into the observer's band and leave a tip error near 2e-2
 instead of the continuous observer's 3e-5; averaged samples attenuate a mode of
-frequency ω by :math:`|\operatorname{sinc}(\omega\Delta t/2)|` and restore the
-continuous observer's accuracy at 1 ms. :func:`aliasing_warning` flags a sampled error
-floor more than ten times the continuous one.
+frequency ω by :math:`|\operatorname{sinc}(\omega\Delta t/2)|`, and the modes the
+observer's model contains are predicted exactly, aliased or not.
+:func:`aliasing_warning` flags a sampled error floor more than ten times the continuous
+one.
 """
 
 from __future__ import annotations
@@ -72,13 +54,21 @@ import numpy as np
 import scipy.linalg as sl
 
 from phdesign.errors import NumericError, check_shape
-from phdesign.numeric.phs import DiscretePHS, feedback_matrix
+from phdesign.numeric.phs import DiscretePHS
+from phdesign.numeric.sampled_discretization import (
+    ObserverModel,
+    Realization,
+    SampledPlant,
+    hold_discretization,
+    sample_plant,
+)
 
 __all__ = [
     "ALIASING_RATIO",
     "SAMPLERS",
     "ContinuousObserver",
     "LoopRun",
+    "SampledPlant",
     "aliasing_warning",
     "check_sampling",
     "default_initial_state",
@@ -122,71 +112,6 @@ def check_sampling(dt: object, sampler: object, *, dt_name: str = "dt") -> float
     return value
 
 
-def hold_discretization(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    r"""Exact discretization of :math:`\dot x = A x + B v` with v held over each step.
-
-    .. math::
-
-        \exp\left(\begin{bmatrix} A & B \\ 0 & 0 \end{bmatrix}\Delta t\right) =
-        \begin{bmatrix} A_d & B_d \\ 0 & I \end{bmatrix}.
-
-    Examples
-    --------
-    >>> Ad, Bd = hold_discretization(np.array([[-2.0]]), np.array([[1.0]]), 0.5)
-    >>> exact = np.exp(-1.0), (1 - np.exp(-1.0)) / 2  # e^{a dt}, (e^{a dt} - 1) / a
-    >>> bool(np.isclose(Ad[0, 0], exact[0])), bool(np.isclose(Bd[0, 0], exact[1]))
-    (True, True)
-    """
-    n, m = B.shape
-    block = np.zeros((n + m, n + m))
-    block[:n, :n] = A
-    block[:n, n:] = B
-    exponential = sl.expm(block * dt)
-    return exponential[:n, :n], exponential[:n, n:]
-
-
-@dataclass(frozen=True)
-class SampledPlant:
-    r"""One period of a plant under a sampler: :math:`x_{k+1} = \Phi x_k + \Gamma u_k`.
-
-    The sampler reads :math:`C_s x_k + D_s u_k`: :math:`y(t_k)` for ``"point"``, the exact
-    mean over :math:`[t_k, t_{k+1}]` for ``"average"`` (module docstring).
-    """
-
-    Phi: np.ndarray
-    Gamma: np.ndarray
-    C_s: np.ndarray
-    D_s: np.ndarray
-
-
-def sample_plant(
-    F: np.ndarray, G: np.ndarray, C: np.ndarray, D: np.ndarray, dt: float, sampler: str
-) -> SampledPlant:
-    """Return the exact one-period map and measurement of a plant under ``sampler``.
-
-    Examples
-    --------
-    The mean of x(t) = exp(-a t) x0 over [0, dt] is x0 (1 - exp(-a dt)) / (a dt):
-
-    >>> s = sample_plant(np.array([[-2.0]]), np.zeros((1, 1)), np.eye(1), np.zeros((1, 1)),
-    ...                  0.5, "average")
-    >>> bool(np.isclose(s.C_s[0, 0], (1 - np.exp(-1.0)) / 1.0))
-    True
-    """
-    n, m = G.shape
-    if sampler == "point":
-        Phi, Gamma = hold_discretization(F, G, dt)
-        return SampledPlant(Phi, Gamma, C.copy(), D.copy())
-    block = np.zeros((2 * n + m, 2 * n + m))
-    block[:n, :n] = F
-    block[:n, 2 * n :] = G
-    block[n : 2 * n, :n] = np.eye(n)
-    exponential = sl.expm(block * dt)
-    Phi, Gamma = exponential[:n, :n], exponential[:n, 2 * n :]
-    S_x, S_u = exponential[n : 2 * n, :n], exponential[n : 2 * n, 2 * n :]
-    return SampledPlant(Phi, Gamma, C @ S_x / dt, C @ S_u / dt + D)
-
-
 def sensor_names(C_m: np.ndarray) -> tuple[str, ...]:
     """``y<i>`` for a row of C_m that picks output i, ``y_m<j>`` for a combination.
 
@@ -219,6 +144,9 @@ class ContinuousObserver:
         Galerkin observer, the kept subspace after a reduction).
     discrete : DiscretePHS
         The discretization it comes from.
+    model : ObserverModel
+        The model the observer runs and its output injection, in its coordinates (what
+        the ``average`` sampler's discretization needs).
     inputs, outputs : tuple of str
         Signal names.
     performance : tuple of int
@@ -236,6 +164,7 @@ class ContinuousObserver:
     energy_matrix: np.ndarray
     basis: np.ndarray = field(repr=False)
     discrete: DiscretePHS = field(repr=False)
+    model: ObserverModel = field(repr=False)
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
     performance: tuple[int, ...]
@@ -267,19 +196,16 @@ class ContinuousObserver:
             A = E^{-1}(J - R - B M K B^\top), \quad B_o = E^{-1} B M [I,\ C_m^\top L],
             \quad C_y = B^\top - D M K B^\top, \quad D_y = D M [I,\ C_m^\top L],
 
-        and the displacement :math:`w(z) = W(z)\hat e` at each of ``points``.
+        (:meth:`ObserverModel.continuous
+        <phdesign.numeric.sampled_discretization.ObserverModel.continuous>`) and the
+        displacement :math:`w(z) = W(z)\hat e` at each of ``points``.
         """
         C = np.atleast_2d(np.asarray(C_m, dtype=float))
         m = d.n_ports
-        K = feedback_matrix(C, L, m)
-        M = np.linalg.inv(np.eye(m) + K @ d.D)
-        inject = np.hstack([np.eye(m), C.T @ np.atleast_2d(np.asarray(L, dtype=float))])
-        A = np.linalg.solve(d.E, d.closed_matrix(K))
-        B = np.linalg.solve(d.E, d.B @ M @ inject)
-        Cy = d.B.T - d.D @ M @ K @ d.B.T
-        Dy = d.D @ M @ inject
+        model = ObserverModel.from_discretization(d, C, L)
+        closed = model.continuous()
         outputs = [f"yhat{i + 1}" for i in range(m)]
-        rows, feed = [Cy], [Dy]
+        rows, feed = [closed.C], [closed.D]
         pts = np.asarray(points, dtype=float).reshape(-1)
         if pts.size:
             if d.displacement_basis is None:
@@ -287,17 +213,18 @@ class ContinuousObserver:
                     f"model {d.model.name!r} has no displacement: drop the displacement points"
                 )
             rows.append(d.displacement_basis(pts))
-            feed.append(np.zeros((pts.size, inject.shape[1])))
+            feed.append(np.zeros((pts.size, closed.B.shape[1])))
             outputs += [f"w({z:g})" for z in pts]
         performance = tuple(range(m, m + pts.size)) if pts.size else tuple(range(m))
         return cls(
-            A=A,
-            B=B,
+            A=closed.A,
+            B=closed.B,
             C=np.vstack(rows),
             D=np.vstack(feed),
             energy_matrix=d.E.copy(),
             basis=np.eye(d.dim),
             discrete=d,
+            model=model,
             inputs=tuple(f"u{i + 1}" for i in range(m)) + sensor_names(C),
             outputs=tuple(outputs),
             performance=performance,
@@ -307,7 +234,9 @@ class ContinuousObserver:
     def project(self, V: np.ndarray, W: np.ndarray, reduction: str) -> ContinuousObserver:
         r"""Petrov-Galerkin reduction :math:`x = V x_r`, :math:`\dot x_r = W^\top(A V x_r + B v)`.
 
-        ``W^T V = I`` is required; the energy matrix becomes :math:`V^\top Q V`.
+        ``W^T V = I`` is required; the energy matrix becomes :math:`V^\top Q V`, and the
+        model the observer runs is projected alike (:meth:`ObserverModel.project
+        <phdesign.numeric.sampled_discretization.ObserverModel.project>`).
         """
         check_shape("W", W, V.shape)
         return ContinuousObserver(
@@ -318,11 +247,35 @@ class ContinuousObserver:
             energy_matrix=V.T @ self.energy_matrix @ V,
             basis=self.basis @ V,
             discrete=self.discrete,
+            model=self.model.project(V, W),
             inputs=self.inputs,
             outputs=self.outputs,
             performance=self.performance,
             points=self.points,
             reduction=reduction,
+        )
+
+    def sampled(self, dt: float, sampler: str) -> Realization:
+        r"""Return the discrete observer for ``sampler`` at period ``dt`` (module docstring).
+
+        ``"point"``: this observer with v held (:func:`hold_discretization`), outputs
+        :math:`C\hat x_k + Dv_k`. ``"average"``: the exact sampled-data observer
+        (:meth:`ObserverModel.averaged
+        <phdesign.numeric.sampled_discretization.ObserverModel.averaged>`), with the
+        model's outputs at :math:`t_k` and the performance rows of C below them.
+        """
+        dt = check_sampling(dt, sampler)
+        if sampler == "point":
+            A_d, B_d = hold_discretization(self.A, self.B, dt)
+            return Realization(A_d, B_d, self.C.copy(), self.D.copy())
+        closed = self.model.averaged(dt)
+        m = self.n_plant_inputs
+        extra = self.C[m:]
+        return Realization(
+            A=closed.A,
+            B=closed.B,
+            C=np.vstack([closed.C, extra]),
+            D=np.vstack([closed.D, np.zeros((extra.shape[0], closed.D.shape[1]))]),
         )
 
 
@@ -376,8 +329,8 @@ def run_loop(
     r"""Run ``plant`` and ``observer`` over ``n_steps`` periods, exactly.
 
     ``sampler=None`` runs the continuous observer on the continuous plant outputs; a
-    sampler name runs the discrete observer (:func:`hold_discretization`) on the sampled
-    outputs (:func:`sample_plant`). The plant input u (``(n_steps, N n)``, default zero)
+    sampler name runs the discrete observer (:meth:`ContinuousObserver.sampled`) on the
+    sampled outputs (:func:`sample_plant`). The plant input u (``(n_steps, N n)``, default zero)
     is held over each period in both cases; ``u`` holds ``u_0 .. u_n_steps`` (the last
     enters only the outputs of the final record). In the sampled case, with
     :math:`X = (x; \hat x)`,
@@ -398,7 +351,12 @@ def run_loop(
     G = np.linalg.solve(plant.E, plant.B)
     Cp, Dp = plant.B.T, plant.D
     n, no, m = plant.dim, observer.order, plant.n_ports
-    Bu, By = observer.B[:, :m], observer.B[:, m:]
+    realization = (
+        Realization(observer.A, observer.B, observer.C, observer.D)
+        if sampler is None
+        else observer.sampled(dt, sampler)
+    )
+    Bu, By = realization.B[:, :m], realization.B[:, m:]
     if sampler is None:
         generator = np.zeros((n + no + m, n + no + m))
         generator[:n, :n] = F
@@ -411,12 +369,11 @@ def run_loop(
         Cs, Ds = Cp, Dp
     else:
         sp = sample_plant(F, G, Cp, Dp, dt, sampler)
-        Ad, Bd = hold_discretization(observer.A, observer.B, dt)
         step = np.zeros((n + no, n + no))
         step[:n, :n] = sp.Phi
-        step[n:, :n] = Bd[:, m:] @ C @ sp.C_s
-        step[n:, n:] = Ad
-        drive = np.vstack([sp.Gamma, Bd[:, :m] + Bd[:, m:] @ C @ sp.D_s])
+        step[n:, :n] = By @ C @ sp.C_s
+        step[n:, n:] = realization.A
+        drive = np.vstack([sp.Gamma, Bu + By @ C @ sp.D_s])
         Cs, Ds = sp.C_s, sp.D_s
     records = n_steps // stride + 1
     X = np.empty((records, n + no))
@@ -445,7 +402,7 @@ def run_loop(
         x=x,
         xhat=xhat,
         y=x @ Cp.T + U @ Dp.T,
-        yhat=xhat @ observer.C.T + v @ observer.D.T,
+        yhat=xhat @ realization.C.T + v @ realization.D.T,
         target=target,
     )
 
