@@ -25,6 +25,7 @@ COMMAND_MODULES = (
     "phdesign.cli.classify_command",
     "phdesign.cli.numeric_commands",
     "phdesign.cli.export_command",
+    "phdesign.cli.loop_command",
 )
 
 

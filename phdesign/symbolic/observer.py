@@ -226,10 +226,12 @@ def parse_gain(text: str, q: int) -> sympy.ImmutableMatrix:
 # --------------------------------------------------------------------------- checks
 def _check_cm(C_m: sympy.MatrixBase, n_outputs: int) -> sympy.ImmutableMatrix:
     C_m = sympy.ImmutableMatrix(C_m)
-    if C_m.rows < 1 or C_m.rows > n_outputs:
+    # q = 0 (no sensors) is the plant's own classification: the propositions' left-hand
+    # side then carries only the plant's boundary dissipation (its [feedback])
+    if C_m.rows > n_outputs:
         raise ObserverError(
             f"Incompatible dimensions of C_m matrix; expected (q, {n_outputs}) with "
-            f"1 <= q <= {n_outputs} but found {C_m.shape}"
+            f"0 <= q <= {n_outputs} but found {C_m.shape}"
         )
     try:
         check_shape("C_m", C_m, (C_m.rows, n_outputs))
@@ -269,7 +271,8 @@ def _exactify_entries(M: sympy.MatrixBase, what: str) -> sympy.ImmutableMatrix:
             except ExpressionError as error:
                 raise ObserverError(str(error)) from None
         entries.append(row)
-    return sympy.ImmutableMatrix(entries)
+    # rows x cols, not from the list: a matrix with no rows keeps its columns
+    return sympy.ImmutableMatrix(M.rows, M.cols, [x for row in entries for x in row])
 
 
 def _py(x: object) -> object:
