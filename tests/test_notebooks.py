@@ -51,6 +51,7 @@ def test_there_are_four_notebooks():
         "03_wave_and_timoshenko",
         "04_higher_order",
         "06_implementation",
+        "07_observer_based_control",
     ]
 
 

@@ -442,10 +442,10 @@ class LoopSpectrum:
 
     def plot(self, ax: Any = None) -> Any:
         """Draw the rightmost resolved loop eigenvalues, marked by the block they belong to."""
-        import matplotlib.figure
+        from phdesign.plots import new_figure
 
         if ax is None:
-            ax = matplotlib.figure.Figure(figsize=(5, 4)).subplots()
+            _, ax = new_figure(figsize=(5, 4))
         for kind, marker in (("plant", "o"), ("error", "x")):
             z = np.array(
                 [w for w, o in zip(self.rightmost, self.origin, strict=True) if o == kind]
