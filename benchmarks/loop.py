@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import statistics
 import sys
-import time
 
 import numpy as np
+from _timing import timed
 
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
@@ -24,16 +24,6 @@ from phdesign.numeric.loop import NumericLoop, loop_spectrum
 from phdesign.numeric.spectrum import spectrum
 
 TARGET = 1.0  # seconds, wall, median
-
-
-def timed(fn, repeat=5):
-    walls, cpus, out = [], [], None
-    for _ in range(repeat):
-        w, c = time.perf_counter(), time.process_time()
-        out = fn()
-        walls.append(time.perf_counter() - w)
-        cpus.append(time.process_time() - c)
-    return out, walls, cpus
 
 
 def main() -> int:

@@ -80,8 +80,8 @@ def test_loop_simulate_writes_csv_and_a_figure_and_refuses_to_overwrite(tmp_path
     ]
     run(argv, capsys)
     rows = list(csv.reader(io.StringIO(target.read_text())))
-    assert rows[0][:8] == ["t", "H", "H_hat", "H_err", "u1", "u2", "u3", "u4"]
-    assert rows[0][-2:] == ["w_tip", "w_hat_tip"]
+    assert rows[0][:4] == ["t", "H", "H_hat", "H_err"]
+    assert rows[0][-6:] == ["w_tip", "w_hat_tip", "u1", "u2", "u3", "u4"]
     assert len(rows) == 12
     assert figure.stat().st_size > 0
     assert main(argv) == 2  # both files exist now: nothing is overwritten without --force

@@ -176,6 +176,16 @@ def assemble(d: DiscretePHS, loop: NumericLoop) -> LoopSystem:
         If an index or a shape does not fit ``d``.
     NumericError
         If the feedthrough makes the loop ill-posed (I + K_a D singular).
+
+    Examples
+    --------
+    >>> from phdesign.models import load_builtin
+    >>> from phdesign.numeric.bridge import to_numeric
+    >>> d = discretize(to_numeric(load_builtin("euler-bernoulli")), "galerkin", 10)
+    >>> tip_torque = NumericLoop((2,), np.eye(1), np.array([[0, 0, 0, 1.0]]), np.eye(1))
+    >>> system = assemble(d, tip_torque)
+    >>> system.A.shape, system.others, system.triangular_residual < 1e-14
+    ((44, 44), (0, 1, 3), True)
     """
     m, n = d.n_ports, d.dim
     loop.check(m)

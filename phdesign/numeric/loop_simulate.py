@@ -20,9 +20,6 @@ autonomous whatever the inputs and is audited on its own.  A residual above
 
 from __future__ import annotations
 
-import csv
-import io
-import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -33,114 +30,75 @@ from phdesign.errors import LoopError, NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.loop import NumericLoop, assemble
-from phdesign.numeric.simulate import ENERGY_BALANCE_RTOL, energy_balance_residual, step_lti
+from phdesign.numeric.simulate import (
+    ENERGY_BALANCE_RTOL,
+    SimulationResult,
+    energy_balance_residual,
+    step_lti,
+)
 
 __all__ = ["LoopSimulation", "simulate_loop"]
 
 
 @dataclass(frozen=True)
-class LoopSimulation:
-    """Time series of the loop: energies, inputs, outputs, estimates and the displacement.
+class LoopSimulation(SimulationResult):
+    """Time series of the loop: a :class:`~phdesign.numeric.simulate.SimulationResult`.
+
+    Its fields (energies H, Ĥ, H̃, outputs y, ŷ, the displacement and its estimate) have
+    the meaning they have for ``simulate``; ``states_hat`` holds the observer's discrete
+    state ê_obs = ê − ẽ.  The loop adds:
 
     Attributes
     ----------
-    t : ndarray (nt,)
-    H, H_hat, H_err : ndarray (nt,)
-        Plant, observer and error energies.
     u : ndarray (nt, m)
         The inputs the plant receives (actuated ones: −K ŷ_a or −K y_a).
-    y, y_hat : ndarray (nt, m)
-        Plant and observer outputs.
-    input_labels, output_labels : tuple of str
+    input_labels : tuple of str
     actuated : tuple of int
         1-based indices of the actuated inputs.
-    z_w, w, w_hat : ndarray or None
-        Displacement points and the displacement of the plant and its estimate.
-    states, states_err : ndarray (nt, dim)
-        Discrete plant and error states (not written to files).
-    info : dict
-        Scheme, sizes and the energy-balance residuals.
+    states_err : ndarray (nt, dim)
+        The discrete error state ẽ, stepped on its own (not written to files).
     """
 
-    t: np.ndarray
-    H: np.ndarray
-    H_hat: np.ndarray
-    H_err: np.ndarray
-    u: np.ndarray
-    y: np.ndarray
-    y_hat: np.ndarray
-    input_labels: tuple[str, ...]
-    output_labels: tuple[str, ...]
-    actuated: tuple[int, ...]
-    method: str
-    resolution: int
-    z_w: np.ndarray | None = None
-    w: np.ndarray | None = None
-    w_hat: np.ndarray | None = None
-    states: np.ndarray | None = field(default=None, repr=False)
+    u: np.ndarray | None = None
+    input_labels: tuple[str, ...] = ()
+    actuated: tuple[int, ...] = ()
     states_err: np.ndarray | None = field(default=None, repr=False)
-    info: dict[str, Any] = field(default_factory=dict, repr=False)
-    warnings: tuple[str, ...] = ()
-    units: dict[str, str] | None = field(default=None, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready (the keys of ``simulate``'s JSON, plus ``u`` and the actuation)."""
-        out: dict[str, Any] = {
-            "method": self.method,
-            "resolution": self.resolution,
-            "t": self.t.tolist(),
-            "H": self.H.tolist(),
-            "H_hat": self.H_hat.tolist(),
-            "H_err": self.H_err.tolist(),
-            "input_labels": list(self.input_labels),
-            "output_labels": list(self.output_labels),
-            "actuated": list(self.actuated),
-            "u": self.u.tolist(),
-            "y": self.y.tolist(),
-            "y_hat": self.y_hat.tolist(),
-        }
-        if self.w is not None and self.z_w is not None and self.w_hat is not None:
-            out.update(z_w=self.z_w.tolist(), w=self.w.tolist(), w_hat=self.w_hat.tolist())
-        out.update({k: v for k, v in self.info.items() if isinstance(v, (int, float, str))})
-        out["warnings"] = list(self.warnings)
-        out["units"] = dict(self.units or {})
+        """JSON-ready: the keys of ``simulate``'s JSON, plus ``u`` and the actuation."""
+        out = super().to_dict()
+        out.update(
+            input_labels=list(self.input_labels),
+            actuated=list(self.actuated),
+            u=None if self.u is None else self.u.tolist(),
+        )
         return out
 
-    def to_json(self) -> str:
-        """Return :meth:`to_dict` as JSON text."""
-        return json.dumps(self.to_dict())
-
     def to_csv(self) -> str:
-        """CSV: t, H, H_hat, H_err, u_i, y_i, y_hat_i and the tip displacement w(b), ŵ(b)."""
-        cols: list[tuple[str, np.ndarray]] = [
-            ("t", self.t),
-            ("H", self.H),
-            ("H_hat", self.H_hat),
-            ("H_err", self.H_err),
+        """CSV: the columns of ``simulate`` (t, H, H_hat, H_err, y, y_hat, tip), then u."""
+        lines = super().to_csv().splitlines()
+        if self.u is None:
+            return "\n".join(lines) + "\n"
+        head = lines[0] + "".join(f",u{i + 1}" for i in range(self.u.shape[1]))
+        rows = [
+            line + "".join(f",{float(x)!r}" for x in row)
+            for line, row in zip(lines[1:], self.u, strict=True)
         ]
-        cols += [(f"u{i + 1}", self.u[:, i]) for i in range(self.u.shape[1])]
-        cols += [(f"y{i + 1}", self.y[:, i]) for i in range(self.y.shape[1])]
-        cols += [(f"y_hat{i + 1}", self.y_hat[:, i]) for i in range(self.y_hat.shape[1])]
-        if self.w is not None and self.w_hat is not None:
-            cols += [("w_tip", self.w[:, -1]), ("w_hat_tip", self.w_hat[:, -1])]
-        buffer = io.StringIO()
-        writer = csv.writer(buffer, lineterminator="\n")
-        writer.writerow([name for name, _ in cols])
-        for row in np.column_stack([c for _, c in cols]):
-            writer.writerow([repr(float(x)) for x in row])
-        return buffer.getvalue()
+        return "\n".join([head, *rows]) + "\n"
 
     def __str__(self) -> str:
         """Return the CSV that ``phdesign loop simulate`` prints."""
         return self.to_csv()
 
     def _summary(self) -> list[tuple[str, str]]:
-        return [
+        rows = [
             ("samples", f"{self.t.size} on [{self.t[0]:g}, {self.t[-1]:g}]"),
             ("H(0) → H(T)", f"{self.H[0]:.6g} → {self.H[-1]:.6g}"),
-            ("H̃(0) → H̃(T)", f"{self.H_err[0]:.6g} → {self.H_err[-1]:.6g}"),
-            ("actuated", ", ".join(f"u{a}" for a in self.actuated)),
         ]
+        if self.H_err is not None:
+            rows.append(("H̃(0) → H̃(T)", f"{self.H_err[0]:.6g} → {self.H_err[-1]:.6g}"))
+        rows.append(("actuated", ", ".join(f"u{a}" for a in self.actuated)))
+        return rows
 
     def __repr__(self) -> str:
         body = ", ".join(f"{k}: {v}" for k, v in self._summary())
@@ -198,6 +156,18 @@ def simulate_loop(
     ------
     LoopError
         If ``u`` drives an actuated input.
+
+    Examples
+    --------
+    >>> from phdesign.models import load_builtin
+    >>> from phdesign.numeric.bridge import initial_state_function, to_numeric
+    >>> beam = load_builtin("euler-bernoulli")
+    >>> nm = to_numeric(beam)
+    >>> loop = NumericLoop((2,), np.eye(1), np.array([[0, 0, 0, 1.0]]), np.eye(1))
+    >>> x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=beam)
+    >>> run = simulate_loop(nm, loop, x0=x0, t_end=1.0, samples=3, resolution=12)
+    >>> bool(run.H[-1] < run.H[0]), run.warnings
+    (True, ())
     """
     if not (np.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a positive number; found {t_end}")
@@ -263,6 +233,7 @@ def simulate_loop(
         w=w,
         w_hat=w_hat,
         states=eh,
+        states_hat=eh - err,
         states_err=err,
         info={
             "scheme": scheme,
