@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sl
 
+from phdesign.errors import LoopError
 from phdesign.loop import Loop
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import NumericModel, constant_H, initial_state_function, to_numeric
@@ -75,6 +76,10 @@ def test_estimated_tip_rotation_damps_the_undamped_beam_that_only_its_tip_veloci
     against its own, and the assembled loop's abscissa = the max of the two.
     """
     loop = Loop(BEAM, actuate=3, feedback=1, sensors=[4], gain=1, parameters={"d": 0})
+    with pytest.raises(LoopError, match="y4 = -e1\\(1\\) is not collocated with the actuated"):
+        Loop(BEAM, actuate=3, sensors=[4], feedback_outputs=4)  # u3 = -k y4: no damper
+    with pytest.raises(LoopError, match="is not measured by these sensors"):
+        Loop(BEAM, actuate=3, sensors=[4], feedback_source="measured")  # y3 is not measured
     report = loop.spectrum(count=10)
     assert report.converged
     assert report.plant.converged
