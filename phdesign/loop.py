@@ -54,8 +54,9 @@ from phdesign.symbolic.model import BCPHS
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.numeric.bridge import NumericModel
-    from phdesign.numeric.loop import LoopSpectrum, LoopSystem, NumericLoop
+    from phdesign.numeric.loop import LoopSystem, NumericLoop
     from phdesign.numeric.loop_simulate import LoopSimulation
+    from phdesign.numeric.loop_spectrum import LoopSpectrum
     from phdesign.numeric.loop_tune import LoopTuneResult
 
 __all__ = ["Loop"]
@@ -273,8 +274,8 @@ class Loop:
         resolution: int | None = None,
         max_resolution: int | None = None,
     ) -> LoopSpectrum:
-        """Return the loop's converged spectrum (:func:`~phdesign.numeric.loop.loop_spectrum`)."""
-        from phdesign.numeric.loop import loop_spectrum
+        """Return the loop's converged spectrum (:func:`.numeric.loop_spectrum.loop_spectrum`)."""
+        from phdesign.numeric.loop_spectrum import loop_spectrum
 
         return loop_spectrum(
             self.numeric_model,

@@ -20,8 +20,9 @@ from phdesign.errors import LoopError
 from phdesign.loop import Loop
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import NumericModel, constant_H, initial_state_function, to_numeric
-from phdesign.numeric.loop import NumericLoop, assemble, loop_spectrum
+from phdesign.numeric.loop import NumericLoop, assemble
 from phdesign.numeric.loop_simulate import simulate_loop
+from phdesign.numeric.loop_spectrum import loop_spectrum
 from phdesign.numeric.loop_tune import tune_loop
 from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.simulate import simulate

@@ -90,7 +90,8 @@ BAD_DESIGNS = [
         r"full row rank.*expected rank 2 but found 1",
     ),
     (sympy.Matrix([[1, 0, 0]]), sympy.eye(1), r"C_m matrix; expected \(1, 4\) but found \(1, 3\)"),
-    (sympy.zeros(0, 4), sympy.eye(0), r"1 <= q <= 4"),
+    # q = 0 is the plant's own classification (issue 16); more rows than outputs is not
+    (sympy.eye(5)[:, :4], sympy.eye(5), r"0 <= q <= 4 but found \(5, 4\)"),
     (sensor_matrix([3, 4], 4), sympy.eye(3), r"L matrix; expected \(2, 2\) but found \(3, 3\)"),
     (sensor_matrix([3, 4], 4), sympy.diag(1, -1), r"positive definite.*minor 2 = -4"),
     # L + L^T = [[2, 3], [3, 2]] is indefinite although the diagonal is positive

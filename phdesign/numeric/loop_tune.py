@@ -13,7 +13,7 @@ the joint problem splits into two independent ones.  The controlled plant
 :math:`E\dot{\hat e} = (J - R - B S_a^\top K S_a B^\top)\hat e` has the form of an error
 system with "sensors" :math:`S_a` and gain :math:`K`, so both are tuned by
 :func:`phdesign.numeric.tune.tune` (converged abscissa, coalescence detection); the pair
-is then verified on the assembled loop (:func:`phdesign.numeric.loop.loop_spectrum`).
+is then verified on the assembled loop (:func:`phdesign.numeric.loop_spectrum.loop_spectrum`).
 Any K with :math:`\alpha_{plant}(K) \le \min_L \alpha_{error}` is optimal too when the
 error system limits the loop; the tuned K is the one that makes the plant fastest.
 """
@@ -27,7 +27,8 @@ import numpy as np
 
 from phdesign.errors import LoopError
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.loop import LoopSpectrum, NumericLoop, loop_spectrum
+from phdesign.numeric.loop import NumericLoop
+from phdesign.numeric.loop_spectrum import LoopSpectrum, loop_spectrum
 from phdesign.numeric.tune import TuneResult, tune
 
 __all__ = ["TUNE_TARGETS", "LoopTuneResult", "tune_loop"]
