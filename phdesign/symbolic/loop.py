@@ -62,7 +62,9 @@ controlled plant and the response to that input gives the loop's verdict
 
 When the error system is exponential but :math:`\tilde y_a` is not bounded by its
 certificate, the argument uses that :math:`\tilde y_a` is an admissible output of the
-error system (the model is well-posed, as every N = 1 model is); the result says so.
+error system: the model is well-posed, as every N = 1 model with Lipschitz H is (Zwart,
+Le Gorrec, Maschke and Villegas, ESAIM COCV 2010, for a dissipative boundary), and the
+verdict's reason says that it rests on this.
 With ``source="measured"`` (:math:`u_a = -K y_a` from the sensors, possible only where
 :math:`y_a` is measured) the plant does not see the observer at all and the loop is as
 good as the weaker of the two.
@@ -371,8 +373,8 @@ def loop_verdict(plant: str, error: str, source: str, bounded: bool) -> tuple[st
         "controlled plant"
         if bounded
         else "assuming ỹ_a is an admissible output of the error system (a well-posed "
-        "model, as every N = 1 model is), K ỹ_a, the input that drives the controlled "
-        "plant, decays with the error"
+        "model, as every N = 1 model with Lipschitz H is), K ỹ_a, the input that drives "
+        "the controlled plant, decays with the error"
     )
     if plant == error == "exponential":
         return "exponential", f"both converge exponentially and {driven}: exponential"
