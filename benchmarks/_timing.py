@@ -20,6 +20,17 @@ def time_command(argv: Sequence[str], runs: int = 7, warmup: int = 1) -> list[fl
     return timings
 
 
+def timed(fn, repeat: int = 5):  # type: ignore[no-untyped-def]
+    """Call ``fn()`` ``repeat`` times in this process; return (last result, walls, cpus)."""
+    walls, cpus, out = [], [], None
+    for _ in range(repeat):
+        wall, cpu = time.perf_counter(), time.process_time()
+        out = fn()
+        walls.append(time.perf_counter() - wall)
+        cpus.append(time.process_time() - cpu)
+    return out, walls, cpus
+
+
 def report(
     label: str, timings: Sequence[float], baseline: Sequence[float], target: float | None
 ) -> bool:

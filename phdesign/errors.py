@@ -49,6 +49,10 @@ class ObserverError(PhdesignError, ValueError):
     """Sensor selection or observer gain is invalid."""
 
 
+class LoopError(PhdesignError, ValueError):
+    """Actuation or feedback of an observer-based loop is invalid."""
+
+
 class ModelFileError(PhdesignError, ValueError):
     """A model file cannot be read: bad TOML, missing or unknown keys."""
 

@@ -20,6 +20,7 @@ from bad_inputs import BAD_MODELS, beam_with
 from phdesign.cli import main
 from phdesign.errors import (
     ExpressionError,
+    LoopError,
     ModelError,
     ModelFileError,
     NumericError,
@@ -594,6 +595,93 @@ COMMAND_ROWS = [
     row(
         "tune wave --sensors 2 --seed -1",
         "argument --seed: expected a non-negative integer; found -1",
+        None,
+    ),
+    # --- issue 16 (loop): observer-based boundary control
+    row(
+        "loop classify euler-bernoulli --actuate 7 --sensors 4",
+        r"actuate: u7 is not an input of the model; expected an index in 1\.\.4 "
+        r"\(u1 = e1\(0\), u2 = e1'\(0\), u3 = e2\(1\), u4 = e2'\(1\)\)",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 0 --sensors 4",
+        "actuate: u0 is not an input of the model",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3,3 --sensors 4",
+        "actuate: input u3 is repeated",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate x --sensors 4",
+        "--actuate: expected comma-separated 1-based indices",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3 --feedback -1 --sensors 4",
+        r"feedback K \+ Kᵀ must be positive definite \(exact\); found eigenvalues \[-2\]",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3 --feedback 0 --sensors 4",
+        r"found eigenvalues \[0\]",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3,4 --feedback [[1,3],[3,1]] --sensors 4",
+        r"positive definite \(exact\); found eigenvalues \[-4, 8\]",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3 --feedback 1,2 --sensors 4",
+        "expected 1 diagonal values",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3 --feedback nan --sensors 4",
+        "feedback K entry 1",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3 --feedback symbolic --sensors 4",
+        "symbolic feedback gains",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3 --feedback-outputs 4 --sensors 4",
+        r"feedback: y4 = -e1\(1\) is not collocated with the actuated input u3; its power "
+        r"conjugate is y3 = e1'\(1\)",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3 --feedback-source measured --sensors 4",
+        r"feedback source measured: y3 = e1'\(1\) \(collocated with the actuated u3\) is not "
+        "measured by these sensors",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3",
+        "loop needs the observer's sensors: give --sensors or --cm",
+        LoopError,
+    ),
+    row(
+        "loop classify euler-bernoulli --actuate 3 --sensors 5",
+        "output index 5 is out of range; expected 1..4",
+        ObserverError,
+    ),
+    row("loop classify euler-bernoulli --sensors 4", "required: --actuate", None),
+    row("loop euler-bernoulli --actuate 3", "invalid choice: 'euler-bernoulli'", None),
+    row("loop spectrum wave --actuate 2 --sensors 2 --count 0", "--count", NumericError),
+    row(
+        "loop simulate euler-bernoulli --actuate 3 --sensors 4 --u u3:sin(t) --resolution 8",
+        "u3 is actuated by the feedback; --u drives only the other inputs (u1, u2, u4)",
+        LoopError,
+    ),
+    row(
+        "loop tune wave --actuate 2 --sensors 2 --tune everything",
+        "argument --tune: invalid choice: 'everything'",
         None,
     ),
 ]

@@ -56,6 +56,7 @@ def test_there_are_six_notebooks():
         "04_higher_order",
         "05_noise_tradeoff",
         "06_implementation",
+        "07_observer_based_control",
     ]
 
 

@@ -29,6 +29,7 @@ COMMAND_MODULES = (
     "phdesign.cli.numeric_commands",
     "phdesign.cli.noise_commands",
     "phdesign.cli.export_command",
+    "phdesign.cli.loop_command",
 )
 
 

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
-from phdesign.errors import ParameterError
+from phdesign.errors import NumericError, ParameterError
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.model import BCPHS
@@ -14,12 +16,15 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 __all__ = [
     "add_json_argument",
     "add_model_argument",
+    "check_finite_series",
     "emit",
     "emit_json",
     "load_model",
     "non_negative_int",
     "parse_parameter_overrides",
     "printable",
+    "run_outputs",
+    "simulation_text",
     "warn",
     "write_output",
 ]
@@ -128,3 +133,80 @@ def non_negative_int(text: str) -> int:
     if value < 0:
         raise argparse.ArgumentTypeError(f"expected a non-negative integer; found {value}")
     return value
+
+
+@contextmanager
+def run_outputs(args: argparse.Namespace) -> Iterator[Callable[[str, Any], None]]:
+    """Reserve ``-o`` and ``--plot`` before a run; yield ``commit(text, result)``.
+
+    Every output is checked before the (possibly long) work and written together at the
+    end (:class:`phdesign.outputs.OutputFiles`): on any failure or interrupt none is left,
+    and no temporary file.  ``commit`` stages the text (or prints it without ``-o``) and
+    ``result.plot()``'s figure, then writes them; warnings raised during the block (e.g.
+    matplotlib's) are printed afterwards as ``phdesign: warning:`` lines.
+    """
+    import warnings
+
+    from phdesign.outputs import OutputFiles
+
+    with OutputFiles(args.force) as out, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fmt = None
+        if args.output:
+            out.add(args.output)
+        if args.plot:
+            from phdesign.plots import check_plot_path
+
+            fmt = check_plot_path(args.plot, args.force)
+            out.add(args.plot)
+        printed: list[str] = []
+
+        def commit(text: str, result: Any) -> None:
+            if args.plot:
+                import io
+
+                picture = io.BytesIO()
+                result.plot().savefig(picture, format=fmt, dpi=110)
+                out.stage(args.plot, picture.getvalue())
+            if args.output:
+                out.stage(args.output, text)
+            out.commit()
+            if not args.output:
+                printed.append(text)
+
+        yield commit
+    for text in printed:
+        emit(text)
+    for warning in dict.fromkeys(str(w.message) for w in caught):
+        warn(warning)
+
+
+def check_finite_series(result: Any) -> None:
+    """Refuse a simulation whose series overflowed (NaN or infinity), naming the first one.
+
+    Large initial states, tiny parameters or huge gains can overflow double precision;
+    such a run is an error, never rows of NaN.
+    """
+    import numpy as np
+
+    for name in ("H", "H_hat", "H_err", "y", "y_hat", "w", "w_hat"):
+        series = getattr(result, name, None)
+        if series is None:
+            continue
+        values = np.asarray(series, dtype=float)
+        bad = ~np.isfinite(values.reshape(values.shape[0], -1)).all(axis=1)
+        if bad.any():
+            first = float(result.t[int(np.argmax(bad))])
+            raise NumericError(
+                f"the simulation overflowed: {name} is not finite from t = {first:.6g} on; "
+                "the initial state, parameters or gain are too large for double precision"
+            )
+
+
+def simulation_text(args: argparse.Namespace, model: str, result: Any) -> str:
+    """Return the text a simulation prints: strict JSON with ``--json``, else its CSV."""
+    if args.json:
+        from phdesign.io import dumps_json
+
+        return dumps_json({"model": model, **result.to_dict()}, indent=None)
+    return str(result)

@@ -20,10 +20,13 @@ from typing import Any
 from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
+    check_finite_series,
     emit,
     emit_json,
     load_model,
     non_negative_int,
+    run_outputs,
+    simulation_text,
     warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
@@ -204,13 +207,10 @@ def _spectrum(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    import warnings
-
     import numpy as np
 
     from phdesign.design import Plant
     from phdesign.numeric.bridge import input_function
-    from phdesign.outputs import OutputFiles
 
     _check_positive("--resolution", args.resolution)
     _check_positive("--t-end", args.t_end)
@@ -234,18 +234,7 @@ def _simulate(args: argparse.Namespace) -> int:
     # a sampled or lower-order observer (--dt, --sampler, --observer-resolution), a noisy
     # run (--noise-intensity, --input-noise), else the continuous noiseless one
     noisy = stochastic_simulation(args)
-    # every output is checked before the simulation and written together at the end: on
-    # any failure or interrupt none is left, and no temporary file
-    with OutputFiles(args.force) as out, warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        fmt = None
-        if args.output:
-            out.add(args.output)
-        if args.plot:
-            from phdesign.plots import check_plot_path
-
-            fmt = check_plot_path(args.plot, args.force)
-            out.add(args.plot)
+    with run_outputs(args) as commit:
         with np.errstate(all="ignore"):  # an overflow is refused below, with one line
             res = sampled_simulation(args, plant.numeric, C_m, L, x0, xhat0)
             if res is None and noisy is not None:
@@ -277,23 +266,7 @@ def _simulate(args: argparse.Namespace) -> int:
                 else:
                     res = plant.simulate(x0, **options)
         check_finite_series(res)
-        if args.json:
-            from phdesign.io import dumps_json
-
-            text = dumps_json({"model": model.name, **res.to_dict()}, indent=None)
-        else:
-            text = str(res)
-        if args.plot:
-            import io
-
-            picture = io.BytesIO()
-            res.plot().savefig(picture, format=fmt, dpi=110)
-            out.stage(args.plot, picture.getvalue())
-        if args.output:
-            out.stage(args.output, text)
-        out.commit()
-    if not args.output:
-        emit(text)
+        commit(simulation_text(args, model.name, res), res)
     notices = []
     if args.x0 is None:
         notices.append(
@@ -302,7 +275,7 @@ def _simulate(args: argparse.Namespace) -> int:
         )
     if observer is not None and args.gain is None:
         notices.append("no --gain given: the observer uses L = I (--gain 1)")
-    for warning in (*notices, *res.warnings, *dict.fromkeys(str(w.message) for w in caught)):
+    for warning in (*notices, *res.warnings):
         warn(warning)
     return 0
 
@@ -349,28 +322,6 @@ class _Progress:
         if self._shown:
             sys.stderr.write("\r" + " " * self._shown + "\r")
             sys.stderr.flush()
-
-
-def check_finite_series(result: Any) -> None:
-    """Refuse a simulation whose series overflowed (NaN or infinity), naming the first one.
-
-    Large initial states, tiny parameters or huge gains can overflow double precision;
-    such a run is an error, never rows of NaN.
-    """
-    import numpy as np
-
-    for name in ("H", "H_hat", "H_err", "y", "y_hat", "w", "w_hat"):
-        series = getattr(result, name, None)
-        if series is None:
-            continue
-        values = np.asarray(series, dtype=float)
-        bad = ~np.isfinite(values.reshape(values.shape[0], -1)).all(axis=1)
-        if bad.any():
-            first = float(result.t[int(np.argmax(bad))])
-            raise NumericError(
-                f"the simulation overflowed: {name} is not finite from t = {first:.6g} on; "
-                "the initial state, parameters or gain are too large for double precision"
-            )
 
 
 def _tune(args: argparse.Namespace) -> int:

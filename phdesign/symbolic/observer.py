@@ -376,6 +376,23 @@ def _number(x: object, what: str) -> sympy.Expr:
         raise ObserverError(str(error)) from None
 
 
+def sensors_and_gain(
+    C_m: Any, L: Any, n_outputs: int
+) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix]:
+    r"""Read :math:`C_m` and :math:`L` (:func:`measurement_matrix`, :func:`gain_matrix`).
+
+    One case more than those readers take: ``C_m`` of shape ``(0, n_outputs)`` with ``L``
+    of shape ``(0, 0)`` means *no sensors*, which classifies the plant by its own boundary
+    dissipation (its ``[feedback]``): the propositions' left-hand side then holds only
+    :math:`	ilde y_c^	op \operatorname{sym}(K) 	ilde y_c` (observer-based control
+    classifies the controlled plant so).  An empty list is not that case: it is refused.
+    """
+    if getattr(C_m, "shape", None) == (0, n_outputs) and getattr(L, "shape", None) == (0, 0):
+        return sympy.ImmutableMatrix.zeros(0, n_outputs), sympy.ImmutableMatrix.zeros(0, 0)
+    exact = measurement_matrix(C_m, n_outputs)
+    return exact, gain_matrix(L, exact.rows)
+
+
 # --------------------------------------------------------------------------- design
 def port_matrices(model: BCPHS) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix]:
     r"""Return :math:`(U, Y)` of ``model`` with the parameter defaults substituted.
@@ -516,8 +533,7 @@ def error_system(
         If ``C_m`` or ``L`` is malformed, or :math:`\dim \mathcal K \ne Nn`.
     """
     nn = order * size
-    C_m = measurement_matrix(C_m, nn - (0 if feedback is None else len(feedback[0])))
-    L = gain_matrix(L, C_m.rows)
+    C_m, L = sensors_and_gain(C_m, L, nn - (0 if feedback is None else len(feedback[0])))
     U = _safe_matrix(U, "U")
     Y = _safe_matrix(Y, "Y")
     T_inv = _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(U, Y)))
@@ -563,8 +579,9 @@ class ObserverDesign:
         from phdesign.arguments import require_model
 
         require_model(self.model)
-        object.__setattr__(self, "C_m", measurement_matrix(self.C_m, self.model.n_ports))
-        object.__setattr__(self, "L", gain_matrix(self.L, self.C_m.rows))
+        C_m, L = sensors_and_gain(self.C_m, self.L, self.model.n_ports)
+        object.__setattr__(self, "C_m", C_m)
+        object.__setattr__(self, "L", L)
 
     def error_system(self) -> ErrorSystem:
         """Return the :class:`ErrorSystem` of this design."""
