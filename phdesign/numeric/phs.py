@@ -78,7 +78,7 @@ class DiscretePHS:
         E symmetric positive definite, J and D skew, R symmetric positive semidefinite:
         what makes every closed loop ũ = −Kỹ with sym(K) ⪰ 0 dissipative.
         """
-        n, m = np.shape(self.E)[0], np.shape(self.B)[1]
+        n, m = np.shape(self.E)[0], np.shape(self.D)[0]
         for name, matrix, shape in (
             ("E", self.E, (n, n)),
             ("J", self.J, (n, n)),
