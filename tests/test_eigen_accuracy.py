@@ -28,6 +28,7 @@ from phdesign.numeric.loop import NumericLoop
 from phdesign.numeric.loop_spectrum import loop_spectrum
 from phdesign.numeric.scales import problem_scales
 from phdesign.numeric.spectrum import eigen, spectrum
+from phdesign.numeric.spectrum_refinement import choose_pair, refine
 from phdesign.symbolic.feedback import close_inputs
 
 BEAM = load_builtin("euler-bernoulli")
@@ -109,3 +110,41 @@ def test_the_loop_spectrum_is_refined_by_the_spectrum_rules_and_stays_honest():
     assert rising
     assert "keep rising with frequency" in rising[0]
     assert not any("separation structure is not reproduced" in w for w in report.warnings)
+
+
+class _SpoiledAtHighDegree:
+    """A per-resolution solver (``ResolutionSolver``) whose rightmost eigenvalue -9.25
+    agrees at resolutions 8 and 12 and is spoiled to -9.9 from resolution 18 on: what
+    QZ's round-off did to airy's Legendre basis at degree 27.  Damped modes
+    -(20 + m) + i (3m + 3), m < p/2 - 3 (few at low p, so the first pairs do not see
+    enough modes above the rightmost to converge), and an unresolved high pair.
+    """
+
+    rate = 1.0
+    dissipative = True
+
+    def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+        m = np.arange(p // 2 - 3)
+        modes = -(20.0 + m) + 1j * (3.0 * m + 3.0)
+        special = -9.25 if p < 18 else -9.9
+        high = -0.1 + 1j * 1000.0 * p
+        lam = np.concatenate([modes, modes.conj(), [special, high, np.conj(high)]])
+        return lam, np.ones(lam.size)
+
+
+def test_an_agreed_eigenvalue_is_kept_when_round_off_spoils_finer_pairs():
+    """The refinement rule (``choose_pair``) on a solver that spoils the rightmost.
+
+    Shift and invert removed the real-model trigger (airy, Legendre basis, sensors y1, y3:
+    QZ lost -9.250156 at degree 27; shift and invert converges there to 14 digits,
+    test_numeric_conditioning.py), so the rule is pinned here on a synthetic solver.
+    """
+    trail = refine(_SpoiledAtHighDegree(), start=8, stop=60, tol=1e-10, rtol_resolved=1e-6)
+    assert [r.pair.resolutions for r in trail] == [(8, 12), (12, 18), (18, 27)]
+    assert trail[-1].converged
+    assert trail[-1].abscissa.value == pytest.approx(-9.9, abs=1e-12)
+    chosen, notes = choose_pair(trail)
+    assert chosen.pair.resolutions == (8, 12)
+    assert chosen.abscissa.value == pytest.approx(-9.25, abs=1e-12)
+    assert len(notes) == 1
+    assert "an eigenvalue that once agreed is real" in notes[0]
