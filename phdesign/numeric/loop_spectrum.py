@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -373,6 +374,17 @@ def _report(
     warnings = [f"controlled plant: {w}" for w in plant.warnings]
     warnings += [f"error system: {w}" for w in error.warnings]
     a, pair = chosen.abscissa, chosen.pair
+    report = partial(  # what both outcomes share: the pair, the blocks, the labels
+        LoopSpectrum,
+        n_total=int(pair.eigenvalues.size),
+        resolutions=pair.resolutions,
+        method=method,
+        plant=plant,
+        error=error,
+        triangular_residual=triangular,
+        model=nm.name,
+        design=design,
+    )
     if a.value is None or a.uncertainty is None or a.attained is None:
         extinct = extinct_twice(trail)
         q = pair.resolutions[1]
@@ -385,7 +397,7 @@ def _report(
                 else ": the loop's spectrum is not resolved at these resolutions"
             )
         )
-        return LoopSpectrum(
+        return report(
             spectral_abscissa=None,
             converged=False,
             digits=None,
@@ -393,17 +405,9 @@ def _report(
             condition_numbers=[],
             origin=[],
             n_resolved=0,
-            n_total=int(pair.eigenvalues.size),
-            resolutions=pair.resolutions,
-            method=method,
-            plant=plant,
-            error=error,
             separation_gap=None,
-            triangular_residual=triangular,
             unbounded_below=extinct,
             warnings=warnings,
-            model=nm.name,
-            design=design,
         )
     own, ill, _ = report_warnings(chosen, a.value, a.uncertainty, a.attained, tol)
     warnings += [f"loop: {w}" for w in notes + own]
@@ -426,7 +430,7 @@ def _report(
                 f"the loop's abscissa differs from max(plant, error) by {gap:.2g}, beyond its "
                 "resolved digits: the separation structure is not reproduced (report this)"
             )
-    return LoopSpectrum(
+    return report(
         spectral_abscissa=float(a.value),
         converged=chosen.converged,
         digits=abscissa_digits(chosen),
@@ -434,16 +438,8 @@ def _report(
         condition_numbers=[float(c) for c in kappa[top]],
         origin=_tag(rightmost, blocks_lam),
         n_resolved=pair.n_resolved,
-        n_total=int(lam.size),
-        resolutions=pair.resolutions,
-        method=method,
-        plant=plant,
-        error=error,
         separation_gap=gap,
-        triangular_residual=triangular,
         ill_conditioned=ill,
         warnings=warnings,
-        model=nm.name,
-        design=design,
         uncertainty=float(a.uncertainty),
     )
