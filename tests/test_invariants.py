@@ -126,3 +126,19 @@ def test_a_skew_p0_evaluated_in_floating_point_is_round_off():
 
     with pytest.raises(ModelError, match="P0"):
         require_semidefinite("P0 + P0^T", 1e-17 * _unit(4, 0, 0), negative=True, error=ModelError)
+
+
+def test_a_model_whose_energy_is_not_positive_is_refused():
+    # H(z) = diag(1, z - 1/2): its smallest eigenvalue is z - 1/2, most negative (-0.5) at z = 0
+    def H(z):
+        out = np.zeros((np.size(z), 2, 2))
+        out[:, 0, 0] = 1.0
+        out[:, 1, 1] = np.ravel(z) - 0.5
+        return out
+
+    with pytest.raises(
+        ModelError,
+        match=r"H\(z\) must be symmetric positive definite; found smallest eigenvalue -0\.5 "
+        r"at z = 0$",
+    ):
+        dataclasses.replace(WAVE, H=H, H_constant=False)

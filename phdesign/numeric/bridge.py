@@ -173,10 +173,14 @@ class NumericModel:
     def _check_dissipative(self) -> None:
         r"""Refuse a model that is not dissipative (:mod:`phdesign.numeric.invariants`).
 
-        :math:`P_0 + P_0^\top \preceq 0` (a :math:`P_0(z)` on a grid of the interval) and
-        the plant's own feedback :math:`K + K^\top \succeq 0`, to round-off.
+        :math:`H(z) \succ 0` (the energy is positive) and :math:`P_0 + P_0^\top \preceq 0`
+        on a grid of the interval, and the plant's own feedback :math:`K + K^\top \succeq
+        0`, to round-off.
         """
-        from phdesign.numeric.invariants import GRID_POINTS, require_semidefinite
+        from phdesign.numeric.invariants import GRID_POINTS, require_definite, require_semidefinite
+
+        z = np.linspace(self.interval[0], self.interval[1], GRID_POINTS)
+        require_definite("H(z)", self.H_at(z), ModelError, points=z)
 
         def _size(M: np.ndarray) -> float:  # round-off is relative to the matrix summed
             return float(np.max(np.abs(M))) if M.size and np.all(np.isfinite(M)) else 0.0
@@ -187,7 +191,6 @@ class NumericModel:
                 "P0 + P0^T", P0 + P0.T, negative=True, reference=_size(P0), error=ModelError
             )
         else:
-            z = np.linspace(self.interval[0], self.interval[1], GRID_POINTS)
             P0 = self.P0_at(z)
             require_semidefinite(
                 "P0(z) + P0(z)^T",
@@ -359,16 +362,8 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         units=dict(getattr(model, "units", ())),
         parameters={str(k): float(v) for k, v in values.items()},
     )
-    # H must be positive definite after substitution (the symbolic check used defaults).
-    zs = np.linspace(nm.interval[0], nm.interval[1], 33)
-    Hv = nm.H_at(zs)
-    if not np.all(np.isfinite(Hv)):
-        raise ParameterError("H is not finite on the interval for these parameter values")
-    if np.min(np.linalg.eigvalsh(0.5 * (Hv + Hv.transpose(0, 2, 1)))) <= 0:
-        raise ParameterError(
-            "H is not positive definite on the interval for these parameter values"
-        )
-    # P0 + P0^T <= 0 and K + K^T >= 0 are checked by NumericModel itself (its invariants)
+    # H > 0, P0 + P0^T <= 0 and K + K^T >= 0 after substitution are checked by NumericModel
+    # itself (its invariants)
     return nm
 
 

@@ -83,16 +83,38 @@ def require_skew(name: str, M: np.ndarray, error: type[PhdesignError] = NumericE
         )
 
 
-def require_definite(name: str, M: np.ndarray, error: type[PhdesignError] = NumericError) -> None:
-    """Raise ``error`` unless the symmetric M is positive definite (Cholesky succeeds)."""
+def require_definite(
+    name: str,
+    M: np.ndarray,
+    error: type[PhdesignError] = NumericError,
+    *,
+    points: np.ndarray | None = None,
+) -> None:
+    """Raise ``error`` unless the symmetric M is positive definite (Cholesky succeeds).
+
+    ``M`` is one matrix, or a stack ``(m, n, n)`` sampled at ``points`` (then the message
+    says where the condition fails).
+
+    Examples
+    --------
+    >>> require_definite("E", np.eye(2))
+    >>> require_definite("H(z)", np.array([np.eye(2), -np.eye(2)]), points=np.array([0.0, 1.0]))
+    ... # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    phdesign.errors.NumericError: H(z) must be ... definite; found smallest eigenvalue -1 at z = 1
+    """
     M = _finite(name, M, error)
     _require_symmetric(name, M, RELATIVE_ROUNDOFF * _size(M), error)
     try:
         np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
-        found = float(np.min(np.linalg.eigvalsh(M)))
+        stack = np.linalg.eigvalsh(M.reshape((-1, *M.shape[-2:])))[:, 0]
+        worst = int(np.argmin(stack))
+        where = "" if points is None else f" at z = {float(np.ravel(points)[worst]):.6g}"
         raise error(
-            f"{name} must be symmetric positive definite; found smallest eigenvalue {found:.3g}"
+            f"{name} must be symmetric positive definite; found smallest eigenvalue "
+            f"{float(stack[worst]):.3g}{where}"
         ) from None
 
 

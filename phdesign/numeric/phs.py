@@ -57,6 +57,14 @@ class DiscretePHS:
         ``project(x0) -> ê`` for a vectorized initial state ``x0(z) -> (m, n)``.
     displacement_basis : callable or None
         ``displacement_basis(z) -> (m, dim)``: w(z) = displacement_basis(z) @ ê.
+
+    Raises
+    ------
+    NumericError
+        If a shape does not fit, or an invariant fails beyond round-off
+        (:mod:`phdesign.numeric.invariants`): E not symmetric positive definite, J or D
+        not skew, R not symmetric positive semidefinite.  The message names the matrix
+        and gives what was found.
     """
 
     model: NumericModel
