@@ -60,6 +60,10 @@ class OutputFileError(PhdesignError, ValueError):
     """An output path is not writable or would overwrite a file without --force."""
 
 
+class SweepError(PhdesignError, ValueError):
+    """A sweep's grid, store or scheduler is invalid or unreachable."""
+
+
 def check_shape(name: str, matrix: Any, expected: tuple[int, ...]) -> None:
     """Raise :class:`ShapeError` unless ``matrix.shape == expected``.
 
