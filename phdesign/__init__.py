@@ -24,3 +24,13 @@ __all__ = [
     "write_model",
 ]
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str) -> object:
+    # PEP 562: ``phdesign.sweep(...)`` imports the sweep package (dask, xarray and zarr only
+    # when a sweep runs) on first use, so that ``import phdesign`` stays light
+    if name == "sweep":
+        import importlib
+
+        return importlib.import_module("phdesign.sweep")
+    raise AttributeError(f"module 'phdesign' has no attribute {name!r}")
