@@ -24,6 +24,7 @@ COMMAND_MODULES = (
     "phdesign.cli.model_commands",
     "phdesign.cli.classify_command",
     "phdesign.cli.numeric_commands",
+    "phdesign.cli.sweep_command",
 )
 
 
