@@ -29,7 +29,7 @@ from phdesign.errors import PhdesignError, SweepError
 from phdesign.sweep.dataset import RUN_ATTRIBUTE, template
 from phdesign.sweep.description import SweepDescription
 from phdesign.sweep.export import output_format, write_export
-from phdesign.sweep.plan import ChunkPlan
+from phdesign.sweep.plan import ChunkPlan, check_chunk_size
 
 __all__ = ["default_chunk_size", "run", "run_chunk"]
 
@@ -140,6 +140,8 @@ def run(
     from phdesign.sweep.schedulers import executor
     from phdesign.sweep.store import ZarrStore
 
+    if chunk_size is not None:
+        check_chunk_size(chunk_size)
     kind = None if output is None else output_format(output)
     if kind != "zarr" and resume:
         raise SweepError(
@@ -161,7 +163,8 @@ def run(
     if action in ("resume", "complete") and store is not None:
         plan = store.plan()
     else:
-        plan = ChunkPlan.for_grid(description.shape, chunk_size or default_chunk_size(description))
+        size = default_chunk_size(description) if chunk_size is None else chunk_size
+        plan = ChunkPlan.for_grid(description.shape, size)
     record: dict[str, Any] = {
         "chunks": plan.n_chunks,
         "chunk_shape": list(plan.chunk_shape),

@@ -25,7 +25,20 @@ from dataclasses import dataclass
 
 from phdesign.errors import SweepError
 
-__all__ = ["ChunkPlan"]
+__all__ = ["ChunkPlan", "check_chunk_size"]
+
+
+def check_chunk_size(chunk_size: object) -> int:
+    """Return ``chunk_size`` if it is a positive integer.
+
+    Raises
+    ------
+    SweepError
+        Anything else.
+    """
+    if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
+        raise SweepError(f"chunk size must be a positive integer; found {chunk_size!r}")
+    return chunk_size
 
 
 @dataclass(frozen=True)
@@ -58,9 +71,7 @@ class ChunkPlan:
         SweepError
             ``chunk_size`` is not a positive integer.
         """
-        if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
-            raise SweepError(f"chunk size must be a positive integer; found {chunk_size!r}")
-        budget = chunk_size
+        budget = check_chunk_size(chunk_size)
         chunk: list[int] = []
         for n in reversed(shape):
             extent = max(1, min(n, budget))

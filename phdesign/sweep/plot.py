@@ -99,7 +99,7 @@ def _unconverged(dataset: Any, figure: str) -> Any:
 
 
 def _draw_map(fig: Figure, ax: Axes, data: Any, flags: Any, dims: list[str], dataset: Any) -> None:
-    y, x = dims
+    x, y = dims  # the first axis across, as in a gain map over (l1, l2)
     values = data.transpose(y, x).values
     xs, ys = dataset[x].values, dataset[y].values
     if values.dtype.kind in "US":

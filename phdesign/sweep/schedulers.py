@@ -35,7 +35,7 @@ from phdesign.errors import SweepError
 
 __all__ = ["CONNECT_TIMEOUT", "WORKER_TIMEOUT", "Executor", "executor", "usable_cores"]
 
-CONNECT_TIMEOUT = 5.0  # seconds to reach a scheduler; the issue asks for an error within 10 s
+CONNECT_TIMEOUT = 4.0  # seconds to reach a scheduler: an error within 10 s, imports included
 WORKER_TIMEOUT = 30.0  # seconds for a reachable cluster to offer a worker
 
 
@@ -103,8 +103,38 @@ def _check_reachable(address: str) -> None:
         ) from None
 
 
+def _check_speaks_dask(address: str) -> None:
+    """Open one Dask connection (with its handshake) within :data:`CONNECT_TIMEOUT`.
+
+    A port that accepts connections and never answers would hold the client forever:
+    Dask's own timeout covers the TCP connection, not the handshake.  The probe runs in a
+    thread of its own, so that it works inside a running event loop (Jupyter) too.
+    """
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect
+
+    async def probe() -> None:
+        comm = await asyncio.wait_for(connect(address), CONNECT_TIMEOUT)
+        await comm.close()
+
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        try:
+            pool.submit(asyncio.run, probe()).result()
+        except (OSError, TimeoutError) as error:
+            reason = str(error) or f"no answer within {CONNECT_TIMEOUT:g} s"
+            raise SweepError(f"cannot reach the Dask scheduler at {address}: {reason}") from None
+        except Exception as error:  # whatever a service that is not Dask sends back
+            raise SweepError(
+                f"cannot reach the Dask scheduler at {address}: the service there does not "
+                f"answer as a Dask scheduler ({type(error).__name__})"
+            ) from None
+
+
 def _connect(address: str) -> Any:
     _check_reachable(address)
+    _check_speaks_dask(address)
     from dask.distributed import Client
 
     try:
@@ -182,7 +212,7 @@ def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Exec
         n_workers=n_workers,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        dashboard_address=":0",  # any free port: never a clash with another cluster's 8787
         silence_logs=logging.ERROR,
     )
     client = Client(cluster)
