@@ -166,6 +166,39 @@ def _validate(scheduler: Any, workers: int | None) -> None:
     )
 
 
+_GUARD = (
+    "a script that runs a sweep on a local cluster must call it under "
+    "'if __name__ == \"__main__\":' (the worker processes import the script again), or "
+    "pass scheduler='synchronous'"
+)
+
+
+def _local_cluster(n_workers: int) -> Any:
+    """Start a LocalCluster of single-threaded worker processes (spawned, as Dask does)."""
+    import logging
+    import multiprocessing
+    import sys
+
+    if getattr(multiprocessing.current_process(), "_inheriting", False):
+        # a worker process importing the user's script again reached its unguarded sweep
+        raise SweepError(_GUARD)
+    from dask.distributed import LocalCluster
+
+    try:
+        return LocalCluster(
+            n_workers=n_workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",  # any free port: never a clash with another 8787
+            silence_logs=logging.ERROR,
+        )
+    except RuntimeError as error:
+        main = sys.modules.get("__main__")
+        if getattr(main, "__file__", None) and getattr(main, "__spec__", None) is None:
+            raise SweepError(f"the local cluster's workers did not start: {_GUARD}") from error
+        raise
+
+
 @contextmanager
 def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Executor]:
     """Open the executor named by ``scheduler`` (see the module docstring).
@@ -203,18 +236,10 @@ def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Exec
         finally:
             client.close()
         return
-    import logging
+    cluster = _local_cluster(workers or usable_cores())
+    from dask.distributed import Client
 
-    from dask.distributed import Client, LocalCluster
-
-    n_workers = workers or usable_cores()
-    cluster = LocalCluster(
-        n_workers=n_workers,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",  # any free port: never a clash with another cluster's 8787
-        silence_logs=logging.ERROR,
-    )
+    n_workers = len(cluster.workers)
     client = Client(cluster)
     try:
         yield Executor("LocalCluster", n_workers, client)
