@@ -195,12 +195,26 @@ def test_classify_sweep_gives_the_damper_certificate():
     np.testing.assert_allclose(ds.kappa.values, k / (1 + k**2), rtol=1e-15)
 
 
-def test_sensor_set_axis_classifies_the_beam_s_single_sensors():
+def test_sensor_set_axis_classifies_the_beam_s_single_sensors(tmp_path):
     ds = phdesign.sweep("euler-bernoulli", job="classify", sensor_sets="3,4;4;3", **SYNC)
     assert ds.sensors.values.tolist() == ["3,4", "4", "3"]
     assert ds.verdict.values.tolist() == ["exponential", "exponential", "inconclusive"]
     assert ds.best.values[2] == ""
     assert np.isnan(ds.kappa.values[2])
+    # text figures and text coordinates survive Zarr, NetCDF and CSV
+    for name in ("sets.zarr", "sets.nc"):
+        phdesign.sweep(
+            "euler-bernoulli",
+            job="classify",
+            sensor_sets="3,4;4;3",
+            output=tmp_path / name,
+            chunk_size=1,
+            **SYNC,
+        )
+        same_figures(phdesign.sweep.open_sweep(tmp_path / name), ds)
+    from phdesign.sweep.export import to_csv
+
+    assert to_csv(ds).splitlines()[1] == '"3,4",exponential,0.5,3.4.3'
 
 
 # --------------------------------------------------------------------- storage

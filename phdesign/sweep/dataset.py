@@ -18,7 +18,14 @@ import numpy as np
 from phdesign.sweep.description import SweepDescription
 from phdesign.sweep.plan import ChunkPlan
 
-__all__ = ["RUN_ATTRIBUTE", "SWEEP_ATTRIBUTE", "attributes", "description_of", "template"]
+__all__ = [
+    "RUN_ATTRIBUTE",
+    "SWEEP_ATTRIBUTE",
+    "attributes",
+    "description_of",
+    "normalized",
+    "template",
+]
 
 SWEEP_ATTRIBUTE = "phdesign_sweep"
 RUN_ATTRIBUTE = "phdesign_run"
@@ -109,3 +116,23 @@ def template(
             attrs["units"] = figure.units
         data_vars[figure.name] = xr.Variable(description.dims, values, attrs)
     return xr.Dataset(data_vars, coords=coords, attrs=attributes(description))
+
+
+def normalized(dataset: Any) -> Any:
+    """Return a stored sweep as :func:`template` lays it out: figure order and dtypes.
+
+    Zarr lists arrays by name and NetCDF gives text back as Python objects; this puts the
+    figures back in the job's order, and text figures and coordinates back to fixed-width
+    strings, so that a sweep read from a file equals the one computed.
+    """
+    description = description_of(dataset)
+    figures = description.job_spec.figures
+    out = dataset[[f.name for f in figures]]
+    for f in figures:
+        if out[f.name].dtype != np.dtype(f.dtype):
+            out[f.name] = out[f.name].astype(f.dtype)
+    for axis in description.axes:
+        _, values, _ = _coordinate(axis)
+        if out[axis.name].dtype != values.dtype:
+            out = out.assign_coords({axis.name: out[axis.name].astype(values.dtype)})
+    return out

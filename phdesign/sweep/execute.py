@@ -195,11 +195,11 @@ def run(
             group = store.writer()
         else:
             arrays = template(description)
-        todo = [(text, plan.chunk_shape, i) for i in range(plan.n_chunks) if i not in done]
+        todo = [(plan.chunk_shape, i) for i in range(plan.n_chunks) if i not in done]
         record["reused"] = len(done)
         record["scheduler"] = ex.describe()
         with _progress(plan.n_chunks, len(done), progress) as bar:
-            for result in ex.map_unordered(run_chunk, todo):
+            for result in ex.map_unordered(run_chunk, text, todo):
                 region = plan.region(result["index"])
                 if store is not None:
                     store.write_chunk(group, result["index"], region, result["arrays"])

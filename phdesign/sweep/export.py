@@ -100,7 +100,7 @@ def open_sweep(path: str | Path) -> Any:
     SweepError
         A Zarr store that is not a complete phdesign sweep.
     """
-    from phdesign.sweep.dataset import description_of
+    from phdesign.sweep.dataset import normalized
 
     target = Path(path)
     if not target.exists():
@@ -128,5 +128,4 @@ def open_sweep(path: str | Path) -> Any:
             raise SweepError(f"cannot read {str(target)!r} as NetCDF: {error}") from None
     else:
         raise SweepError(f"cannot read a sweep back from {str(target)!r}: plots read .zarr or .nc")
-    description_of(dataset)  # refuses a file that is not a phdesign sweep
-    return dataset
+    return normalized(dataset)  # refuses a file that is not a phdesign sweep

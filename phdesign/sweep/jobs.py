@@ -220,7 +220,7 @@ JOBS: dict[str, Job] = {
         ),
         prepare="phdesign.sweep.spectrum_job:prepare",
         needs_sensors=False,
-        points_per_chunk=48,
+        points_per_chunk=32,
         settings_per_chunk=4,
     ),
     "classify": Job(

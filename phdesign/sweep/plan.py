@@ -1,12 +1,12 @@
 """How the points of a sweep are cut into chunks: the unit of work and of storage.
 
 A chunk is a block of the grid (one slice per axis), at most ``chunk_size`` points,
-filled from the last axis outwards: a gain map's chunk is a run of rows of gains at one
-model and sensor set.  Chunks are numbered in C order over the grid of blocks.  The
-layout depends on the grid and the chunk size only (never on the scheduler or the
-number of workers), and each point's figures depend on the point only, so a sweep's
-results are the same however its chunks are scheduled, and a stored sweep can be resumed
-chunk by chunk.
+filled from the last axis outwards, with blocks of even size along each axis: a gain
+map's chunk is a run of rows of gains at one model and sensor set.  Chunks are numbered
+in C order over the grid of blocks.  The layout depends on the grid and the chunk size
+only (never on the scheduler or the number of workers), and each point's figures depend
+on the point only, so a sweep's results are the same however its chunks are scheduled,
+and a stored sweep can be resumed chunk by chunk.
 
 Examples
 --------
@@ -15,6 +15,8 @@ Examples
 ((1, 2, 20), 30)
 >>> plan.region(1)
 (slice(0, 1, None), slice(2, 4, None), slice(0, 20, None))
+>>> ChunkPlan.for_grid((36, 36), 32).chunk_shape
+(1, 18)
 """
 
 from __future__ import annotations
@@ -74,7 +76,9 @@ class ChunkPlan:
         budget = check_chunk_size(chunk_size)
         chunk: list[int] = []
         for n in reversed(shape):
-            extent = max(1, min(n, budget))
+            # as many blocks as the budget needs along this axis, then blocks of even size
+            # (36 points in budgets of 32: two blocks of 18, not 32 and a straggler of 4)
+            extent = math.ceil(n / math.ceil(n / budget)) if n else 1
             chunk.append(extent)
             budget = max(1, budget // extent)
         return cls(tuple(shape), tuple(reversed(chunk)))

@@ -15,9 +15,9 @@ Examples
 --------
 >>> import numpy as np, xarray as xr
 >>> ds = xr.Dataset(
-...     {"spectral_abscissa": (("l2", "l1"), -np.ones((2, 3))),
-...      "converged": (("l2", "l1"), np.array([[True, True, False], [True, True, True]]))},
-...     coords={"l2": [0.1, 1.0], "l1": [0.1, 0.2, 0.3]},
+...     {"spectral_abscissa": (("l1", "l2"), -np.ones((3, 2))),
+...      "converged": (("l1", "l2"), np.array([[True, True], [True, False], [True, True]]))},
+...     coords={"l1": [0.1, 0.2, 0.3], "l2": [0.1, 1.0]},
 ... )
 >>> fig = plot_sweep(ds)
 >>> fig.axes[0].get_xlabel(), fig.axes[0].get_legend().get_texts()[0].get_text()

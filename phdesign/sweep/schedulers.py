@@ -64,22 +64,28 @@ class Executor:
     client: Any = None
 
     def map_unordered(
-        self, function: Callable[..., Any], tasks: Sequence[tuple[Any, ...]]
+        self, function: Callable[..., Any], shared: Any, tasks: Sequence[tuple[Any, ...]]
     ) -> Iterator[Any]:
-        """Yield ``function(*task)`` for every task, in the order they complete."""
+        """Yield ``function(shared, *task)`` for every task, in the order they complete.
+
+        ``shared`` (the sweep's description) is sent to each worker once, not with every
+        task.
+        """
         if self.client is None:
             for task in tasks:
-                yield function(*task)
+                yield function(shared, *task)
             return
         from dask.distributed import as_completed
 
-        futures = [self.client.submit(function, *task, pure=False) for task in tasks]
+        common = self.client.scatter(shared, broadcast=True, hash=False)
+        futures = [self.client.submit(function, common, *task, pure=False) for task in tasks]
         try:
             for future in as_completed(futures):
                 yield future.result()
         finally:
             for future in futures:
                 future.cancel()
+            common.release()
 
     def describe(self) -> str:
         """One line: where the chunks ran."""
@@ -156,6 +162,11 @@ def _validate(scheduler: Any, workers: int | None) -> None:
         isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
     ):
         raise SweepError(f"workers must be a positive integer; found {workers!r}")
+    if workers is not None and scheduler not in (None, "local"):
+        raise SweepError(
+            "workers sizes the local cluster a sweep starts; it does not apply to "
+            f"scheduler {scheduler!r}"
+        )
     if scheduler is None or not isinstance(scheduler, str):
         return
     if scheduler in ("synchronous", "local") or "://" in scheduler:
@@ -230,6 +241,11 @@ def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Exec
     if scheduler is None:
         address = os.environ.get("DASK_SCHEDULER_ADDRESS") or None
     if address is not None:
+        if workers is not None:
+            raise SweepError(
+                f"workers sizes a local cluster; the scheduler at {address} has its own "
+                "(drop workers, or pass scheduler='local')"
+            )
         client = _connect(address)
         try:
             yield Executor(address, len(client.scheduler_info().get("workers", {})), client)

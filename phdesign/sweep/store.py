@@ -181,9 +181,6 @@ class ZarrStore:
         """Open the stored sweep as an :class:`xarray.Dataset` (read lazily, no dask)."""
         import xarray as xr
 
-        from phdesign.sweep.dataset import description_of
+        from phdesign.sweep.dataset import normalized
 
-        dataset = xr.open_zarr(self.path, chunks=None, consolidated=True, zarr_format=2)
-        # Zarr lists arrays by name: give the figures back in the job's order
-        figures = [f.name for f in description_of(dataset).job_spec.figures]
-        return dataset[figures]
+        return normalized(xr.open_zarr(self.path, chunks=None, consolidated=True, zarr_format=2))
