@@ -94,8 +94,8 @@ class ExternalCluster:
                 process.terminate()
             for process in group:
                 try:
-                    process.wait(timeout=10)
-                except subprocess.TimeoutExpired:
+                    process.wait(timeout=3)
+                except subprocess.TimeoutExpired:  # a slow goodbye under load: not a failure
                     process.kill()
                     process.wait()
         for log in self.logs:
