@@ -274,8 +274,13 @@ COMMAND_ROWS = [
     row(f"{MAP} --job classify --tol 1e-3 -o {{tmp}}/m.zarr", "has no option 'tol'", SweepError),
     row(f"{MAP} --tol -1 -o {{tmp}}/m.zarr", "option tol: expected a positive number", SweepError),
     row(f"{MAP} --job nosuch -o {{tmp}}/m.zarr", "argument --job: invalid choice: 'nosuch'", None),
-    row(f"{MAP} --gain 1,2 -o {{tmp}}/m.zarr", "expected 1 diagonal values", SweepError),
-    row(f"{MAP} --gain 0 -o {{tmp}}/m.zarr", "entries must be finite and positive", SweepError),
+    row(
+        "sweep euler-bernoulli --sensors 3,4 --grid l1=0.1:1:3 --gain 1,2,3 -o {tmp}/m.zarr",
+        "expected 2 diagonal values (one per sensor) or a single one; found 3",
+        ObserverError,
+    ),
+    row(f"{MAP} --gain 0 -o {{tmp}}/m.zarr", "entry 1 must be a finite positive", ObserverError),
+    row(f"{MAP} --gain nan -o {{tmp}}/m.zarr", "entry 1 must be a finite positive", ObserverError),
     row(
         "sweep wave --sensor-sets 1;3 --grid l=1:2:3 -o {tmp}/m.zarr",
         "output index 3 is out of range; expected 1..2",

@@ -232,26 +232,26 @@ def _axes_difference(mine: tuple[Axis, ...], theirs: tuple[Axis, ...]) -> str:
     return "the axes differ"
 
 
-def _fixed_gain(gain: str | Sequence[float] | float | None, what: str) -> tuple[float, ...] | None:
-    if gain is None:
-        return None
+def _fixed_gain(
+    gain: str | Sequence[float] | float, count: int, meaning: str
+) -> tuple[float, ...]:
+    """Read fixed diagonal entries of L (``count`` of them, or one for all) exactly."""
+    from phdesign.errors import ObserverError
+    from phdesign.symbolic.observer import diagonal_values
+
     if isinstance(gain, str):
-        parts = [p.strip() for p in gain.split(",")]
-        values = []
-        for p in parts:
-            try:
-                values.append(float(p))
-            except ValueError:
-                raise SweepError(
-                    f"{what}: expected positive diagonal entries such as 0.1,1; found {gain!r}"
-                ) from None
+        entries: list[object] = [p.strip() for p in gain.split(",")]
     elif isinstance(gain, int | float):
-        values = [float(gain)]
+        entries = [gain]
     else:
-        values = [float(g) for g in gain]
-    if not values or any(not (v > 0 and v < float("inf")) for v in values):
-        raise SweepError(f"{what}: entries must be finite and positive; found {gain!r}")
-    return tuple(values)
+        entries = list(gain)
+    values = tuple(float(v) for v in diagonal_values(entries, count, meaning))
+    for i, v in enumerate(values):
+        if not v > 0:
+            raise ObserverError(
+                f"--gain: entry {i + 1} must be a finite positive number (L + Lᵀ ≻ 0); found {v!r}"
+            )
+    return values
 
 
 def describe(
@@ -319,20 +319,20 @@ def describe(
         sizes = [len(sensor_set_indices(v)) for v in set_axis.values]
     else:
         sizes = []
-    fixed_gain = _fixed_gain(gain, "gain")
-    if fixed_gain is not None:
+    fixed_gain = None
+    if gain is not None:
         if not has_sensors:
             raise SweepError("a gain needs sensors: give sensors or sensor_sets")
-        if set_axis is not None and len(fixed_gain) != 1:
-            raise SweepError(
-                "with sensor sets the fixed gain is one value for every sensor; "
-                f"found {len(fixed_gain)} values"
-            )
-        if fixed_sensors is not None and len(fixed_gain) not in (1, len(fixed_sensors)):
-            raise SweepError(
-                f"gain: expected {len(fixed_sensors)} diagonal values (one per sensor) or a "
-                f"single one; found {len(fixed_gain)}"
-            )
+        if set_axis is not None:
+            if isinstance(gain, str) and "," in gain:
+                raise SweepError(
+                    "with sensor sets the fixed gain is one value for every sensor; "
+                    f"found {gain!r}"
+                )
+            fixed_gain = _fixed_gain(gain, 1, "one for every sensor of every set")
+        else:
+            assert fixed_sensors is not None  # has_sensors without a set axis
+            fixed_gain = _fixed_gain(gain, len(fixed_sensors), "one per sensor")
 
     gain_axes = [parse_axis(name, text, "gain") for name, text in (grid or {}).items()]
     if gain_axes and not has_sensors:

@@ -98,6 +98,13 @@ def _unconverged(dataset: Any, figure: str) -> Any:
     return dataset["converged"]
 
 
+def _mark_unconverged(ax: Axes, x: np.ndarray, y: np.ndarray) -> None:
+    """Red crosses on the points whose spectrum did not converge, counted in the legend."""
+    count = len(x)
+    label = f"not converged ({count} point{'s' if count > 1 else ''})"
+    ax.plot(x, y, ls="none", marker="x", color="red", ms=6, label=label)
+
+
 def _draw_map(fig: Figure, ax: Axes, data: Any, flags: Any, dims: list[str], dataset: Any) -> None:
     x, y = dims  # the first axis across, as in a gain map over (l1, l2)
     values = data.transpose(y, x).values
@@ -140,16 +147,7 @@ def _draw_map(fig: Figure, ax: Axes, data: Any, flags: Any, dims: list[str], dat
         bad = ~flags.transpose(y, x).values.astype(bool)
         if bad.any():
             jj, ii = np.nonzero(bad)
-            count = int(bad.sum())
-            ax.plot(
-                xs[ii],
-                ys[jj],
-                ls="none",
-                marker="x",
-                color="red",
-                ms=5,
-                label=f"not converged ({count} point{'s' if count > 1 else ''})",
-            )
+            _mark_unconverged(ax, xs[ii], ys[jj])
             ax.legend(loc="lower left", fontsize="small")
     ax.set(xlabel=_label(dataset, x), ylabel=_label(dataset, y))
     if _is_log(dataset, x):
@@ -179,16 +177,7 @@ def _draw_curves(ax: Axes, data: Any, flags: Any, dims: list[str], dataset: Any)
         if flag is not None:
             bad = ~flag.values.astype(bool)
             if bad.any():
-                count = int(bad.sum())
-                ax.plot(
-                    xs[bad],
-                    values[bad],
-                    ls="none",
-                    marker="x",
-                    color="red",
-                    ms=7,
-                    label=f"not converged ({count} point{'s' if count > 1 else ''})",
-                )
+                _mark_unconverged(ax, xs[bad], values[bad])
     if _is_log(dataset, x):
         ax.set_xscale("log")
     ax.set(xlabel=_label(dataset, x), ylabel=_label(dataset, data.name))
