@@ -263,7 +263,9 @@ COMMAND_ROWS = [
     row(
         f"{SWEEP} --param rho=2 --param-grid rho=1:2:3", "by --param and --param-grid", SweepError
     ),
-    row(f"{SWEEP} --grid T=1:2:3", "expected l1, l2", SweepError),
+    row(f"{SWEEP} --grid T=1:2:3", "T is a model parameter, not a gain", SweepError),
+    row("sweep wave --sensors 2,x --grid l1=1:2:3 -o {tmp}/m.zarr", "found 'x'", ObserverError),
+    row("sweep wave --sensors 3 --grid l1=1:2:3 -o {tmp}/m.zarr", "expected 1..2", ObserverError),
     row(f"{SWEEP}", "a sweep needs at least one axis", SweepError),
     row("sweep wave --grid l1=0.1:1:3 -o {tmp}/m.zarr", "gain axes need sensors", SweepError),
     row(

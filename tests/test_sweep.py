@@ -117,6 +117,10 @@ def test_description_refuses_what_the_model_lacks():
         describe(wave, param_grid={"rho": "-1:1:3"})
     with pytest.raises(SweepError, match="needs at least one axis"):
         describe(wave, sensors=[2])
+    with pytest.raises(phdesign.PhdesignError, match="expected integer output indices"):
+        describe(wave, sensors=[1.5], grid={"l1": "1:2:3"})
+    assert describe(wave, sensors="2", grid={"l1": "1:2:3"}).sensors == (2,)
+    assert describe(wave, sensors=np.array([2]), grid={"l1": "1:2:3"}).sensors == (2,)
     with pytest.raises(SweepError, match="job classify needs sensors"):
         describe(wave, job="classify", param_grid={"rho": "1:2:3"})
     with pytest.raises(SweepError, match="job classify has no option 'tol'"):

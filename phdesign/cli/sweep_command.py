@@ -145,13 +145,6 @@ def _named(items: list[str], flag: str, example: str = "l1=0.01:3:40:log") -> di
     return named
 
 
-def _sensor_indices(text: str, n_outputs: int) -> list[int]:
-    from phdesign.symbolic.observer import parse_sensors
-
-    C_m = parse_sensors(text, n_outputs)  # validates: integers, range, repetition
-    return [next(c + 1 for c in range(C_m.cols) if C_m[r, c] != 0) for r in range(C_m.rows)]
-
-
 def _sweep(args: argparse.Namespace) -> int:
     from phdesign.cli.common import parse_parameter_overrides
     from phdesign.sweep import describe, summarize
@@ -164,9 +157,6 @@ def _sweep(args: argparse.Namespace) -> int:
     if both:
         raise SweepError(f"parameter {both[0]} is given by --param and --param-grid; give it once")
     model = load_model(args)
-    sensors = None
-    if args.sensors is not None:
-        sensors = _sensor_indices(args.sensors, model.order * model.size)
     options = {
         name: getattr(args, f"option_{name}")
         for name in _job_options()
@@ -175,7 +165,7 @@ def _sweep(args: argparse.Namespace) -> int:
     description = describe(
         model,
         job=args.job,
-        sensors=sensors,
+        sensors=args.sensors,
         sensor_sets=args.sensor_sets,
         gain=args.gain,
         grid=grid,

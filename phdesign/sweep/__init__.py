@@ -67,7 +67,7 @@ def sweep(
     model: Any,
     *,
     job: str = "spectrum",
-    sensors: Sequence[int] | None = None,
+    sensors: str | Sequence[int] | None = None,
     sensor_sets: str | Sequence[Sequence[int]] | None = None,
     gain: str | float | Sequence[float] | None = None,
     grid: Mapping[str, str | Sequence[float]] | None = None,
@@ -93,8 +93,8 @@ def sweep(
         ``unbounded_below``, ``ill_conditioned`` of the error system
         :math:`\tilde u = -C_m^\top L C_m \tilde y` (of the plant, u = 0, without
         sensors); ``classify``: ``verdict``, ``kappa`` (κ* of the best variant), ``best``.
-    sensors : sequence of int, optional
-        Measured outputs (1-based), the same at every point.
+    sensors : str or sequence of int, optional
+        Measured outputs (1-based), the same at every point: ``[3, 4]`` or ``"3,4"``.
     sensor_sets : str or sequence, optional
         An axis of sensor sets: ``"3,4;4;2"``, ``"all"`` or ``[(3, 4), (4,)]``.
     gain : str, float or sequence of float, optional

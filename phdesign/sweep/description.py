@@ -232,6 +232,28 @@ def _axes_difference(mine: tuple[Axis, ...], theirs: tuple[Axis, ...]) -> str:
     return "the axes differ"
 
 
+def _sensor_indices(sensors: str | Sequence[int], n_outputs: int) -> tuple[int, ...]:
+    """Read ``"3,4"`` or ``[3, 4]`` as 1-based output indices, checked against the model."""
+    import operator
+
+    from phdesign.errors import ObserverError
+    from phdesign.symbolic.observer import parse_sensors, sensor_matrix
+
+    if isinstance(sensors, str):
+        C_m = parse_sensors(sensors, n_outputs)  # integers, range and repetition
+        return tuple(
+            next(c + 1 for c in range(C_m.cols) if C_m[r, c] != 0) for r in range(C_m.rows)
+        )
+    try:
+        indices = tuple(operator.index(i) for i in sensors)
+    except TypeError:
+        raise ObserverError(
+            f"sensors: expected integer output indices such as [3, 4]; found {sensors!r}"
+        ) from None
+    sensor_matrix(indices, n_outputs)  # range and repetition
+    return indices
+
+
 def _fixed_gain(
     gain: str | Sequence[float] | float, count: int, meaning: str
 ) -> tuple[float, ...]:
@@ -258,7 +280,7 @@ def describe(
     model: Any,
     *,
     job: str = "spectrum",
-    sensors: Sequence[int] | None = None,
+    sensors: str | Sequence[int] | None = None,
     sensor_sets: str | Sequence[Sequence[int]] | None = None,
     gain: str | Sequence[float] | float | None = None,
     grid: GridSpec | None = None,
@@ -273,8 +295,8 @@ def describe(
         The model, fixed parameter values already applied (``model.with_parameters``).
     job : str
         ``"spectrum"`` or ``"classify"`` (see :data:`phdesign.sweep.jobs.JOBS`).
-    sensors : sequence of int, optional
-        The measured outputs (1-based), the same at every point.
+    sensors : str or sequence of int, optional
+        The measured outputs (1-based), the same at every point: ``[3, 4]`` or ``"3,4"``.
     sensor_sets : str or sequence of sequences of int, optional
         An axis of sensor sets instead: ``"3,4;4;2"``, ``"all"`` or ``[(3, 4), (4,)]``.
     gain : str, float or sequence of float, optional
@@ -298,7 +320,6 @@ def describe(
     """
     from phdesign import __version__
     from phdesign.io import model_to_toml
-    from phdesign.symbolic.observer import sensor_matrix
 
     spec = get_job(job)
     n_outputs = int(model.order * model.size)
@@ -306,8 +327,7 @@ def describe(
         raise SweepError("give either sensors (one set) or sensor_sets (an axis), not both")
     fixed_sensors = None
     if sensors is not None:
-        fixed_sensors = tuple(int(i) for i in sensors)
-        sensor_matrix(fixed_sensors, n_outputs)  # range and repetition checks
+        fixed_sensors = _sensor_indices(sensors, n_outputs)
     set_axis = None if sensor_sets is None else parse_sensor_sets(sensor_sets, n_outputs)
     has_sensors = fixed_sensors is not None or set_axis is not None
     if spec.needs_sensors and not has_sensors:
@@ -334,6 +354,13 @@ def describe(
             assert fixed_sensors is not None  # has_sensors without a set axis
             fixed_gain = _fixed_gain(gain, len(fixed_sensors), "one per sensor")
 
+    known = tuple(sorted(str(s) for s in model.parameter_names))
+    for name in grid or {}:
+        if name in known:
+            raise SweepError(
+                f"grid {name}: {name} is a model parameter, not a gain; give it as a "
+                f"parameter axis (param_grid, --param-grid {name}=...)"
+            )
     gain_axes = [parse_axis(name, text, "gain") for name, text in (grid or {}).items()]
     if gain_axes and not has_sensors:
         raise SweepError("gain axes need sensors: give sensors or sensor_sets")
@@ -352,7 +379,6 @@ def describe(
                 "(or l for every entry)"
             )
 
-    known = tuple(sorted(str(s) for s in model.parameter_names))
     param_axes = []
     for name, text in (param_grid or {}).items():
         if name not in known:
@@ -369,9 +395,6 @@ def describe(
             except PhdesignError as error:
                 raise type(error)(f"parameter grid {name} = {value!r}: {error}") from None
         param_axes.append(axis)
-    for a in gain_axes:
-        if a.name in known:
-            raise SweepError(f"grid {a.name} names a gain; use param_grid for the parameter")
 
     axes = tuple(([set_axis] if set_axis else []) + param_axes + gain_axes)
     if not axes:
