@@ -16,7 +16,9 @@ invocation, alternating the two so that a change of the machine's load hits both
   chunk compute time (target < 5 %), and the parallel efficiency (chunk compute over
   workers x wall time);
 * the Zarr store's cost per chunk (a synchronous run written to a store, against the same
-  in memory).
+  in memory);
+* the cores the machine gives two workers at that moment (a fixed workload, two copies at
+  once against one alone): on a shared machine, the ceiling of the speed-up.
 
 Both runs must give identical arrays (checked).  BLAS runs one thread per process (the
 chunk function limits it, and the workers are started with one thread).  ``--pair``
@@ -45,6 +47,28 @@ GRID = {"l1": "0.01:3:20:log", "l2": "0.1:10:20:log"}
 
 def _noop(text: str, chunk_shape: tuple[int, ...], index: int) -> dict:
     return {"index": index, "arrays": {}, "seconds": 0.0}
+
+
+def _burn(seconds_hint: float = 0.5) -> float:
+    """A fixed CPU workload (dense eigenvalues, one thread); returns its wall time."""
+    from threadpoolctl import threadpool_limits
+
+    rng = np.random.default_rng(0)
+    A = rng.standard_normal((62, 62))
+    start = time.perf_counter()
+    with threadpool_limits(limits=1):
+        for _ in range(int(200 * seconds_hint)):
+            np.linalg.eigvals(A)
+    return time.perf_counter() - start
+
+
+def capacity(client) -> float:
+    """How many cores the machine gives two workers now: 2 t(one alone) / t(two at once)."""
+    workers = list(client.scheduler_info()["workers"])
+    alone = client.submit(_burn, pure=False, workers=workers[:1]).result()
+    both = [client.submit(_burn, pure=False, workers=[w]) for w in workers[:2]]
+    together = max(f.result() for f in both)
+    return 2 * alone / together
 
 
 def _warm() -> None:
@@ -108,6 +132,7 @@ def main(argv: list[str] | None = None) -> int:
     startup = time.perf_counter() - start
     phdesign.sweep(beam, sensors=[3, 4], grid={"l1": "0.1,1"}, scheduler=client)
 
+    capacity_before = capacity(client)
     sync_wall, dask_wall, sync_compute, dask_compute = [], [], [], []
     chunks = 0
     for _ in range(args.repeat):
@@ -124,6 +149,7 @@ def main(argv: list[str] | None = None) -> int:
             chunks = run["chunks"]
     converged = int(ds_sync.converged.sum())
 
+    capacity_after = capacity(client)
     from phdesign.sweep.schedulers import Executor
 
     executor = Executor("LocalCluster", 2, client)
@@ -156,6 +182,10 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"2 workers:   {d:.2f} s (runs: {', '.join(f'{t:.2f}' for t in dask_wall)}); "
         f"speed-up {s / d:.2f}x (target >= 1.6x: {'met' if s / d >= 1.6 else 'MISSED'})"
+    )
+    print(
+        f"cores free for 2 workers (a fixed load, 2 copies against 1): "
+        f"{capacity_before:.2f} before, {capacity_after:.2f} after: the speed-up's ceiling now"
     )
     print(f"local cluster start-up and warm-up: {startup:.2f} s (not in the 2-worker time)")
     efficiency = statistics.median(dask_compute) / (2 * d)
