@@ -115,7 +115,17 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
 
 
 #: Subpackages and modules reachable as attributes (``phd.plots``), imported on first use.
-_SUBMODULES = ("cli", "design", "errors", "io", "models", "numeric", "plots", "symbolic")
+_SUBMODULES = (
+    "cli",
+    "design",
+    "errors",
+    "io",
+    "models",
+    "numeric",
+    "plots",
+    "sweep",
+    "symbolic",
+)
 
 
 def __getattr__(name: str) -> Any:

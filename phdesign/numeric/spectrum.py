@@ -70,6 +70,7 @@ from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.scales import ProblemScales
 from phdesign.numeric.spectrum_refinement import (
     ILL_CONDITION,
+    Discretizations,
     PairResult,
     choose_pair,
     extinct_twice,
@@ -290,6 +291,7 @@ def spectrum(
     rtol_resolved: float | None = None,
     count: int = 6,
     basis: str | None = None,
+    discretizations: Discretizations | None = None,
 ) -> SpectrumReport:
     """Converged spectral abscissa and rightmost eigenvalues (module docstring).
 
@@ -315,6 +317,10 @@ def spectrum(
         The Galerkin basis (default: the defaults table's for the model's order,
         :mod:`phdesign.numeric.defaults`); the plain Legendre basis lowers the largest
         resolution for N >= 3, where its round-off grows with the degree.
+    discretizations : Discretizations, optional
+        The model's discretizations by ``method`` and ``basis``, shared by many calls at
+        different gains (:class:`~phdesign.numeric.spectrum_refinement.Discretizations`):
+        the report is the same, without discretizing again.
 
     Returns
     -------
@@ -353,6 +359,7 @@ def spectrum(
             tol=tol,
             rtol_resolved=rtol_resolved,
             basis=basis,
+            discretizations=discretizations,
         )
     sensors = None if C_m is None else np.atleast_2d(np.asarray(C_m, float)).tolist()
     gain = None if L is None else np.atleast_2d(np.asarray(L, float)).tolist()

@@ -19,17 +19,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from phdesign.errors import NumericError
 from phdesign.numeric.abscissa import MIN_MODES_ABOVE, Abscissa, estimate_abscissa
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.drift import PairSpectrum, pair_spectrum
-from phdesign.numeric.eigen import prepare, rescaled
+from phdesign.numeric.eigen import PreparedSystem, prepare, rescaled
 from phdesign.numeric.evaluator import fine_resolution
 from phdesign.numeric.scales import ProblemScales, dimensionless_model
 from phdesign.numeric.spectrum_report import RefinementStep
 
 __all__ = [
     "ILL_CONDITION",
+    "Discretizations",
     "PairResult",
     "choose_pair",
     "convergence_rule",
@@ -111,22 +113,49 @@ def convergence_rule(pair: PairSpectrum, a: Abscissa, tol: float) -> str:
     return ""
 
 
+class Discretizations:
+    """The dimensionless model's discretizations, once per resolution, for any gain.
+
+    They do not depend on the gain, so a gain map shares one (the sweep's ``spectrum`` job
+    gives one to :func:`phdesign.numeric.spectrum.spectrum` for every gain of a chunk);
+    :func:`refine` makes its own when given none.
+
+    Parameters
+    ----------
+    nm : NumericModel
+    method : {"galerkin", "fd"}
+    basis : {"scaled", "legendre"}, optional
+        The Galerkin basis (default: the defaults table's, for the order).
+    """
+
+    def __init__(self, nm: NumericModel, method: str, basis: str | None = None) -> None:
+        self.model, self.method, self.basis = nm, method, basis
+        self.dimensionless, self.scales = dimensionless_model(nm)
+        self._cache: dict[int, PreparedSystem] = {}
+
+    def serves(self, nm: NumericModel, method: str, basis: str | None) -> bool:
+        """Tell whether these discretizations are those of ``nm`` by ``method`` and ``basis``."""
+        return self.model is nm and self.method == method and self.basis == basis
+
+    def __call__(self, p: int) -> PreparedSystem:
+        """Return the discretization at resolution ``p``, prepared for QZ (cached)."""
+        if p not in self._cache:
+            # QZ, not the whitened Hessenberg QR: a report keeps every digit it can
+            discrete = discretize(self.dimensionless, self.method, p, basis=self.basis)
+            self._cache[p] = prepare(discrete, whitened=False)
+        return self._cache[p]
+
+
 class _Resolutions:
     """Eigenvalues (with condition numbers) of the closed loop, once per resolution."""
 
-    def __init__(
-        self, nm: NumericModel, method: str, K: np.ndarray | None, basis: str | None = None
-    ) -> None:
-        self.dimensionless, self.scales = dimensionless_model(nm)
-        self.method, self.K, self.basis = method, K, basis
+    def __init__(self, discretizations: Discretizations, K: np.ndarray | None) -> None:
+        self.discretizations, self.scales, self.K = discretizations, discretizations.scales, K
         self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     def solve(self, p: int) -> tuple[np.ndarray, np.ndarray]:
         if p not in self._cache:
-            # QZ, not the whitened Hessenberg QR: a report keeps every digit it can
-            discrete = discretize(self.dimensionless, self.method, p, basis=self.basis)
-            system = prepare(discrete, whitened=False)
-            lam, kappa = system.eigen_condition(self.K)
+            lam, kappa = self.discretizations(p).eigen_condition(self.K)
             self._cache[p] = (rescaled(lam, self.scales.rate), kappa)
         return self._cache[p]
 
@@ -141,12 +170,22 @@ def refine(
     tol: float,
     rtol_resolved: float,
     basis: str | None = None,
+    discretizations: Discretizations | None = None,
 ) -> tuple[list[PairResult], ProblemScales]:
     """Stage 1: pairs (p, ⌈1.5 p⌉) from ``start`` until one converges or p_fine >= ``stop``.
 
-    ``basis`` is the Galerkin basis (default: the defaults table's, for the order).
+    ``basis`` is the Galerkin basis (default: the defaults table's, for the order);
+    ``discretizations`` those of ``nm`` by ``method`` and ``basis`` already made (a gain map).
     """
-    solver = _Resolutions(nm, method, K, basis)
+    if discretizations is None:
+        discretizations = Discretizations(nm, method, basis)
+    elif not discretizations.serves(nm, method, basis):
+        raise NumericError(
+            "discretizations: expected those of this model, method and basis; found "
+            f"{discretizations.model.name!r} by {discretizations.method!r} "
+            f"(basis {discretizations.basis!r})"
+        )
+    solver = _Resolutions(discretizations, K)
     trail: list[PairResult] = []
     p = int(start)
     while True:

@@ -62,6 +62,7 @@ Matrix([
 from __future__ import annotations
 
 import operator
+import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
@@ -79,10 +80,12 @@ from phdesign.symbolic.model import BCPHS
 __all__ = [
     "ErrorSystem",
     "ObserverDesign",
+    "diagonal_values",
     "error_system",
     "gain_matrix",
     "gain_symbols",
     "measurement_matrix",
+    "parse_sensor_indices",
     "port_inverse",
     "port_matrices",
     "sensor_matrix",
@@ -142,6 +145,27 @@ def sensor_matrix(sensors: Iterable[int] | int, n_outputs: int) -> sympy.Immutab
     return sympy.ImmutableMatrix(
         len(picked), n_outputs, lambda r, c: 1 if c == picked[r] - 1 else 0
     )
+
+
+def parse_sensor_indices(text: str, name: str = "sensors") -> list[int]:
+    """Read ``"3,4"`` into ``[3, 4]`` (range and repetition are checked by :func:`sensor_matrix`).
+
+    ``name`` is the argument or option named in the message.
+
+    Examples
+    --------
+    >>> parse_sensor_indices(" 3, 4")
+    [3, 4]
+    """
+    indices = []
+    for part in (p.strip() for p in str(text).split(",")):
+        if not re.fullmatch(r"[+-]?\d+", part):
+            raise ObserverError(
+                f"{name}: expected comma-separated output indices like 3,4; "
+                f"found {part!r} in {text!r}"
+            )
+        indices.append(int(part))
+    return indices
 
 
 def measurement_matrix(C_m: Any, n_outputs: int) -> sympy.ImmutableMatrix:
@@ -238,7 +262,7 @@ def gain_matrix(gain: Any, q: int, per: str = "sensor") -> sympy.ImmutableMatrix
     elif isinstance(gain, Iterable) and not isinstance(gain, Mapping | set | frozenset):
         entries = list(gain.tolist() if hasattr(gain, "tolist") else gain)
         if entries and all(_is_scalar(x) for x in entries):
-            return _check_gain(sympy.diag(*_diagonal(entries, q, per)), q)
+            return _check_gain(sympy.diag(*diagonal_values(entries, q, per)), q)
         rows = _rows(entries, "gain")
     else:
         raise ObserverError(
@@ -254,8 +278,11 @@ def gain_matrix(gain: Any, q: int, per: str = "sensor") -> sympy.ImmutableMatrix
     return _check_gain(L, q)
 
 
-def _diagonal(entries: list[Any], count: int, per: str) -> list[sympy.Expr]:
-    """Read diagonal gain entries exactly; a single entry is used ``count`` times."""
+def diagonal_values(entries: list[Any], count: int, per: str) -> list[sympy.Expr]:
+    """Read diagonal gain entries exactly; a single entry is used ``count`` times.
+
+    ``per`` is what one entry belongs to, for messages (``"sensor"``).
+    """
     for i, entry in enumerate(entries):
         if str(entry).strip().lower().lstrip("+-") in ("nan", "inf", "infinity"):
             raise ObserverError(
