@@ -32,9 +32,13 @@ class GainEstimate:
     Attributes
     ----------
     estimate : Estimate
-        The peak over the resolved band at the fine member of each resolution pair.
+        The peak over the resolved band at the fine member of each resolution pair; its
+        comparison pair is the coarse member's peak over the trimmed band
+        (:func:`phdesign.numeric.noise.noise`).
     frequency : float or None
-        Where the finest peak lies (rad per unit time).
+        Where the finest peak lies (rad per unit time): the lowest frequency among peaks
+        equal to the tolerance (the damped wave's first resonance, not one of the
+        infinitely many after it).
     frequencies : tuple of float
         The peak frequency of every pair.
     band : float or None

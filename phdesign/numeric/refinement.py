@@ -6,9 +6,13 @@ values :math:`f_0, \dots, f_m` at resolutions :math:`p_0 < \dots < p_m`:
 - it has **converged** when the last two agree,
   :math:`|f_m - f_{m-1}| \le \mathrm{tol} \cdot |f_m|`; its digits are
   :math:`-\log_{10}(|f_m - f_{m-1}| / |f_m|)`;
-- it **diverges** when, over the last three, it grows and its growth per unit of
-  :math:`\log p` does not slow down,
+- it **diverges** when, over the last three, it grows by more than its tolerance at each
+  step, :math:`f_k - f_{k-1} > \mathrm{tol} \cdot |f_k|` for :math:`k = m-1, m`, and its
+  growth per unit of :math:`\log p` does not slow down,
   :math:`d_k = (f_k - f_{k-1}) / \log(p_k / p_{k-1})`, :math:`d_m \ge 0.95\, d_{m-1} > 0`.
+  Increments below the tolerance are the figure's own noise (round-off, or the last digits
+  of a converged value), not growth: a value that agrees to 13 digits at every resolution
+  but whose comparison pair disagrees is *not converged*, never diverging.
   A convergent sequence :math:`f_\infty - c p^{-s}` has :math:`d_m / d_{m-1} =
   (p_{m-1}/p_m)^{s} < 1`; a divergent one :math:`c p^r` or :math:`c \log p` has a ratio
   :math:`\ge 1`.  The local growth exponent :math:`r = \log(f_m/f_{m-1}) / \log(p_m/p_{m-1})`
@@ -117,6 +121,8 @@ def settle(
     'diverges (grows like p^1.00)'
     >>> settle("w(1)", [0.1347085750, 0.1347085724], [20, 30], 1e-6).status()
     'converged (7.7 digits)'
+    >>> settle("g", [1, 1 + 1e-14, 1 + 3e-14], [30, 45, 68], 1e-6, pair=(1, 1 + 2e-6)).status()
+    'not converged (5.7 digits)'
     """
     f = [float(v) for v in values]
     p = [int(r) for r in resolutions]
@@ -136,10 +142,14 @@ def settle(
         if any(not math.isfinite(v) for v in f[-2:]):
             diverges = True
         else:
-            rates = [
-                (f[k] - f[k - 1]) / math.log(p[k] / p[k - 1]) for k in (len(f) - 2, len(f) - 1)
-            ]
-            diverges = rates[0] > 0 and rates[1] >= DIVERGENCE_RATIO * rates[0] and f[-2] > 0
+            last = (len(f) - 2, len(f) - 1)
+            rates = [(f[k] - f[k - 1]) / math.log(p[k] / p[k - 1]) for k in last]
+            # growth is evidence only where it exceeds the figure's own accuracy: two
+            # round-off increments (1e-14 on a value of 1) are not a trend
+            visible = all(f[k] - f[k - 1] > tol * abs(f[k]) for k in last)
+            diverges = (
+                visible and rates[0] > 0 and rates[1] >= DIVERGENCE_RATIO * rates[0] and f[-2] > 0
+            )
             if diverges:
                 growth = math.log(f[-1] / f[-2]) / math.log(p[-1] / p[-2])
     return Estimate(name, tuple(f), tuple(p), bool(converged), bool(diverges), digits, growth)
