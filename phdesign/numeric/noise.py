@@ -66,6 +66,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from phdesign.arguments import positive_int, positive_number
 from phdesign.errors import NumericError, ObserverError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
@@ -390,16 +391,18 @@ def noise(
     feedback_matrix(C, Lm, nm.n_ports)  # shapes and L + L^T > 0, before any work
     sigma, w_in = noise_intensities(nm, C.shape[0], intensity, input_intensity)
     functionals = parse_functionals(performance, nm, model)
-    if tol is None:
-        tol = DEFAULT_TOL.get(method, 1e-3)
-    if not (math.isfinite(tol) and tol > 0):
-        raise NumericError(f"tol must be a positive number; found {tol}")
+    tol = DEFAULT_TOL.get(method, 1e-3) if tol is None else positive_number(tol, "tol")
     rtol = RESOLVED_RTOL.get(method, 1e-2)
     p0, pmax = default_resolutions(nm, method)
-    p = int(resolution) if resolution is not None else p0
-    pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
-    if p <= 0 or pmax < p:
-        raise NumericError(f"resolution must be positive and at most max_resolution; found {p}")
+    p = p0 if resolution is None else positive_int(resolution, "resolution")
+    if max_resolution is None:
+        pmax = max(pmax, p)
+    else:
+        pmax = positive_int(max_resolution, "max_resolution")
+        if pmax < p:
+            raise NumericError(
+                f"max_resolution must be at least the first resolution {p}; found {pmax}"
+            )
     cache = discretizations if discretizations is not None else {}
 
     run = _Refinement(functionals, tol)

@@ -35,7 +35,7 @@ __all__ = ["DIVERGENCE_RATIO", "Estimate", "settle"]
 DIVERGENCE_RATIO = 0.95
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Estimate:
     """One figure at several resolutions and its verdict (module docstring).
 
@@ -74,6 +74,26 @@ class Estimate:
         if self.digits is None:
             return "not converged"
         return f"not converged ({max(self.digits, 0.0):.1f} digits)"
+
+    def __str__(self) -> str:
+        """``w(1) = 0.1347085719   converged (8.5 digits) (0.1347, ... at resolutions ...)``."""
+        values = ", ".join(f"{v:.6g}" for v in self.values)
+        at = ", ".join(str(r) for r in self.resolutions)
+        head = self.name if self.value is None else f"{self.name} = {self.value:.10g}"
+        return f"{head}   {self.status()}" + (f" ({values} at resolutions {at})" if at else "")
+
+    def __repr__(self) -> str:
+        value = None if self.value is None else float(f"{self.value:.10g}")
+        return (
+            f"Estimate(name={self.name[:60]!r}, value={value}, status={self.status()!r}, "
+            f"resolutions={self.resolutions[-6:]})"
+        )
+
+    def _repr_html_(self) -> str:
+        from phdesign._display import html_table
+
+        rows = [[str(r), f"{v:.12g}"] for r, v in zip(self.resolutions, self.values, strict=True)]
+        return html_table(["resolution", self.name], rows, footer=self.status())
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary (non-finite values become null)."""

@@ -38,7 +38,9 @@ from typing import Any
 
 import numpy as np
 
+from phdesign.arguments import positive_number
 from phdesign.errors import NumericError
+from phdesign.numeric.arguments import check_initial_state
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.order import REDUCTIONS, OrderSelection, check_order, select_order
 from phdesign.numeric.sampling import (
@@ -429,6 +431,27 @@ def _plant_degree(nm: NumericModel, order: int | None, plant_resolution: int | N
     return max(PLANT_DEGREE, needed)
 
 
+def _displacement_points(nm: NumericModel, points: Any) -> tuple[float, ...]:
+    """Return the points of the outputs ``w(z)``: numbers of [a, b] (default: b, if any)."""
+    if points is None:
+        return (nm.interval[1],) if nm.displacement is not None else ()
+    a, b = nm.interval
+    if nm.displacement is None and np.size(points):
+        raise NumericError(
+            f"points: model {nm.name!r} has no displacement: drop the displacement points"
+        )
+    try:
+        values = tuple(float(z) for z in np.atleast_1d(np.asarray(points, dtype=float)))
+    except (TypeError, ValueError):
+        raise NumericError(
+            f"points: expected numbers in [{a:g}, {b:g}]; found {points!r}"
+        ) from None
+    outside = [z for z in values if not (math.isfinite(z) and a <= z <= b)]
+    if outside:
+        raise NumericError(f"points: expected numbers in [{a:g}, {b:g}]; found {outside[0]:g}")
+    return values
+
+
 def export_observer(
     nm: NumericModel,
     C_m: np.ndarray,
@@ -502,9 +525,11 @@ def export_observer(
         raise NumericError(f"unknown reduction {reduction!r}; expected one of {REDUCTIONS}")
     if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a finite positive number; found {t_end!r}")
+    positive_number(tol, "tol")
+    positive_number(output_tol, "output_tol")
+    check_initial_state(x0, nm, "x0")
     plant_degree = verification_plant_degree(nm, order, plant_resolution, reduction)
-    if points is None:
-        points = (nm.interval[1],) if nm.displacement is not None else ()
+    points = _displacement_points(nm, points)
     plant = discretize(nm, "galerkin", plant_degree)
     initial = default_initial_state(nm.size, nm.interval) if x0 is None else x0
     text = x0_text or ("x_i = (z - a)/(b - a) - 0.9 for every component" if x0 is None else "x0")
