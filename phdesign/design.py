@@ -413,7 +413,13 @@ class Observer:
         if direction is None and grid is None and self.L is not None:
             direction = numeric_matrix(self.L, "L", "tradeoff (the default direction)")
         elif direction is not None:
-            direction = numeric_matrix(gain_matrix(direction, self.q), "direction", "tradeoff")
+            try:  # read as a gain is read (exact numbers, one per sensor or the matrix)
+                exact = gain_matrix(direction, self.q)
+            except ObserverError as error:
+                raise ObserverError(
+                    f"direction (the gain L_0 of the ray s L_0): {error}"
+                ) from None
+            direction = numeric_matrix(exact, "direction", "tradeoff")
         return tradeoff(
             self.plant.numeric,
             C,
@@ -440,7 +446,7 @@ class Observer:
         x0: str | Callable[[Any], Any] | None = None,
         t_end: float = 5.0,
         plant_resolution: int | None = None,
-        points: Sequence[float] | None = None,
+        points: float | Sequence[float] | None = None,
     ) -> SampledObserver:
         r"""Return the observer a controller runs: finite order, sampled every ``dt``.
 
@@ -509,7 +515,7 @@ class Observer:
             x0_text=x0 if isinstance(x0, str) else None,
             t_end=t_end,
             plant_resolution=plant_resolution,
-            points=None if points is None else tuple(points),
+            points=points,
             model_name=self.model.name,
         )
 

@@ -32,14 +32,14 @@ matrix in the efforts, or :math:`V^\top E V` after a reduction x = V x_r).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from phdesign.arguments import positive_number
-from phdesign.errors import NumericError
+from phdesign.errors import ArgumentError, NumericError
 from phdesign.numeric.arguments import check_initial_state
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.order import REDUCTIONS, OrderSelection, check_order, select_order
@@ -441,7 +441,7 @@ def _displacement_points(nm: NumericModel, points: Any) -> tuple[float, ...]:
             f"points: model {nm.name!r} has no displacement: drop the displacement points"
         )
     try:
-        values = tuple(float(z) for z in np.atleast_1d(np.asarray(points, dtype=float)))
+        values = tuple(float(z) for z in np.asarray(points, dtype=float).ravel())
     except (TypeError, ValueError):
         raise NumericError(
             f"points: expected numbers in [{a:g}, {b:g}]; found {points!r}"
@@ -468,7 +468,7 @@ def export_observer(
     x0_text: str | None = None,
     t_end: float = 5.0,
     plant_resolution: int | None = None,
-    points: tuple[float, ...] | None = None,
+    points: float | Sequence[float] | None = None,
     model_name: str | None = None,
 ) -> SampledObserver:
     """Design the observer a controller runs: order, sampled discretization, verification.
@@ -499,7 +499,7 @@ def export_observer(
         Length of those runs.
     plant_resolution : int, optional
         Galerkin degree of the verification plant (default 48, raised to twice the order).
-    points : tuple of float, optional
+    points : float or sequence of float, optional
         Displacement points of the outputs ``w(z)``; default (b,) for a model with a
         displacement, none otherwise.
     model_name : str, optional
@@ -525,6 +525,8 @@ def export_observer(
         raise NumericError(f"unknown reduction {reduction!r}; expected one of {REDUCTIONS}")
     if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a finite positive number; found {t_end!r}")
+    if not isinstance(verify, bool):
+        raise ArgumentError(f"verify must be True or False; found {verify!r}")
     positive_number(tol, "tol")
     positive_number(output_tol, "output_tol")
     check_initial_state(x0, nm, "x0")
