@@ -33,9 +33,13 @@ and the identities of the open plant become (direct expansion, using
     W_C' \Sigma W_B'^\top = \begin{pmatrix} 0 & I \end{pmatrix}, \qquad
     W_C' \Sigma W_C'^\top = 0 .
 
-The first is the dissipative boundary of Jacob and Zwart (Theorem 7.2.4: with
-:math:`u_r = 0` the operator generates a contraction semigroup iff
-:math:`W_B'\Sigma W_B'^\top \succeq 0`); the other two say that :math:`y_r` is still
+The first is the dissipative boundary of Le Gorrec, Zwart and Maschke (*Dirac structures
+and boundary control systems associated with skew-symmetric differential operators*, SIAM
+J. Control Optim. 44(5), 1864-1892, 2005): for the skew-symmetric operator
+:math:`\sum_k P_k \partial_z^k \mathcal H` of any order N with a full-rank boundary
+operator, :math:`u_r = 0` gives a contraction semigroup iff
+:math:`W_B'\Sigma W_B'^\top \succeq 0` (a dissipative :math:`P_0`,
+:math:`P_0 + P_0^\top \preceq 0`, keeps it one); the other two say that :math:`y_r` is still
 power conjugate to :math:`u_r` and blind to the closed condition.  On the admissible
 traces the power is :math:`u^\top y = u_r^\top y_r + u_c^\top y_c`, so the energy balance
 of the closed plant is

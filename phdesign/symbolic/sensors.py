@@ -172,7 +172,7 @@ def measurement_matrix(C_m: Any, n_outputs: int) -> sympy.ImmutableMatrix:
 # --------------------------------------------------------------------------- gains
 @lru_cache(maxsize=64)
 def gain_symbols(q: int) -> tuple[sympy.Symbol, ...]:
-    """Return the positive symbols ``l1 .. lq`` used for symbolic gains."""
+    """Return the positive symbols ``l1``, ``l2``, ..., ``lq`` of symbolic gains."""
     return tuple(sympy.Symbol(f"l{i + 1}", positive=True) for i in range(q))
 
 
