@@ -11,7 +11,14 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from phdesign.cli.common import add_json_argument, add_model_argument, emit, emit_json, load_model
+from phdesign.cli.common import (
+    add_json_argument,
+    add_model_argument,
+    emit,
+    emit_json,
+    emit_result,
+    load_model,
+)
 from phdesign.errors import SweepError
 from phdesign.sweep.jobs import JOBS
 
@@ -183,11 +190,7 @@ def _sweep(args: argparse.Namespace) -> int:
         progress=False if args.no_progress else None,
     )
     summary = summarize(dataset)
-    if args.json:
-        emit_json(summary.to_dict())
-    else:
-        emit(str(summary))
-    return 0
+    return emit_result(args, summary)
 
 
 def _plot(args: argparse.Namespace) -> int:
