@@ -186,9 +186,9 @@ def check_feedback(
 
     Called by the model's validation; returns how each condition was checked.
     """
-    from phdesign.symbolic import model as model_module
     from phdesign.symbolic.definiteness import check_definite
     from phdesign.symbolic.expressions import Z
+    from phdesign.symbolic.validation import check_finite, check_symbols
 
     feedback = model.feedback
     if feedback is None:
@@ -197,8 +197,8 @@ def check_feedback(
     K = feedback.gain
     if Z in K.free_symbols:
         raise ModelError("feedback gain K must not depend on z; it acts at the boundary")
-    model_module.check_symbols(K, "feedback gain K", symbols)
-    model_module.check_finite(K, "feedback gain K", defaults)
+    check_symbols(K, "feedback gain K", symbols)
+    check_finite(K, "feedback gain K", defaults)
     dissipative = check_definite(
         K + K.T, "K + K^T", model.interval, defaults, sign=1, strict=False
     )
