@@ -240,24 +240,45 @@ for ax, (name, g) in zip(axes7, designs.items(), strict=True):
 # %% [markdown]
 # ## Gain map and tuned gain
 #
-# The spectral abscissa over a grid of $(l_1, l_2)$, from one `AbscissaEvaluator`: the
-# Galerkin pair of degrees 20 and 30 prepared once, eigenvalues only at each gain, and the
-# same abscissa as `spectrum()` at that pair. Near a coalescence of eigenvalues (where
-# the error mode is critically damped) the cluster fails the drift test; the evaluator
-# keeps every eigenvalue of the resolved band that belongs to a cluster, so it never
-# drops the rightmost one.
+# The spectral abscissa over a $36 \times 36$ grid of $(l_1, l_2)$ is a design sweep:
+# `phdesign.sweep` evaluates the `spectrum` job at every gain, in chunks of gains, each
+# chunk discretizing the Galerkin degrees once and running `spectrum()`'s refinement and
+# rules at each gain. Here the chunks run in this process (`scheduler="synchronous"`, so
+# that the notebook also runs as a plain script); without it they run on a local Dask
+# cluster, one worker process per core (from a script, under `if __name__ == "__main__":`,
+# since the workers re-import it), and `scheduler="tcp://host:8786"` sends them to any
+# Dask cluster, with the same numbers. Every point carries its `converged` flag; the same
+# map is `phdesign sweep euler-bernoulli --sensors 3,4 --grid l1=... --grid l2=... -o
+# map.zarr`.
 
 # %%
-evaluator = AbscissaEvaluator(nm, C, (20, 30))
-l1_grid = np.logspace(-2.5, 0.0, 36)
-l2_grid = np.logspace(-1.5, 1.3, 36)
-gains = [np.diag([a, b]) for b in l2_grid for a in l1_grid]
-alpha_map = evaluator.abscissas(gains).reshape(l2_grid.size, l1_grid.size)
-j, i = np.unravel_index(np.argmin(alpha_map), alpha_map.shape)
+import phdesign
+
+gain_map = phdesign.sweep(
+    beam,
+    sensors=[3, 4],
+    grid={"l1": f"{10**-2.5!r}:1:36:log", "l2": f"{10**-1.5!r}:{10**1.3!r}:36:log"},
+    options={"resolution": 20, "max_resolution": 30},
+    scheduler="synchronous",
+    progress=False,
+)
+print(phdesign.sweep.summarize(gain_map))
+l1_grid, l2_grid = gain_map.l1.values, gain_map.l2.values
+alpha_map = gain_map.spectral_abscissa.transpose("l2", "l1").values
+j, i = np.unravel_index(np.nanargmin(alpha_map), alpha_map.shape)
 print(
     f"best grid point: (l1, l2) = ({l1_grid[i]:.3f}, {l2_grid[j]:.3f}), "
-    f"alpha = {alpha_map[j, i]:.3f} ({evaluator.evaluations} evaluations)"
+    f"alpha = {alpha_map[j, i]:.3f}"
 )
+assert int(gain_map.unbounded_below.sum()) == 0
+
+# each point is what spectrum() reports at that gain (the same refinement, at the same
+# degrees), and the evaluator used below for single gains agrees at the first pair
+evaluator = AbscissaEvaluator(nm, C, (20, 30))
+for jj, ii in [(j, i), (0, 0), (35, 35), (10, 20)]:
+    L_point = np.diag([l1_grid[ii], l2_grid[jj]])
+    report = spectrum(nm, C, L_point, resolution=20, max_resolution=30)
+    assert alpha_map[jj, ii] == report.spectral_abscissa
 
 tuned = tune(nm, C)
 g_tuned = tuple(float(x) for x in np.diag(tuned.gain))

@@ -6,6 +6,9 @@ A flat namespace for notebooks and scripts::
     beam = phd.load("euler-bernoulli")
     obs = phd.Observer(beam, sensors=[3, 4], gain=[0.1, 1])
     obs.classify()
+    obs.noise()                          # what the gain costs in sensor noise
+    obs.export(dt=1e-3)                  # the sampled observer for a controller
+    phd.Loop(obs, actuate=3).spectrum()  # observer-based control u3 = -K y3_hat
 
 Every name is imported on first use (PEP 562), so ``import phdesign`` stays light: the
 command line and ``phdesign.plots`` start without sympy, numpy or matplotlib until a name
@@ -44,7 +47,8 @@ _EXPORTS: dict[str, str] = {
     "SensorSearch": "phdesign.symbolic.search",
     # the design objects
     "Observer": "phdesign.design",
-    "Plant": "phdesign.design",
+    "Plant": "phdesign.plant",
+    "Loop": "phdesign.loop",
     # numbers
     "to_numeric": "phdesign.numeric.bridge",
     "discretize": "phdesign.numeric.discretize",
@@ -54,6 +58,9 @@ _EXPORTS: dict[str, str] = {
     "SimulationResult": "phdesign.numeric.simulate",
     "tune": "phdesign.numeric.tune",
     "TuneResult": "phdesign.numeric.tune",
+    "NoiseReport": "phdesign.numeric.noise_report",
+    "Tradeoff": "phdesign.numeric.tradeoff",
+    "SampledObserver": "phdesign.numeric.sampled",
     # errors
     "PhdesignError": "phdesign.errors",
 }
@@ -62,13 +69,17 @@ __all__ = [
     "BCPHS",
     "Classification",
     "Displacement",
+    "Loop",
+    "NoiseReport",
     "Observer",
     "PhdesignError",
     "Plant",
     "Ports",
+    "SampledObserver",
     "SensorSearch",
     "SimulationResult",
     "SpectrumReport",
+    "Tradeoff",
     "TuneResult",
     "__version__",
     "builtin_names",
@@ -93,15 +104,20 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDEs
-    from phdesign.design import Observer, Plant
+    from phdesign.design import Observer
     from phdesign.errors import PhdesignError
     from phdesign.io import model_from_toml, model_to_toml, read_model, write_model
+    from phdesign.loop import Loop
     from phdesign.models import builtin_names, load, load_builtin
     from phdesign.numeric.bridge import to_numeric
     from phdesign.numeric.discretize import discretize
+    from phdesign.numeric.noise_report import NoiseReport
+    from phdesign.numeric.sampled import SampledObserver
     from phdesign.numeric.simulate import SimulationResult, simulate
     from phdesign.numeric.spectrum import SpectrumReport, spectrum
+    from phdesign.numeric.tradeoff import Tradeoff
     from phdesign.numeric.tune import TuneResult, tune
+    from phdesign.plant import Plant
     from phdesign.symbolic.classify import Classification, classify
     from phdesign.symbolic.model import BCPHS, Displacement
     from phdesign.symbolic.observer import (
@@ -115,7 +131,19 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
 
 
 #: Subpackages and modules reachable as attributes (``phd.plots``), imported on first use.
-_SUBMODULES = ("cli", "design", "errors", "io", "models", "numeric", "plots", "symbolic")
+_SUBMODULES = (
+    "cli",
+    "design",
+    "errors",
+    "io",
+    "loop",
+    "models",
+    "numeric",
+    "plant",
+    "plots",
+    "sweep",
+    "symbolic",
+)
 
 
 def __getattr__(name: str) -> Any:

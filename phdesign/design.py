@@ -30,25 +30,26 @@ The observer implemented is the paper's:
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
-from functools import cached_property
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import sympy
 
 from phdesign._display import REPR_LIMIT, html_table, matrix_text, sensors_text, shorten
-from phdesign.arguments import choice, positive_int, require_model
-from phdesign.errors import ArgumentError, ObserverError, ParameterError
+from phdesign.arguments import choice
+from phdesign.errors import ArgumentError, ObserverError
+from phdesign.plant import Plant, numeric_matrix
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import gain_matrix, measurement_matrix, sensor_matrix
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     import numpy as np
 
-    from phdesign.numeric.bridge import NumericModel
-    from phdesign.numeric.phs import DiscretePHS
+    from phdesign.numeric.noise_report import NoiseReport
+    from phdesign.numeric.sampled import SampledObserver
     from phdesign.numeric.simulate import SimulationResult
     from phdesign.numeric.spectrum import SpectrumReport
+    from phdesign.numeric.tradeoff import Tradeoff
     from phdesign.numeric.tune import TuneResult
     from phdesign.symbolic.classify import Classification
 
@@ -56,198 +57,6 @@ __all__ = ["STATESPACE_SYSTEMS", "Observer", "Plant", "numeric_matrix"]
 
 #: The systems :meth:`Observer.statespace` exports.
 STATESPACE_SYSTEMS = ("plant", "observer", "error")
-
-
-def numeric_matrix(M: sympy.MatrixBase, name: str, what: str) -> np.ndarray:
-    """Return an exact numeric matrix as floats; refuse symbols, saying what to do.
-
-    Parameters
-    ----------
-    M : sympy matrix
-        :math:`C_m` or :math:`L`.
-    name : str
-        Its name in messages.
-    what : str
-        The numeric computation that needs it (``"spectrum"``, ``"simulate"``).
-    """
-    import numpy as np
-
-    if M.free_symbols:
-        names = ", ".join(sorted(map(str, M.free_symbols)))
-        raise ObserverError(
-            f"{what} needs numbers for {name}; {name} = {matrix_text(M)} is symbolic ({names}): "
-            "give numbers (the gain [0.1, 1], or --gain 0.1,1 on the command line) or tune "
-            "one; symbolic gains are for classify, which answers for all their positive values"
-        )
-    return np.array(M.evalf(17).tolist(), dtype=float)
-
-
-@dataclass(frozen=True, repr=False)
-class Plant:
-    """A model with its parameter overrides and discretization: the numeric plumbing.
-
-    Parameters
-    ----------
-    model : BCPHS
-        The symbolic model (:func:`phdesign.load`).
-    parameters : mapping of str to number, optional
-        Overrides of the model's parameter defaults (``{"d": 0.5}``), used by the
-        classification and by the numbers alike.
-    method : {"galerkin", "fd"}
-        Discretization (:func:`phdesign.numeric.discretize.discretize`).
-    resolution : int, optional
-        Degree or nodes per group; for spectra, the first resolution of the refinement.
-
-    Examples
-    --------
-    >>> from phdesign.models import load_builtin
-    >>> plant = Plant(load_builtin("euler-bernoulli"), parameters={"d": 0.5})
-    >>> plant.numeric.parameters["d"]
-    0.5
-    >>> round(plant.spectrum().spectral_abscissa, 10)  # every mode has Re λ = -d/2
-    -0.25
-    """
-
-    model: BCPHS
-    parameters: Mapping[str, Any] = field(default_factory=dict, hash=False)
-    method: str = "galerkin"
-    resolution: int | None = None
-
-    def __post_init__(self) -> None:
-        require_model(self.model)
-        if not isinstance(self.parameters, Mapping):
-            raise ParameterError(
-                "parameters must be a mapping of names to values such as {'d': 0.5}; found "
-                f"{type(self.parameters).__name__}"
-            )
-        from phdesign.numeric.discretize import METHODS
-
-        choice(self.method, "method", METHODS)
-        if self.resolution is not None:
-            positive_int(self.resolution, "resolution")
-        object.__setattr__(self, "parameters", dict(self.parameters))
-        self.design_model  # noqa: B018 - checks the overrides now, not at first use
-
-    @cached_property
-    def design_model(self) -> BCPHS:
-        """The model with the parameter overrides as its defaults."""
-        return self.model.with_parameters(self.parameters) if self.parameters else self.model
-
-    @cached_property
-    def numeric(self) -> NumericModel:
-        """The numeric model (parameters substituted), made once."""
-        from phdesign.numeric.bridge import to_numeric
-
-        return to_numeric(self.model, self.parameters or None)
-
-    def discrete(self, resolution: int | None = None) -> DiscretePHS:
-        """Return the discretized plant at ``resolution`` (default: the plant's)."""
-        from phdesign.numeric.discretize import discretize
-
-        return discretize(self.numeric, self.method, resolution or self.resolution)
-
-    def initial_state(self, x0: str | Callable[[Any], Any] | None, name: str) -> Any:
-        """Return an initial state as a function of z (text ``"x1: z - 0.9"`` is parsed)."""
-        if x0 is None or callable(x0):
-            return x0
-        if not isinstance(x0, str):
-            raise ArgumentError(
-                f"{name} must be text such as 'x1: 0, x2: z - 0.9' or a function of z; "
-                f"found {type(x0).__name__}"
-            )
-        from phdesign.numeric.bridge import initial_state_function
-
-        return initial_state_function(x0, self.numeric)
-
-    def spectrum(
-        self, *, max_resolution: int | None = None, tol: float | None = None, count: int = 6
-    ) -> SpectrumReport:
-        """Return the converged spectrum of the plant with u = 0."""
-        return self.closed_spectrum(
-            None, None, max_resolution=max_resolution, tol=tol, count=count
-        )
-
-    def closed_spectrum(
-        self,
-        C_m: np.ndarray | None,
-        L: np.ndarray | None,
-        *,
-        max_resolution: int | None = None,
-        tol: float | None = None,
-        count: int = 6,
-    ) -> SpectrumReport:
-        r"""Return the converged spectrum with :math:`u = -C_m^\top L C_m y` (u = 0 without)."""
-        from phdesign.numeric.spectrum import spectrum
-
-        return spectrum(
-            self.numeric,
-            C_m,
-            L,
-            method=self.method,
-            resolution=self.resolution,
-            max_resolution=max_resolution,
-            tol=tol,
-            count=count,
-        )
-
-    def simulate(
-        self,
-        x0: str | Callable[[Any], Any] | None = None,
-        *,
-        t_end: float = 5.0,
-        samples: int = 501,
-        u: Callable[[float], Any] | None = None,
-        scheme: str = "expm",
-        tol: float = 1e-6,
-    ) -> SimulationResult:
-        """Simulate the plant alone from ``x0`` (text or a function of z; zero by default).
-
-        ``tol`` bounds the error of ``scheme="midpoint"`` (its substeps are chosen to meet
-        it; :func:`phdesign.numeric.simulate.simulate`).
-        """
-        return self.run(None, None, x0, t_end=t_end, samples=samples, u=u, scheme=scheme, tol=tol)
-
-    def run(
-        self,
-        C_m: np.ndarray | None,
-        L: np.ndarray | None,
-        x0: str | Callable[[Any], Any] | None = None,
-        *,
-        xhat0: str | Callable[[Any], Any] | None = None,
-        labels: Mapping[str, str] | None = None,
-        **options: Any,
-    ) -> SimulationResult:
-        """Simulate the plant, with the observer of ``(C_m, L)`` when given.
-
-        ``options`` are those of :func:`phdesign.numeric.simulate.simulate` (``t_end``,
-        ``samples``, ``u``, ``scheme``, ``z_w``), checked there; ``labels`` name the design
-        in the result (presentation only: the plots' titles and the JSON).
-        """
-        from phdesign.numeric.simulate import simulate
-
-        result = simulate(
-            self.numeric,
-            C_m,
-            L,
-            x0=self.initial_state(x0, "x0"),
-            xhat0=self.initial_state(xhat0, "xhat0"),
-            method=self.method,
-            resolution=self.resolution,
-            **options,
-        )
-        return self.labelled(result, **(labels or {}))
-
-    def labelled(self, result: SimulationResult, **labels: str) -> SimulationResult:
-        """Return the result with the model's name (and the design's ``labels``) in its ``info``.
-
-        Presentation only: the plots' titles and the JSON name what was simulated.
-        """
-        return replace(result, info={**result.info, "model": self.model.name, **labels})
-
-    def __repr__(self) -> str:
-        extra = f", parameters={self.parameters}" if self.parameters else ""
-        text = f"Plant(model={self.model.name!r}{extra}, method={self.method!r})"
-        return shorten(text, REPR_LIMIT)
 
 
 @dataclass(frozen=True, init=False, repr=False)
@@ -478,6 +287,237 @@ class Observer:
         if system == "observer":
             return export.observer_statespace(d, C, L)
         return export.error_statespace(d, C, L)
+
+    # ------------------------------------------------------------------ noise and export
+    def noise(
+        self,
+        *,
+        intensity: float | Sequence[float] | None = None,
+        input_intensity: float | Sequence[float] | None = None,
+        performance: str | Sequence[str] | None = None,
+        max_resolution: int | None = None,
+        tol: float | None = None,
+    ) -> NoiseReport:
+        r"""Return what the gain costs in sensor noise: each figure converged or flagged.
+
+        The observer receives :math:`y_m + \nu`, :math:`\mathbb E[\nu(t)\nu(s)^\top] =
+        \Sigma_\nu \delta(t - s)`, so the error system is driven at the boundary,
+
+        .. math::
+
+            \tilde u = -C_m^\top L C_m \tilde y - C_m^\top L \nu ,
+
+        and the report gives the steady-state variance of each performance output's
+        error, the L²-gain from the noise to :math:`\tilde x` (energy norm) with its
+        frequency, and the expected error energy :math:`\mathbb E[\tilde H]`, which is
+        infinite for the PDE (reported as diverging, never as a number):
+        :func:`phdesign.numeric.noise.noise`.
+
+        Parameters
+        ----------
+        intensity : float or sequence of float, optional
+            Sensor noise intensities :math:`\sigma_i^2`, one per sensor or one for all
+            (default 1).
+        input_intensity : float or sequence of float, optional
+            White noise on the plant inputs, which the observer does not know (default none).
+        performance : str or sequence of str, optional
+            Outputs whose estimation-error variance is reported: ``"w(1)"`` (the
+            displacement at a point), a boundary trace such as ``"e1(1)"``, or an integral
+            ``"x2: sin(pi*z)"``; default the displacement at b when the model has one.
+        max_resolution, tol : optional
+            Largest resolution of the refinement, and the relative agreement that makes a
+            figure converged (default 1e-6 Galerkin, 1e-3 FD).
+
+        Returns
+        -------
+        NoiseReport
+            ``.performance[0].value`` (None unless converged), ``.rms()``, ``.l2_gain``,
+            ``.error_energy``; ``str()`` is what ``phdesign noise`` prints.
+
+        Examples
+        --------
+        >>> from phdesign.models import load_builtin
+        >>> string = Observer(load_builtin("wave"), sensors=[2], gain=0.5)
+        >>> report = string.noise(performance="x2: 1", intensity=0.3)
+        >>> round(report.performance[0].value, 8)  # Var = k sigma^2 / 2 for the damper k
+        0.075
+        >>> report.error_energy.diverges, round(report.l2_gain.value**2, 8)  # sigma^2 max(1, k)^2
+        (True, 0.3)
+        """
+        from phdesign.numeric.noise import noise
+
+        C, L = self.numeric_gain("noise")
+        return noise(
+            self.plant.numeric,
+            C,
+            L,
+            model=self.plant.design_model,
+            intensity=intensity,
+            input_intensity=input_intensity,
+            performance=performance,
+            method=self.plant.method,
+            resolution=self.plant.resolution,
+            max_resolution=max_resolution,
+            tol=tol,
+        )
+
+    def tradeoff(
+        self,
+        *,
+        direction: Any = None,
+        scales: Sequence[float] | None = None,
+        grid: Sequence[Sequence[float]] | None = None,
+        intensity: float | Sequence[float] | None = None,
+        input_intensity: float | Sequence[float] | None = None,
+        performance: str | Sequence[str] | None = None,
+    ) -> Tradeoff:
+        r"""Decay rate against error RMS for these sensors, over a ray or a grid of gains.
+
+        Along the ray :math:`L(s) = s L_0` (or over a grid of diagonal gains) each gain
+        gets the converged spectral abscissa :math:`\alpha` of the error system (decay
+        rate :math:`-\alpha`) and the noise figures of :meth:`noise`; the gains that no
+        other beats in both decay and RMS of the first performance output are marked
+        Pareto-optimal (:func:`phdesign.numeric.tradeoff.tradeoff`).
+
+        Parameters
+        ----------
+        direction : number, sequence or matrix, optional
+            :math:`L_0`; default this observer's gain (so :math:`s = 1` is this design),
+            or the identity for an observer without one.
+        scales : sequence of float, optional
+            The scales s (default 12 log-spaced from 0.1 to 10).
+        grid : sequence of sequences of float, optional
+            Per-sensor gain values, every combination a diagonal gain (instead of a ray).
+        intensity, input_intensity, performance
+            As for :meth:`noise`.
+
+        Returns
+        -------
+        Tradeoff
+            ``.points`` (gain, decay rate, rms, Pareto flag), ``.pareto_points``,
+            ``.to_csv()``, ``.plot()``; ``str()`` is what ``phdesign tradeoff`` prints.
+
+        Examples
+        --------
+        >>> from phdesign.models import load_builtin
+        >>> string = Observer(load_builtin("wave"), sensors=[2], gain=0.5)
+        >>> t = string.tradeoff(scales=[0.5, 1, 4], performance="x2: 1")
+        >>> [round(p.decay_rate, 6) for p in t.points]  # (1/2) ln|(1 + k)/(1 - k)|
+        [0.255413, 0.549306, 0.549306]
+        >>> [p.pareto for p in t.points]  # k = 2 decays as fast as k = 1/2, noisier
+        [True, True, False]
+        """
+        from phdesign.numeric.tradeoff import tradeoff
+
+        C = numeric_matrix(self.C_m, "C_m", "tradeoff")
+        if direction is None and grid is None and self.L is not None:
+            direction = numeric_matrix(self.L, "L", "tradeoff (the default direction)")
+        elif direction is not None:
+            try:  # read as a gain is read (exact numbers, one per sensor or the matrix)
+                exact = gain_matrix(direction, self.q)
+            except ObserverError as error:
+                raise ObserverError(
+                    f"direction (the gain L_0 of the ray s L_0): {error}"
+                ) from None
+            direction = numeric_matrix(exact, "direction", "tradeoff")
+        return tradeoff(
+            self.plant.numeric,
+            C,
+            model=self.plant.design_model,
+            direction=direction,
+            scales=scales,
+            grid=grid,
+            intensity=intensity,
+            input_intensity=input_intensity,
+            performance=performance,
+            method=self.plant.method,
+        )
+
+    def export(
+        self,
+        *,
+        dt: float,
+        sampler: str = "average",
+        order: int | None = None,
+        reduction: str = "none",
+        tol: float = 1e-6,
+        output_tol: float = 1e-3,
+        verify: bool = False,
+        x0: str | Callable[[Any], Any] | None = None,
+        t_end: float = 5.0,
+        plant_resolution: int | None = None,
+        points: float | Sequence[float] | None = None,
+    ) -> SampledObserver:
+        r"""Return the observer a controller runs: finite order, sampled every ``dt``.
+
+        .. math::
+
+            \hat x_{k+1} = A \hat x_k + B v_k, \qquad \hat y_k = C \hat x_k + D v_k,
+            \qquad v_k = (u_k;\ y_{m,k}),
+
+        exact for the declared sampler: ``"average"`` (the mean of :math:`y_m` over each
+        period; its error system is dissipative for every period) or ``"point"``
+        (samples :math:`y_m(t_k)`, which alias a boundary velocity's unresolved content):
+        :func:`phdesign.numeric.sampled.export_observer`.  The observer is a
+        Legendre-Galerkin one whatever the plant's ``method``; its order is chosen from
+        ``tol`` and ``output_tol`` unless given.
+
+        Parameters
+        ----------
+        dt : float
+            Sampling period (s).
+        sampler : {"average", "point"}
+        order : int, optional
+            Observer states (default: the smallest that meets the targets).
+        reduction : {"none", "modal", "balanced"}
+        tol, output_tol : float
+            Relative accuracy of the rightmost error eigenvalues; error floor of the
+            performance outputs relative to their peak.
+        verify : bool
+            Run the exported observer against a high-resolution plant.
+        x0 : str or callable, optional
+            Plant initial state of those runs (``"x1: 0, x2: z - 0.9"``, or a function of z).
+        t_end : float
+        plant_resolution : int, optional
+            Galerkin degree of the verification plant.
+        points : sequence of float, optional
+            Displacement points of the outputs ``w(z)`` (default b, with a displacement).
+
+        Returns
+        -------
+        SampledObserver
+            ``.A, .B, .C, .D``, ``.inputs``, ``.outputs``, ``.statespace()``,
+            ``.write(path, "json" | "c" | "npz" | "statespace")``.
+
+        Examples
+        --------
+        >>> from phdesign.models import load_builtin
+        >>> string = Observer(load_builtin("wave"), sensors=[2], gain=0.5)
+        >>> sampled = string.export(dt=1e-2, order=12)
+        >>> sampled.order, sampled.inputs, sampled.sampler
+        (12, ('u1', 'u2', 'y2'), 'average')
+        """
+        from phdesign.numeric.sampled import export_observer
+
+        C, L = self.numeric_gain("export")
+        return export_observer(
+            self.plant.numeric,
+            C,
+            L,
+            dt=dt,
+            sampler=sampler,
+            order=order,
+            reduction=reduction,
+            tol=tol,
+            output_tol=output_tol,
+            verify=verify,
+            x0=self.plant.initial_state(x0, "x0"),
+            x0_text=x0 if isinstance(x0, str) else None,
+            t_end=t_end,
+            plant_resolution=plant_resolution,
+            points=points,
+            model_name=self.model.name,
+        )
 
     # ------------------------------------------------------------------ display
     def labels(self) -> dict[str, str]:

@@ -69,6 +69,10 @@ class ArgumentError(PhdesignError, TypeError):
     """An argument of a library function is of the wrong kind (e.g. a name for a model)."""
 
 
+class SweepError(PhdesignError, ValueError):
+    """A sweep's grid, store or scheduler is invalid or unreachable."""
+
+
 def check_shape(
     name: str,
     matrix: Any,

@@ -27,6 +27,7 @@ from phdesign.errors import (
     ObserverError,
     OutputFileError,
     ParameterError,
+    SweepError,
 )
 
 
@@ -81,6 +82,8 @@ NOISE = "noise euler-bernoulli --sensors 3,4 --gain 0.1,1"
 TRADE = "tradeoff euler-bernoulli --sensors 3,4"
 TUNE_BEAM = "tune euler-bernoulli --sensors 3,4"
 EXPORT = "export euler-bernoulli --sensors 3,4 --gain 0.1,1 --format json"
+SWEEP = "sweep wave --sensors 2 --scheduler synchronous -o {tmp}/m.zarr"
+MAP = "sweep wave --sensors 2 --grid l1=0.1:1:3 --scheduler synchronous"
 COMMAND_ROWS = [
     # model selection and parameters
     row("ports nosuch", "unknown model 'nosuch'; expected a built-in model", ModelFileError),
@@ -684,6 +687,128 @@ COMMAND_ROWS = [
         "argument --tune: invalid choice: 'everything'",
         None,
     ),
+    # sweep (issue 17): grids, axes, jobs, outputs and stores, schedulers; then plot
+    row(f"{SWEEP} --grid l1=", "grid l1: empty; expected start:stop:count", SweepError),
+    row(f"{SWEEP} --grid l1=3:0.01:40:log", "a log grid runs from start up to stop", SweepError),
+    row(f"{SWEEP} --grid l1=1:0.1:5", r"expected start < stop but found 1.0 >= 0.1", SweepError),
+    row(f"{SWEEP} --grid l1=0.1:3:0", "count must be at least 1; found zero points", SweepError),
+    row(f"{SWEEP} --grid l1=0:3:10:log", "a log grid needs start > 0 and stop > 0", SweepError),
+    row(f"{SWEEP} --grid l1=0.1:3:2.5", "count must be a whole number of points", SweepError),
+    row(
+        f"{SWEEP} --grid l1=0.1:3", "expected start:stop:count or start:stop:count:log", SweepError
+    ),
+    row(f"{SWEEP} --grid l1=0.3,0.1", "values must be strictly increasing", SweepError),
+    row(f"{SWEEP} --grid l1=-1:1:3", r"gains must be positive \(L \+ Lᵀ ≻ 0\)", SweepError),
+    row(f"{SWEEP} --grid l1=a:1:3", "grid l1 start: expected a number; found 'a'", SweepError),
+    row(f"{SWEEP} --grid k=0.1:1:3", "gain axis 'k': expected l1, l2, ...", SweepError),
+    row(f"{SWEEP} --grid l1", "--grid expects NAME=VALUE such as l1=0.01:3:40:log", SweepError),
+    row(f"{SWEEP} --grid l1=0.1:1:3 --grid l1=1:2:3", "--grid l1 is given twice", SweepError),
+    row(
+        f"{SWEEP} --grid l2=0.1:1:3",
+        r"gain axis l2 is beyond the sensors \(1 sensor\); expected l1..l1",
+        SweepError,
+    ),
+    row(
+        f"{SWEEP} --param-grid mass=0:1:3",
+        "unknown parameter 'mass'; the model's parameters are T, rho",
+        ParameterError,
+    ),
+    row(f"{SWEEP} --param-grid rho=-1:1:3", "rho = -1.0: H must be positive definite", ModelError),
+    row(
+        f"{SWEEP} --param rho=2 --param-grid rho=1:2:3", "by --param and --param-grid", SweepError
+    ),
+    row(f"{SWEEP} --grid T=1:2:3", "T is a model parameter, not a gain", SweepError),
+    row("sweep wave --sensors 2,x --grid l1=1:2:3 -o {tmp}/m.zarr", "found 'x'", ObserverError),
+    row("sweep wave --sensors 3 --grid l1=1:2:3 -o {tmp}/m.zarr", "expected 1..2", ObserverError),
+    row(f"{SWEEP}", "a sweep needs at least one axis", SweepError),
+    row("sweep wave --grid l1=0.1:1:3 -o {tmp}/m.zarr", "gain axes need sensors", SweepError),
+    row(
+        "sweep wave --job classify --param-grid rho=1:2:3 -o {tmp}/m.zarr",
+        "job classify needs sensors",
+        SweepError,
+    ),
+    row(f"{MAP} --job classify --tol 1e-3 -o {{tmp}}/m.zarr", "has no option 'tol'", SweepError),
+    row(f"{MAP} --tol -1 -o {{tmp}}/m.zarr", "option tol: expected a positive number", SweepError),
+    row(f"{MAP} --job nosuch -o {{tmp}}/m.zarr", "argument --job: invalid choice: 'nosuch'", None),
+    row(
+        "sweep euler-bernoulli --sensors 3,4 --grid l1=0.1:1:3 --gain 1,2,3 -o {tmp}/m.zarr",
+        "expected 2 diagonal values (one per sensor) or a single one; found 3",
+        ObserverError,
+    ),
+    row(f"{MAP} --gain 0 -o {{tmp}}/m.zarr", "entry 1 must be a finite positive", ObserverError),
+    row(f"{MAP} --gain nan -o {{tmp}}/m.zarr", "entry 1 must be a finite positive", ObserverError),
+    row(
+        "sweep wave --sensor-sets 1;3 --grid l=1:2:3 -o {tmp}/m.zarr",
+        "output index 3 is out of range; expected 1..2",
+        SweepError,
+    ),
+    row("sweep wave --sensor-sets 1;1 --grid l=1:2:3 -o {tmp}/m.zarr", "given twice", SweepError),
+    row(
+        "sweep wave --sensor-sets 1,2;2 --gain 1,2 --grid l=1:2:3 -o {tmp}/m.zarr",
+        "with sensor sets the fixed gain is one value for every sensor",
+        SweepError,
+    ),
+    row(
+        "sweep wave --sensors 2 --sensor-sets 1 -o {tmp}/m.zarr",
+        "argument --sensor-sets: not allowed with argument --sensors",
+        None,
+    ),
+    row(f"{MAP}", "the following arguments are required: -o/--output", None),
+    row(
+        f"{MAP} -o {{tmp}}/m.txt", "unknown format '.txt'; expected a .zarr store", OutputFileError
+    ),
+    row(
+        f"{MAP} -o {{tmp}}/m.zarr",
+        "exists; resume the sweep it holds (--resume) or replace it (--force)",
+        OutputFileError,
+        **{"m.zarr": "not a store"},
+    ),
+    row(
+        f"{MAP} -o {{tmp}}/m.csv",
+        "exists; pass --force",
+        OutputFileError,
+        **{"m.csv": "earlier results"},
+    ),
+    row(
+        f"{MAP} -o {{tmp}}/m.zarr --resume",
+        "it is not a phdesign sweep store",
+        SweepError,
+        **{"m.zarr": "not a store"},
+    ),
+    row(f"{MAP} -o {{tmp}}/m.csv --resume", "resume continues a Zarr store", SweepError),
+    row(f"{MAP} -o {{tmp}}/m.zarr --resume --force", "not allowed with argument --resume", None),
+    row(f"{MAP} -o {{tmp}}/none/m.zarr", "folder .*none' does not exist", OutputFileError),
+    row(
+        "sweep wave --sensors 2 --grid l1=0.1:1:3 -o {tmp}/m.zarr --scheduler tcp://127.0.0.1:1",
+        "cannot reach the Dask scheduler at tcp://127.0.0.1:1",
+        SweepError,
+    ),
+    row(f"{MAP} -o {{tmp}}/m.zarr --scheduler nonsense", "expected 'synchronous'", SweepError),
+    row(f"{MAP} -o {{tmp}}/m.zarr --chunk-size 0", "chunk size must be a positive", SweepError),
+    row(f"{MAP} -o {{tmp}}/m.zarr --workers 0", "workers must be a positive integer", SweepError),
+    row(f"{MAP} -o {{tmp}}/m.zarr --method spectral", "argument --method: invalid choice", None),
+    row("plot {tmp}/none.zarr -o {tmp}/p.png", "no such file or folder", OutputFileError),
+    row(
+        "plot {tmp}/m.csv -o {tmp}/p.png",
+        "cannot read a sweep back from .*plots read .zarr or .nc",
+        SweepError,
+        **{"m.csv": "l1,kappa"},
+    ),
+    row(
+        "plot {tmp}/m.zarr -o {tmp}/p.png",
+        "is not a phdesign sweep store",
+        SweepError,
+        **{"m.zarr": "x"},
+    ),
+    row("plot {tmp}/m.nc -o {tmp}/p.png", "cannot read .* as NetCDF", SweepError, **{"m.nc": "x"}),
+    row("plot {tmp}/m.zarr -o {tmp}/p.xyz", "unknown image format 'xyz'", OutputFileError),
+    row(
+        "plot {tmp}/m.zarr -o {tmp}/p.png",
+        "exists; pass --force",
+        OutputFileError,
+        **{"p.png": "an earlier picture"},
+    ),
+    row("plot {tmp}/m.zarr -o {tmp}/p.png --select d", "--select expects NAME=VALUE", SweepError),
 ]
 
 

@@ -30,6 +30,7 @@ COMMAND_MODULES = (
     "phdesign.cli.noise_commands",
     "phdesign.cli.export_command",
     "phdesign.cli.loop_command",
+    "phdesign.cli.sweep_command",
 )
 
 

@@ -12,7 +12,12 @@ import argparse
 import sys
 from typing import Any
 
-from phdesign.cli.common import add_json_argument, add_model_argument, emit, emit_json, load_model
+from phdesign.cli.common import (
+    add_json_argument,
+    add_model_argument,
+    emit_result,
+    load_model,
+)
 from phdesign.cli.design_arguments import (
     add_observer_arguments,
     observer_from_args,
@@ -63,11 +68,7 @@ def _classify(args: argparse.Namespace) -> int:
     if observer is None:
         raise ObserverError("classify needs --sensors, --cm or --all-sensors")
     result = observer.classify(method=args.method)
-    if args.json:
-        emit_json(result.to_dict())
-    else:
-        emit(str(result))
-    return 0
+    return emit_result(args, result)
 
 
 def _progress_bar() -> Any:
@@ -92,8 +93,4 @@ def _search(args: argparse.Namespace, model: Any) -> int:
         found = search_sensors(model, gain=gain, progress=_progress_bar())
     except ObserverError as error:
         raise with_option_names(error) from None
-    if args.json:
-        emit_json(found.to_dict())
-    else:
-        emit(str(found))
-    return 0
+    return emit_result(args, found)

@@ -117,6 +117,18 @@ def emit_json(value: Any) -> None:
     emit(dumps_json(value))
 
 
+def emit_result(args: argparse.Namespace, result: Any, model: str | None = None) -> int:
+    """Print a result as JSON with ``--json``, else the text it prints itself; return 0.
+
+    The JSON is ``result.to_dict()``, after a ``"model"`` key when ``model`` is given.
+    """
+    if getattr(args, "json", False):
+        emit_json({**({} if model is None else {"model": model}), **result.to_dict()})
+    else:
+        emit(str(result))
+    return 0
+
+
 def write_output(path: str, text: str | bytes, force: bool) -> None:
     """Write an output file atomically, refusing to overwrite unless ``force``."""
     from phdesign.io import atomic_write

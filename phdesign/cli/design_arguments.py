@@ -67,15 +67,9 @@ def add_observer_arguments(
 
 def parse_sensors_text(text: str) -> list[int]:
     """Read ``"3,4"`` into ``[3, 4]`` (the indices are checked by the observer)."""
-    indices = []
-    for part in (p.strip() for p in str(text).split(",")):
-        if not re.fullmatch(r"[+-]?\d+", part):
-            raise ObserverError(
-                f"--sensors: expected comma-separated output indices like 3,4; "
-                f"found {part!r} in {text!r}"
-            )
-        indices.append(int(part))
-    return indices
+    from phdesign.symbolic.observer import parse_sensor_indices  # sympy: on first use
+
+    return parse_sensor_indices(text, "--sensors")
 
 
 def parse_rows_text(text: str, option: str) -> Any:

@@ -15,8 +15,7 @@ from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
     check_finite_series,
-    emit,
-    emit_json,
+    emit_result,
     load_model,
     run_outputs,
     simulation_text,
@@ -156,11 +155,7 @@ def _loop(args: argparse.Namespace, numeric: bool = True) -> Any:
 
 
 def _print(args: argparse.Namespace, result: Any, model: str) -> int:
-    if args.json:
-        emit_json({"model": model, **result.to_dict()})
-    else:
-        emit(str(result))
-    return 0
+    return emit_result(args, result, model=model)
 
 
 def _classify(args: argparse.Namespace) -> int:

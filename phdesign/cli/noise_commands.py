@@ -29,7 +29,7 @@ from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
     emit,
-    emit_json,
+    emit_result,
     write_output,
 )
 from phdesign.cli.design_arguments import add_observer_arguments
@@ -225,10 +225,7 @@ def _noise(args: argparse.Namespace) -> int:
         resolution=args.resolution,
         tol=args.tol,
     )
-    if args.json:
-        emit_json(report.to_dict())
-    else:
-        emit(str(report))
+    emit_result(args, report)
     if args.plot:
         report.plot(args.plot, force=args.force)
     return 0
@@ -439,8 +436,4 @@ def noise_tuning(args: argparse.Namespace) -> int | None:
         min_decay=args.min_decay,
         **_noise_inputs(args, nm, model, C_m.shape[0]),
     )
-    if args.json:
-        emit_json({"model": model.name, **result.to_dict()})
-    else:
-        emit(str(result))
-    return 0
+    return emit_result(args, result, model=model.name)

@@ -21,8 +21,7 @@ from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
     check_finite_series,
-    emit,
-    emit_json,
+    emit_result,
     load_model,
     non_negative_int,
     run_outputs,
@@ -199,11 +198,7 @@ def _spectrum(args: argparse.Namespace) -> int:
         tol=args.tol,
         count=args.count,
     )
-    if args.json:
-        emit_json(rep.to_dict())
-    else:
-        emit(str(rep))
-    return 0
+    return emit_result(args, rep)
 
 
 def _simulate(args: argparse.Namespace) -> int:
@@ -349,8 +344,4 @@ def _tune(args: argparse.Namespace) -> int:
     finally:
         if progress is not None:
             progress.clear()
-    if args.json:
-        emit_json(res.to_dict())
-    else:
-        emit(str(res))
-    return 0
+    return emit_result(args, res)

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -169,8 +169,8 @@ def parse_functionals(
     """Read a list of performance outputs; ``None`` gives :func:`default_performance`."""
     if items is None:
         return default_performance(nm)
-    if isinstance(items, (str, Functional)):
-        items = [items]
+    if isinstance(items, (str, Functional)) or not isinstance(items, Iterable):
+        items = [items]  # one output; a non-text one is refused by parse_functional
     out = tuple(
         item if isinstance(item, Functional) else parse_functional(item, nm, model)
         for item in items

@@ -47,7 +47,12 @@ is reported, never a number) or not converged.  The gain γ obeys the spectrum's
 unresolved high frequencies of a discretization lose the boundary damping (on the damped
 wave its H∞ peak grows like p²), so γ is the peak over the *resolved band*
 :math:`|\omega| \le \Omega`, Ω the largest modulus of an eigenvalue that agrees between
-the two resolutions of a pair, compared between both members of the pair on that band.
+the two resolutions of a pair.  Ω is the edge of what the pair's *coarse* member
+resolves, so that member is checked on the trimmed band :math:`(p_c/p_f)\,\Omega`, as far
+inside its resolution as the fine member is at Ω.  Peaks within the tolerance of the
+largest are equal, and the lowest-frequency one is reported with its frequency: the damped
+wave's response has equal peaks at infinitely many frequencies (one per resonance), and
+the first is both the PDE's answer and the one a discretization resolves best.
 The discretization's own supremum over all frequencies is reported beside it.
 """
 
@@ -61,6 +66,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from phdesign.arguments import positive_int, positive_number
 from phdesign.errors import NumericError, ObserverError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
@@ -87,6 +93,8 @@ __all__ = [
 DEFAULT_TOL = {"galerkin": 1e-6, "fd": 1e-3}
 #: Relative drift under which an eigenvalue is resolved (the spectrum's defaults).
 RESOLVED_RTOL = {"galerkin": 1e-6, "fd": 1e-2}
+#: Grid maxima this far (relative) below the largest peak are not refined as its ties.
+_TIE_SCREEN = 1e-2
 
 
 def check_intensity(values: Any, count: int, name: str) -> np.ndarray:
@@ -239,6 +247,7 @@ def peak_gain(
     eigenvalues: np.ndarray,
     refine: int = 3,
     rtol: float = 1e-7,
+    ties: float = 0.0,
 ) -> tuple[float, float]:
     """Return ``(gain, frequency)``: the largest ``response`` over ``0 <= omega <= upper``.
 
@@ -247,6 +256,12 @@ def peak_gain(
     (Brent, to ``rtol`` in ω: the peak value is then exact to about ``rtol``²
     relative to the peak's width) of the ``refine`` highest local maxima between their
     grid neighbours.
+
+    With ``ties > 0``, peaks within ``ties`` (relative) of the largest are equal: the
+    lowest-frequency one is returned, with its own value.  A PDE whose response has equal
+    peaks at infinitely many frequencies (the damped wave: one per resonance) attains its
+    supremum at the first; a discretization resolves that one best, while the highest it
+    happens to find may lie at the edge of what it resolves.
     """
     lam = eigenvalues[np.isfinite(eigenvalues)]
     freqs = np.abs(lam.imag)
@@ -267,28 +282,48 @@ def peak_gain(
     grid = grid[np.r_[True, np.diff(grid) > 1e-12 * np.maximum(1.0, grid[1:])]]
     values = response(grid)
     interior = np.r_[True, values[1:] >= values[:-1]] & np.r_[values[:-1] >= values[1:], True]
-    candidates = np.flatnonzero(interior)
-    candidates = candidates[np.argsort(-values[candidates])[:refine]]
-    best = (float(values[candidates[0]]), float(grid[candidates[0]]))
-    for k in (int(c) for c in candidates):
+    maxima = np.flatnonzero(interior)
+
+    def refined(k: int) -> tuple[float, float]:
+        """Return the local maximum bracketed by the grid neighbours of point ``k``."""
+        point = (float(values[k]), float(grid[k]))
         lo, hi = float(grid[max(k - 1, 0)]), float(grid[min(k + 1, grid.size - 1)])
         if hi <= lo:
-            continue
+            return point
         found = minimize_scalar(
             lambda w: -response_at(float(w)),
             bounds=(lo, hi),
             method="bounded",
             options={"xatol": rtol * max(1.0, hi)},
         )
-        value = -float(found.fun)
-        if value > best[0]:
-            best = (value, float(found.x))
+        return max(point, (-float(found.fun), float(found.x)))
+
+    highest = maxima[np.argsort(-values[maxima])[:refine]]
+    peaks = {int(k): refined(int(k)) for k in highest}
+    best = max(peaks.values())
+    if ties <= 0:
+        return best
+    # the lowest-frequency peak within `ties` of the largest; grid values are lower
+    # bounds of their peaks, so a grid maximum below the threshold can still reach it
+    threshold = (1.0 - ties) * best[0]
+    for k in (int(k) for k in maxima):
+        if grid[k] >= best[1]:
+            break
+        if values[k] < (1.0 - _TIE_SCREEN) * best[0]:
+            continue
+        peak = peaks.get(k) or refined(k)
+        if peak[0] >= threshold:
+            return peak
     return best
 
 
-def _sup(stats: ErrorStatistics, upper: float, refine: int = 3) -> tuple[float, float]:
+def _sup(
+    stats: ErrorStatistics, upper: float, refine: int = 3, ties: float = 0.0
+) -> tuple[float, float]:
     pencil = stats.pencil
-    return peak_gain(pencil.response, pencil.response_at, upper, stats.eigenvalues, refine)
+    return peak_gain(
+        pencil.response, pencil.response_at, upper, stats.eigenvalues, refine, ties=ties
+    )
 
 
 def _resolved_band(fine: ErrorStatistics, coarse: ErrorStatistics, rtol: float) -> float | None:
@@ -356,16 +391,18 @@ def noise(
     feedback_matrix(C, Lm, nm.n_ports)  # shapes and L + L^T > 0, before any work
     sigma, w_in = noise_intensities(nm, C.shape[0], intensity, input_intensity)
     functionals = parse_functionals(performance, nm, model)
-    if tol is None:
-        tol = DEFAULT_TOL.get(method, 1e-3)
-    if not (math.isfinite(tol) and tol > 0):
-        raise NumericError(f"tol must be a positive number; found {tol}")
+    tol = DEFAULT_TOL.get(method, 1e-3) if tol is None else positive_number(tol, "tol")
     rtol = RESOLVED_RTOL.get(method, 1e-2)
     p0, pmax = default_resolutions(nm, method)
-    p = int(resolution) if resolution is not None else p0
-    pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
-    if p <= 0 or pmax < p:
-        raise NumericError(f"resolution must be positive and at most max_resolution; found {p}")
+    p = p0 if resolution is None else positive_int(resolution, "resolution")
+    if max_resolution is None:
+        pmax = max(pmax, p)
+    else:
+        pmax = positive_int(max_resolution, "max_resolution")
+        if pmax < p:
+            raise NumericError(
+                f"max_resolution must be at least the first resolution {p}; found {pmax}"
+            )
     cache = discretizations if discretizations is not None else {}
 
     run = _Refinement(functionals, tol)
@@ -381,16 +418,29 @@ def noise(
     return run.report(nm, C, Lm, sigma, w_in, method)
 
 
-def _gain_pair(coarse: ErrorStatistics, fine: ErrorStatistics, rtol: float) -> dict[str, Any]:
-    """Return the peak over the pair's resolved band at both of its members."""
+def _gain_pair(
+    coarse: ErrorStatistics, fine: ErrorStatistics, rtol: float, tol: float
+) -> dict[str, Any]:
+    r"""Return the fine member's peak over the pair's resolved band, and its check.
+
+    The band :math:`|\omega| \le \Omega` is where the two members' eigenvalues agree, so
+    :math:`\Omega` is the edge of what the *coarse* member resolves, while the fine member
+    is there only about :math:`p_c / p_f` of the way to its own edge.  The coarse member
+    is therefore compared on the trimmed band :math:`|\omega| \le (p_c/p_f)\,\Omega`,
+    where it is as far inside its resolution as the fine member is at :math:`\Omega`
+    (near the edge its response lags its eigenvalues: the tails of the unresolved
+    resonances just above).  Peaks within ``tol`` of the largest count as equal and the
+    lowest-frequency one is taken (:func:`peak_gain`): the figure cannot tell them apart,
+    and the first is the one both members resolve best.
+    """
     out: dict[str, Any] = {"resolution": fine.resolution, "band": None}
     if not (coarse.stable and fine.stable):
         return out
     band = _resolved_band(fine, coarse, rtol)
     out["band"] = band
     if band is not None:
-        out["fine"] = _sup(fine, band)
-        out["coarse"] = _sup(coarse, band)
+        out["fine"] = _sup(fine, band, ties=tol)
+        out["coarse"] = _sup(coarse, band * coarse.resolution / fine.resolution, ties=tol)
     return out
 
 
@@ -417,7 +467,7 @@ class _Refinement:
         self.variances.append([stats.variance(r) for r in rows])
         self.sups.append(_discrete_sup(stats) if stats.stable else (math.inf, math.nan))
         if len(self.stats) >= 2:
-            self.pairs.append(_gain_pair(self.stats[-2], stats, rtol))
+            self.pairs.append(_gain_pair(self.stats[-2], stats, rtol, self.tol))
 
     @property
     def steady(self) -> bool:

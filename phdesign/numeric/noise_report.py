@@ -8,7 +8,6 @@ noise-aware tuning results.
 
 from __future__ import annotations
 
-import html
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -32,9 +31,13 @@ class GainEstimate:
     Attributes
     ----------
     estimate : Estimate
-        The peak over the resolved band at the fine member of each resolution pair.
+        The peak over the resolved band at the fine member of each resolution pair; its
+        comparison pair is the coarse member's peak over the trimmed band
+        (:func:`phdesign.numeric.noise.noise`).
     frequency : float or None
-        Where the finest peak lies (rad per unit time).
+        Where the finest peak lies (rad per unit time): the lowest frequency among peaks
+        equal to the tolerance (the damped wave's first resonance, not one of the
+        infinitely many after it).
     frequencies : tuple of float
         The peak frequency of every pair.
     band : float or None
@@ -339,10 +342,7 @@ def _numbers(values: Sequence[float] | np.ndarray) -> str:
 
 
 def html_table(header: Sequence[str], rows: Sequence[Sequence[Any]], caption: str = "") -> str:
-    """Return a small HTML table (escaped) for ``_repr_html_``."""
-    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
-    body = "".join(
-        "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows
-    )
-    cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
-    return f"<table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    """Return a small HTML table (escaped) for ``_repr_html_`` (the package's one table)."""
+    from phdesign._display import html_table as table
+
+    return table(header, rows, caption or None)

@@ -6,9 +6,13 @@ values :math:`f_0, \dots, f_m` at resolutions :math:`p_0 < \dots < p_m`:
 - it has **converged** when the last two agree,
   :math:`|f_m - f_{m-1}| \le \mathrm{tol} \cdot |f_m|`; its digits are
   :math:`-\log_{10}(|f_m - f_{m-1}| / |f_m|)`;
-- it **diverges** when, over the last three, it grows and its growth per unit of
-  :math:`\log p` does not slow down,
+- it **diverges** when, over the last three, it grows by more than its tolerance at each
+  step, :math:`f_k - f_{k-1} > \mathrm{tol} \cdot |f_k|` for :math:`k = m-1, m`, and its
+  growth per unit of :math:`\log p` does not slow down,
   :math:`d_k = (f_k - f_{k-1}) / \log(p_k / p_{k-1})`, :math:`d_m \ge 0.95\, d_{m-1} > 0`.
+  Increments below the tolerance are the figure's own noise (round-off, or the last digits
+  of a converged value), not growth: a value that agrees to 13 digits at every resolution
+  but whose comparison pair disagrees is *not converged*, never diverging.
   A convergent sequence :math:`f_\infty - c p^{-s}` has :math:`d_m / d_{m-1} =
   (p_{m-1}/p_m)^{s} < 1`; a divergent one :math:`c p^r` or :math:`c \log p` has a ratio
   :math:`\ge 1`.  The local growth exponent :math:`r = \log(f_m/f_{m-1}) / \log(p_m/p_{m-1})`
@@ -31,7 +35,7 @@ __all__ = ["DIVERGENCE_RATIO", "Estimate", "settle"]
 DIVERGENCE_RATIO = 0.95
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Estimate:
     """One figure at several resolutions and its verdict (module docstring).
 
@@ -70,6 +74,26 @@ class Estimate:
         if self.digits is None:
             return "not converged"
         return f"not converged ({max(self.digits, 0.0):.1f} digits)"
+
+    def __str__(self) -> str:
+        """``w(1) = 0.1347085719   converged (8.5 digits) (0.1347, ... at resolutions ...)``."""
+        values = ", ".join(f"{v:.6g}" for v in self.values)
+        at = ", ".join(str(r) for r in self.resolutions)
+        head = self.name if self.value is None else f"{self.name} = {self.value:.10g}"
+        return f"{head}   {self.status()}" + (f" ({values} at resolutions {at})" if at else "")
+
+    def __repr__(self) -> str:
+        value = None if self.value is None else float(f"{self.value:.10g}")
+        return (
+            f"Estimate(name={self.name[:60]!r}, value={value}, status={self.status()!r}, "
+            f"resolutions={self.resolutions[-6:]})"
+        )
+
+    def _repr_html_(self) -> str:
+        from phdesign._display import html_table
+
+        rows = [[str(r), f"{v:.12g}"] for r, v in zip(self.resolutions, self.values, strict=True)]
+        return html_table(["resolution", self.name], rows, footer=self.status())
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary (non-finite values become null)."""
@@ -117,6 +141,8 @@ def settle(
     'diverges (grows like p^1.00)'
     >>> settle("w(1)", [0.1347085750, 0.1347085724], [20, 30], 1e-6).status()
     'converged (7.7 digits)'
+    >>> settle("g", [1, 1 + 1e-14, 1 + 3e-14], [30, 45, 68], 1e-6, pair=(1, 1 + 2e-6)).status()
+    'not converged (5.7 digits)'
     """
     f = [float(v) for v in values]
     p = [int(r) for r in resolutions]
@@ -136,10 +162,14 @@ def settle(
         if any(not math.isfinite(v) for v in f[-2:]):
             diverges = True
         else:
-            rates = [
-                (f[k] - f[k - 1]) / math.log(p[k] / p[k - 1]) for k in (len(f) - 2, len(f) - 1)
-            ]
-            diverges = rates[0] > 0 and rates[1] >= DIVERGENCE_RATIO * rates[0] and f[-2] > 0
+            last = (len(f) - 2, len(f) - 1)
+            rates = [(f[k] - f[k - 1]) / math.log(p[k] / p[k - 1]) for k in last]
+            # growth is evidence only where it exceeds the figure's own accuracy: two
+            # round-off increments (1e-14 on a value of 1) are not a trend
+            visible = all(f[k] - f[k - 1] > tol * abs(f[k]) for k in last)
+            diverges = (
+                visible and rates[0] > 0 and rates[1] >= DIVERGENCE_RATIO * rates[0] and f[-2] > 0
+            )
             if diverges:
                 growth = math.log(f[-1] / f[-2]) / math.log(p[-1] / p[-2])
     return Estimate(name, tuple(f), tuple(p), bool(converged), bool(diverges), digits, growth)

@@ -32,13 +32,15 @@ matrix in the efforts, or :math:`V^\top E V` after a reduction x = V x_r).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from phdesign.errors import NumericError
+from phdesign.arguments import positive_number
+from phdesign.errors import ArgumentError, NumericError
+from phdesign.numeric.arguments import check_initial_state
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.order import REDUCTIONS, OrderSelection, check_order, select_order
 from phdesign.numeric.sampling import (
@@ -429,6 +431,27 @@ def _plant_degree(nm: NumericModel, order: int | None, plant_resolution: int | N
     return max(PLANT_DEGREE, needed)
 
 
+def _displacement_points(nm: NumericModel, points: Any) -> tuple[float, ...]:
+    """Return the points of the outputs ``w(z)``: numbers of [a, b] (default: b, if any)."""
+    if points is None:
+        return (nm.interval[1],) if nm.displacement is not None else ()
+    a, b = nm.interval
+    if nm.displacement is None and np.size(points):
+        raise NumericError(
+            f"points: model {nm.name!r} has no displacement: drop the displacement points"
+        )
+    try:
+        values = tuple(float(z) for z in np.asarray(points, dtype=float).ravel())
+    except (TypeError, ValueError):
+        raise NumericError(
+            f"points: expected numbers in [{a:g}, {b:g}]; found {points!r}"
+        ) from None
+    outside = [z for z in values if not (math.isfinite(z) and a <= z <= b)]
+    if outside:
+        raise NumericError(f"points: expected numbers in [{a:g}, {b:g}]; found {outside[0]:g}")
+    return values
+
+
 def export_observer(
     nm: NumericModel,
     C_m: np.ndarray,
@@ -445,7 +468,7 @@ def export_observer(
     x0_text: str | None = None,
     t_end: float = 5.0,
     plant_resolution: int | None = None,
-    points: tuple[float, ...] | None = None,
+    points: float | Sequence[float] | None = None,
     model_name: str | None = None,
 ) -> SampledObserver:
     """Design the observer a controller runs: order, sampled discretization, verification.
@@ -476,7 +499,7 @@ def export_observer(
         Length of those runs.
     plant_resolution : int, optional
         Galerkin degree of the verification plant (default 48, raised to twice the order).
-    points : tuple of float, optional
+    points : float or sequence of float, optional
         Displacement points of the outputs ``w(z)``; default (b,) for a model with a
         displacement, none otherwise.
     model_name : str, optional
@@ -502,9 +525,13 @@ def export_observer(
         raise NumericError(f"unknown reduction {reduction!r}; expected one of {REDUCTIONS}")
     if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a finite positive number; found {t_end!r}")
+    if not isinstance(verify, bool):
+        raise ArgumentError(f"verify must be True or False; found {verify!r}")
+    positive_number(tol, "tol")
+    positive_number(output_tol, "output_tol")
+    check_initial_state(x0, nm, "x0")
     plant_degree = verification_plant_degree(nm, order, plant_resolution, reduction)
-    if points is None:
-        points = (nm.interval[1],) if nm.displacement is not None else ()
+    points = _displacement_points(nm, points)
     plant = discretize(nm, "galerkin", plant_degree)
     initial = default_initial_state(nm.size, nm.interval) if x0 is None else x0
     text = x0_text or ("x_i = (z - a)/(b - a) - 0.9 for every component" if x0 is None else "x0")

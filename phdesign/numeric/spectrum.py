@@ -73,6 +73,7 @@ from phdesign.numeric.scales import ProblemScales
 from phdesign.numeric.spectrum_refinement import (
     ILL_CONDITION,
     ClosedLoopSolver,
+    Discretizations,
     PairResult,
     choose_pair,
     extinct_twice,
@@ -325,6 +326,7 @@ def spectrum(
     rtol_resolved: float | None = None,
     count: int = 6,
     basis: str | None = None,
+    discretizations: Discretizations | None = None,
 ) -> SpectrumReport:
     """Converged spectral abscissa and rightmost eigenvalues (module docstring).
 
@@ -350,6 +352,10 @@ def spectrum(
         The Galerkin basis (default: the defaults table's for the model's order,
         :mod:`phdesign.numeric.defaults`); the plain Legendre basis lowers the largest
         resolution for N >= 3, where its round-off grows with the degree.
+    discretizations : Discretizations, optional
+        The model's discretizations by ``method`` and ``basis``, shared by many calls at
+        different gains (:class:`~phdesign.numeric.spectrum_refinement.Discretizations`):
+        the report is the same, without discretizing again.
 
     Returns
     -------
@@ -379,7 +385,9 @@ def spectrum(
     pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
     system = "plant (u = 0)" if K is None else "observer error system"
     with small_dense_threads():
-        solver = ClosedLoopSolver(nm, K, method=method, basis=basis)
+        solver = ClosedLoopSolver(
+            nm, K, method=method, basis=basis, discretizations=discretizations
+        )
         trail = refine(solver, start=p, stop=pmax, tol=tol, rtol_resolved=rtol_resolved)
     scales = solver.scales
     sensors = None if C_m is None else np.atleast_2d(np.asarray(C_m, float)).tolist()

@@ -26,11 +26,12 @@ from typing import Protocol
 
 import numpy as np
 
+from phdesign.errors import NumericError
 from phdesign.numeric.abscissa import MIN_MODES_ABOVE, Abscissa, estimate_abscissa
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.drift import PairSpectrum, pair_spectrum
-from phdesign.numeric.eigen import SHIFT, prepare, rescaled
+from phdesign.numeric.eigen import SHIFT, PreparedSystem, prepare, rescaled
 from phdesign.numeric.evaluator import fine_resolution
 from phdesign.numeric.scales import dimensionless_model
 from phdesign.numeric.spectrum_report import RefinementStep
@@ -38,6 +39,7 @@ from phdesign.numeric.spectrum_report import RefinementStep
 __all__ = [
     "ILL_CONDITION",
     "ClosedLoopSolver",
+    "Discretizations",
     "PairResult",
     "ResolutionSolver",
     "choose_pair",
@@ -139,31 +141,84 @@ class ResolutionSolver(Protocol):
         ...
 
 
+class Discretizations:
+    """The dimensionless model's discretizations, once per resolution, for any gain.
+
+    They do not depend on the gain, so a gain map shares one (the sweep's ``spectrum`` job
+    gives one to :func:`phdesign.numeric.spectrum.spectrum` for every gain of a chunk);
+    :func:`refine` makes its own when given none.
+
+    Parameters
+    ----------
+    nm : NumericModel
+    method : {"galerkin", "fd"}
+    basis : {"scaled", "legendre"}, optional
+        The Galerkin basis (default: the defaults table's, for the order).
+    """
+
+    def __init__(self, nm: NumericModel, method: str, basis: str | None = None) -> None:
+        self.model, self.method, self.basis = nm, method, basis
+        self.dimensionless, self.scales = dimensionless_model(nm)
+        self._cache: dict[int, PreparedSystem] = {}
+
+    def serves(self, nm: NumericModel, method: str, basis: str | None) -> bool:
+        """Tell whether these discretizations are those of ``nm`` by ``method`` and ``basis``."""
+        return self.model is nm and self.method == method and self.basis == basis
+
+    def __call__(self, p: int) -> PreparedSystem:
+        """Return the discretization at resolution ``p``, prepared for the eigen stage (cached).
+
+        Shift and invert (:mod:`phdesign.numeric.eigen`) at
+        :data:`~phdesign.numeric.eigen.SHIFT`, the rate of the dimensionless model.
+        """
+        if p not in self._cache:
+            discrete = discretize(self.dimensionless, self.method, p, basis=self.basis)
+            self._cache[p] = prepare(discrete, shift=SHIFT)
+        return self._cache[p]
+
+
 class ClosedLoopSolver:
     r"""Eigenvalues of the closed loop ũ = −Kỹ of the dimensionless model, once per resolution.
 
-    Shift and invert (:mod:`phdesign.numeric.eigen`) at :data:`~phdesign.numeric.eigen.SHIFT`
-    times the rate (1 for the dimensionless model), scaled back by the rate.  The closed
-    loop is dissipative: the model and its discretizations check their invariants and
-    ``K`` comes from :func:`~phdesign.numeric.discretize.feedback_matrix`
-    (:math:`L + L^\top \succ 0`).
+    Shift and invert (:mod:`phdesign.numeric.eigen`) on the discretizations of
+    :class:`Discretizations` (made here unless given: a gain map shares them), scaled back
+    by the rate.  The closed loop is dissipative: the model and its discretizations check
+    their invariants and ``K`` comes from
+    :func:`~phdesign.numeric.discretize.feedback_matrix` (:math:`L + L^\top \succ 0`).
+
+    Raises
+    ------
+    NumericError
+        If ``discretizations`` are not those of ``nm`` by ``method`` and ``basis``.
     """
 
     dissipative = True
 
     def __init__(
-        self, nm: NumericModel, K: np.ndarray | None, *, method: str, basis: str | None = None
+        self,
+        nm: NumericModel,
+        K: np.ndarray | None,
+        *,
+        method: str,
+        basis: str | None = None,
+        discretizations: Discretizations | None = None,
     ) -> None:
-        self.dimensionless, self.scales = dimensionless_model(nm)
+        if discretizations is None:
+            discretizations = Discretizations(nm, method, basis)
+        elif not discretizations.serves(nm, method, basis):
+            raise NumericError(
+                "discretizations: expected those of this model, method and basis; found "
+                f"{discretizations.model.name!r} by {discretizations.method!r} "
+                f"(basis {discretizations.basis!r})"
+            )
+        self.discretizations, self.scales, self.K = discretizations, discretizations.scales, K
         self.rate = self.scales.rate
-        self.method, self.K, self.basis = method, K, basis
         self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
         """Eigenvalues and condition numbers at resolution ``p`` (cached)."""
         if p not in self._cache:
-            discrete = discretize(self.dimensionless, self.method, p, basis=self.basis)
-            lam, kappa = prepare(discrete, shift=SHIFT).eigen_condition(self.K)
+            lam, kappa = self.discretizations(p).eigen_condition(self.K)
             self._cache[p] = (rescaled(lam, self.rate), kappa)
         return self._cache[p]
 

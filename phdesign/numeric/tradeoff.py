@@ -288,7 +288,9 @@ def gain_family(
     if grid is not None:
         if direction is not None or scales is not None:
             raise NumericError("give either a grid of gains or a ray (direction and scales)")
-        axes = [np.atleast_1d(np.asarray(a, dtype=float)) for a in grid]
+        if isinstance(grid, str) or not isinstance(grid, Sequence | np.ndarray):
+            raise NumericError(f"grid: expected one sequence of gains per sensor; found {grid!r}")
+        axes = [np.atleast_1d(_floats(a, f"grid axis {i + 1}")) for i, a in enumerate(grid)]
         if len(axes) != q:
             raise NumericError(f"grid: expected {q} axes (one per sensor); found {len(axes)}")
         for i, a in enumerate(axes):
@@ -298,13 +300,21 @@ def gain_family(
                 )
         gains = [np.diag(np.array(c)) for c in product(*axes)]
         return gains, [None] * len(gains), None
-    L0 = np.eye(q) if direction is None else np.asarray(direction, dtype=float)
+    L0 = np.eye(q) if direction is None else _floats(direction, "direction")
     if L0.ndim == 1:
         L0 = np.diag(np.broadcast_to(L0, (q,)) if L0.size == 1 else L0)
-    s = np.geomspace(0.1, 10.0, 12) if scales is None else np.asarray(scales, dtype=float)
+    s = np.geomspace(0.1, 10.0, 12) if scales is None else _floats(scales, "scales").ravel()
     if s.size == 0 or not np.all(np.isfinite(s)) or np.any(s <= 0):
         raise NumericError(f"scales: expected positive finite numbers; found {s.tolist()}")
     return [float(v) * L0 for v in s], [float(v) for v in s], L0
+
+
+def _floats(values: Any, name: str) -> np.ndarray:
+    """``values`` as a float array, or a :class:`NumericError` naming ``name``."""
+    try:
+        return np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise NumericError(f"{name}: expected numbers; found {values!r}") from None
 
 
 def tradeoff(

@@ -33,9 +33,13 @@ and the identities of the open plant become (direct expansion, using
     W_C' \Sigma W_B'^\top = \begin{pmatrix} 0 & I \end{pmatrix}, \qquad
     W_C' \Sigma W_C'^\top = 0 .
 
-The first is the dissipative boundary of Jacob and Zwart (Theorem 7.2.4: with
-:math:`u_r = 0` the operator generates a contraction semigroup iff
-:math:`W_B'\Sigma W_B'^\top \succeq 0`); the other two say that :math:`y_r` is still
+The first is the dissipative boundary of Le Gorrec, Zwart and Maschke (*Dirac structures
+and boundary control systems associated with skew-symmetric differential operators*, SIAM
+J. Control Optim. 44(5), 1864-1892, 2005): for the skew-symmetric operator
+:math:`\sum_k P_k \partial_z^k \mathcal H` of any order N with a full-rank boundary
+operator, :math:`u_r = 0` gives a contraction semigroup iff
+:math:`W_B'\Sigma W_B'^\top \succeq 0` (a dissipative :math:`P_0`,
+:math:`P_0 + P_0^\top \preceq 0`, keeps it one); the other two say that :math:`y_r` is still
 power conjugate to :math:`u_r` and blind to the closed condition.  On the admissible
 traces the power is :math:`u^\top y = u_r^\top y_r + u_c^\top y_c`, so the energy balance
 of the closed plant is
@@ -182,9 +186,9 @@ def check_feedback(
 
     Called by the model's validation; returns how each condition was checked.
     """
-    from phdesign.symbolic import model as model_module
     from phdesign.symbolic.definiteness import check_definite
     from phdesign.symbolic.expressions import Z
+    from phdesign.symbolic.validation import check_finite, check_symbols
 
     feedback = model.feedback
     if feedback is None:
@@ -193,8 +197,8 @@ def check_feedback(
     K = feedback.gain
     if Z in K.free_symbols:
         raise ModelError("feedback gain K must not depend on z; it acts at the boundary")
-    model_module.check_symbols(K, "feedback gain K", symbols)
-    model_module.check_finite(K, "feedback gain K", defaults)
+    check_symbols(K, "feedback gain K", symbols)
+    check_finite(K, "feedback gain K", defaults)
     dissipative = check_definite(
         K + K.T, "K + K^T", model.interval, defaults, sign=1, strict=False
     )

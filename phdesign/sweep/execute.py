@@ -1,0 +1,222 @@
+"""Running a sweep: chunks as tasks, results written as they arrive.
+
+:func:`run_chunk` is the task.  It runs wherever the scheduler puts it (this process, a
+local worker, a remote one) and depends on its arguments only: it rebuilds the model
+from the description's TOML, applies the setting's parameter values, prepares the job's
+evaluator once per setting (kept for the next chunks of the same setting in that
+process), evaluates every point of the chunk with one BLAS thread, and returns the
+figures.  :func:`run` plans the chunks, checks the output before anything runs, opens
+the executor, and writes each chunk as it completes (Zarr) or collects it (in memory,
+CSV, NetCDF), with a progress bar on a terminal.
+
+The figures of a point do not depend on the chunk it belongs to, on the other points of
+the chunk, on the order in which chunks complete or on the process that ran them: a
+synchronous run, a local cluster and a remote one give identical arrays.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from phdesign.errors import PhdesignError, SweepError
+from phdesign.sweep.dataset import RUN_ATTRIBUTE, template
+from phdesign.sweep.description import SweepDescription
+from phdesign.sweep.export import output_format, write_export
+from phdesign.sweep.plan import ChunkPlan, check_chunk_size
+
+__all__ = ["default_chunk_size", "run", "run_chunk"]
+
+
+def default_chunk_size(description: SweepDescription) -> int:
+    """Return the points per chunk: about half a second of the job's work."""
+    job = description.job_spec
+    size = job.points_per_chunk if description.has_gain_axes else job.settings_per_chunk
+    return max(1, min(size, description.size))
+
+
+@lru_cache(maxsize=4)
+def _description(text: str) -> SweepDescription:
+    return SweepDescription.from_json(text)
+
+
+@lru_cache(maxsize=8)
+def _evaluator(text: str, setting: tuple[Any, ...]) -> Any:
+    """Return the job's evaluator for one setting, built once per process and setting."""
+    from phdesign.io import model_from_toml
+
+    description = _description(text)
+    sensors, params = setting
+    model = model_from_toml(description.model_toml, source=f"sweep model {description.model_name}")
+    if params:
+        model = model.with_parameters(dict(params))
+    factory = description.job_spec.evaluator_factory()
+    return factory(model, sensors, dict(description.options))
+
+
+def _point_label(description: SweepDescription, point: tuple[int, ...]) -> str:
+    return ", ".join(
+        f"{a.name}={a.values[i]!r}" for a, i in zip(description.axes, point, strict=True)
+    )
+
+
+def run_chunk(text: str, chunk_shape: tuple[int, ...], index: int) -> dict[str, Any]:
+    """Compute one chunk: ``{"index", "arrays": {figure: block}, "seconds"}``.
+
+    Raises
+    ------
+    SweepError
+        The worker runs another phdesign version than the description's.
+    PhdesignError
+        A point the library refuses (its message names the point).
+    """
+    from threadpoolctl import threadpool_limits
+
+    from phdesign import __version__
+
+    description = _description(text)
+    if description.version != __version__:
+        raise SweepError(
+            f"a worker runs phdesign {__version__}; the sweep was described with "
+            f"{description.version}: install the same version on every worker"
+        )
+    plan = ChunkPlan(description.shape, tuple(chunk_shape))
+    region = plan.region(index)
+    figures = description.job_spec.figures
+    names = {f.name for f in figures}
+    block = tuple(s.stop - s.start for s in region)
+    arrays = {f.name: np.full(block, f.fill, dtype=f.dtype) for f in figures}
+    start = time.perf_counter()
+    with threadpool_limits(limits=1):
+        for point in plan.points(index):
+            local = tuple(p - s.start for p, s in zip(point, region, strict=True))
+            try:
+                evaluate = _evaluator(text, description.setting_at(point))
+                values = evaluate(description.gain_at(point))
+            except PhdesignError as error:
+                label = _point_label(description, point)
+                raise type(error)(f"sweep point {label}: {error}") from None
+            if set(values) != names:
+                raise RuntimeError(
+                    f"job {description.job} returned {sorted(values)}; expected {sorted(names)}"
+                )
+            for f in figures:
+                value = values[f.name]
+                arrays[f.name][local] = f.fill if value is None else value
+    return {"index": index, "arrays": arrays, "seconds": time.perf_counter() - start}
+
+
+def _progress(total: int, initial: int, enabled: bool | None) -> Any:
+    from tqdm import tqdm
+
+    show = sys.stderr.isatty() if enabled is None else enabled
+    return tqdm(
+        total=total, initial=initial, unit="chunk", desc="sweep", disable=not show, file=sys.stderr
+    )
+
+
+def run(
+    description: SweepDescription,
+    *,
+    output: str | Path | None = None,
+    resume: bool = False,
+    force: bool = False,
+    scheduler: Any = None,
+    workers: int | None = None,
+    chunk_size: int | None = None,
+    progress: bool | None = None,
+) -> Any:
+    """Compute a described sweep and return its :class:`xarray.Dataset`.
+
+    See :func:`phdesign.sweep.sweep` for the parameters.  Everything that can be refused
+    (the output, the scheduler) is checked before anything is written.
+    """
+    from phdesign.sweep.schedulers import executor
+    from phdesign.sweep.store import ZarrStore
+
+    if chunk_size is not None:
+        check_chunk_size(chunk_size)
+    kind = None if output is None else output_format(output)
+    if kind != "zarr" and resume:
+        raise SweepError(
+            "resume continues a Zarr store; "
+            + (
+                "give one as output"
+                if output is None
+                else f"{str(output)!r} is written once, at the end"
+            )
+        )
+    store = ZarrStore(Path(output)) if kind == "zarr" and output is not None else None
+    action = "memory"
+    if store is not None:
+        action = store.check(description, resume=resume, force=force, chunk_size=chunk_size)
+    elif output is not None:
+        from phdesign.io import check_output_path
+
+        check_output_path(output, force)
+    if action in ("resume", "complete") and store is not None:
+        plan = store.plan()
+    else:
+        size = default_chunk_size(description) if chunk_size is None else chunk_size
+        plan = ChunkPlan.for_grid(description.shape, size)
+    record: dict[str, Any] = {
+        "chunks": plan.n_chunks,
+        "chunk_shape": list(plan.chunk_shape),
+        "computed": 0,
+        "reused": 0,
+        "seconds": 0.0,
+        "compute_seconds": 0.0,
+        "scheduler": "none (the store was complete)",
+        "output": None if output is None else str(output),
+    }
+    if action == "complete" and store is not None:
+        record["reused"] = plan.n_chunks
+        dataset = store.dataset()
+        dataset.attrs[RUN_ATTRIBUTE] = json.dumps(record)
+        return dataset
+    started = time.perf_counter()
+    text = description.to_json()
+    with executor(scheduler, workers) as ex:
+        done: set[int] = set()
+        arrays = None
+        group = None
+        if store is not None:
+            if action in ("create", "replace"):
+                store.create(
+                    template(description, plan, lazy=True), description, plan, action == "replace"
+                )
+            done = store.done()
+            group = store.writer()
+        else:
+            arrays = template(description)
+        todo = [(plan.chunk_shape, i) for i in range(plan.n_chunks) if i not in done]
+        record["reused"] = len(done)
+        record["scheduler"] = ex.describe()
+        with _progress(plan.n_chunks, len(done), progress) as bar:
+            for result in ex.map_unordered(run_chunk, text, todo):
+                region = plan.region(result["index"])
+                if store is not None:
+                    store.write_chunk(group, result["index"], region, result["arrays"])
+                else:
+                    assert arrays is not None
+                    for name, block in result["arrays"].items():
+                        arrays[name].values[region] = block
+                record["computed"] += 1
+                record["compute_seconds"] += result["seconds"]
+                bar.update(1)
+    record["seconds"] = time.perf_counter() - started
+    if store is not None:
+        store.mark_complete(record)
+        dataset = store.dataset()
+    else:
+        dataset = arrays
+    dataset.attrs[RUN_ATTRIBUTE] = json.dumps(record)
+    if store is None and output is not None:
+        write_export(dataset, output, force)
+    return dataset

@@ -1,0 +1,279 @@
+"""Pictures of a sweep result, read from its Dataset: gain maps and parameter studies.
+
+:func:`plot_sweep` looks at the axes that have more than one value (after ``select``):
+
+* one axis: the figure against it (a parameter study, a gain sweep), one curve per
+  sensor set when the sensor sets are a second axis;
+* two numeric axes: a map (a gain map over (l1, l2), a map over (d, l)); text figures
+  (the verdict) as categories;
+* a third axis of at most :data:`MAX_PANELS` values: one panel per value.
+
+Points whose spectrum did not converge (``converged`` false) are marked on every picture,
+never drawn as if they had.  matplotlib is imported only here, and only when drawing.
+
+Examples
+--------
+>>> import numpy as np, xarray as xr
+>>> ds = xr.Dataset(
+...     {"spectral_abscissa": (("l1", "l2"), -np.ones((3, 2))),
+...      "converged": (("l1", "l2"), np.array([[True, True], [True, False], [True, True]]))},
+...     coords={"l1": [0.1, 0.2, 0.3], "l2": [0.1, 1.0]},
+... )
+>>> fig = plot_sweep(ds)
+>>> fig.axes[0].get_xlabel(), fig.axes[0].get_legend().get_texts()[0].get_text()
+('l1', 'not converged (1 point)')
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from phdesign.errors import SweepError
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["MAX_PANELS", "plot_sweep", "save_plot", "select_points"]
+
+MAX_PANELS = 12
+_VERDICT_COLORS = {"exponential": "tab:green", "asymptotic": "gold", "inconclusive": "0.6"}
+
+
+def select_points(dataset: Any, select: Mapping[str, Any] | None) -> Any:
+    """``dataset`` at the given axis values (nearest value for numeric axes).
+
+    Raises
+    ------
+    SweepError
+        An axis the sweep does not have, or a sensor set that is not on the axis.
+    """
+    if not select:
+        return dataset
+    picked = dataset
+    for name, value in select.items():
+        if name not in dataset.coords:
+            axes = ", ".join(dataset[next(iter(dataset.data_vars))].dims)
+            raise SweepError(f"select: the sweep has no axis {name!r}; its axes: {axes}")
+        values = dataset[name].values
+        if values.dtype.kind in "US":
+            if str(value) not in values.tolist():
+                raise SweepError(
+                    f"select: {name} = {value!r} is not on the axis; expected one of "
+                    f"{', '.join(values.tolist())}"
+                )
+            picked = picked.sel({name: str(value)})
+        else:
+            try:
+                number = float(value)
+            except ValueError:
+                raise SweepError(f"select: {name} expects a number; found {value!r}") from None
+            picked = picked.sel({name: number}, method="nearest")
+    return picked
+
+
+def _varying(data: Any) -> list[str]:
+    return [d for d in data.dims if data.sizes[d] > 1]
+
+
+def _is_log(dataset: Any, dim: str) -> bool:
+    return dataset[dim].attrs.get("scale") == "log"
+
+
+def _label(dataset: Any, name: str) -> str:
+    units = dataset[name].attrs.get("units")
+    return f"{name} [{units}]" if units else name
+
+
+def _unconverged(dataset: Any, figure: str) -> Any:
+    """Return the ``converged`` flags when the figure depends on them, else ``None``."""
+    if "converged" not in dataset.data_vars or figure == "converged":
+        return None
+    return dataset["converged"]
+
+
+def _mark_unconverged(ax: Axes, x: np.ndarray, y: np.ndarray) -> None:
+    """Red crosses on the points whose spectrum did not converge, counted in the legend."""
+    count = len(x)
+    label = f"not converged ({count} point{'s' if count > 1 else ''})"
+    ax.plot(x, y, ls="none", marker="x", color="red", ms=6, label=label)
+
+
+def _draw_map(fig: Figure, ax: Axes, data: Any, flags: Any, dims: list[str], dataset: Any) -> None:
+    x, y = dims  # the first axis across, as in a gain map over (l1, l2)
+    values = data.transpose(y, x).values
+    xs, ys = dataset[x].values, dataset[y].values
+    if values.dtype.kind in "US":
+        categories = [c for c in _VERDICT_COLORS if c in values] + sorted(
+            set(values.ravel().tolist()) - set(_VERDICT_COLORS) - {""}
+        )
+        from matplotlib.colors import ListedColormap
+
+        codes = np.full(values.shape, np.nan)
+        for k, c in enumerate(categories):
+            codes[values == c] = k
+        colors = [_VERDICT_COLORS.get(c, f"C{k}") for k, c in enumerate(categories)]
+        ax.pcolormesh(
+            xs,
+            ys,
+            np.ma.masked_invalid(codes),
+            shading="nearest",
+            cmap=ListedColormap(colors or ["white"]),
+            vmin=-0.5,
+            vmax=max(len(categories), 1) - 0.5,
+        )
+        from matplotlib.patches import Patch
+
+        ax.legend(
+            handles=[Patch(color=col, label=c) for c, col in zip(categories, colors, strict=True)],
+            loc="upper left",
+            fontsize="small",
+        )
+    else:
+        from matplotlib import colormaps
+
+        cmap = colormaps["viridis"].with_extremes(bad="0.8")
+        mesh = ax.pcolormesh(
+            xs, ys, np.ma.masked_invalid(values.astype(float)), shading="nearest", cmap=cmap
+        )
+        fig.colorbar(mesh, ax=ax, label=_label(dataset, data.name))
+    if flags is not None:
+        bad = ~flags.transpose(y, x).values.astype(bool)
+        if bad.any():
+            jj, ii = np.nonzero(bad)
+            _mark_unconverged(ax, xs[ii], ys[jj])
+            ax.legend(loc="lower left", fontsize="small")
+    ax.set(xlabel=_label(dataset, x), ylabel=_label(dataset, y))
+    if _is_log(dataset, x):
+        ax.set_xscale("log")
+    if _is_log(dataset, y):
+        ax.set_yscale("log")
+
+
+def _draw_curves(ax: Axes, data: Any, flags: Any, dims: list[str], dataset: Any) -> None:
+    x = next((d for d in dims if dataset[d].dtype.kind not in "US"), dims[0])
+    groups = [d for d in dims if d != x]
+    series: list[tuple[str | None, Any, Any]] = [(None, data, flags)]
+    if groups:
+        g = groups[0]
+        series = [
+            (str(v), data.sel({g: v}), None if flags is None else flags.sel({g: v}))
+            for v in dataset[g].values
+        ]
+    xs = dataset[x].values
+    for label, curve, flag in series:
+        values = curve.values
+        text = None if label is None else f"{groups[0]} {label}"
+        if values.dtype.kind in "US" or values.dtype == bool:
+            ax.step(xs, values.astype(str), where="mid", label=text)
+            continue
+        ax.plot(xs, values.astype(float), marker="o", ms=3, label=text)
+        if flag is not None:
+            bad = ~flag.values.astype(bool)
+            if bad.any():
+                _mark_unconverged(ax, xs[bad], values[bad])
+    if _is_log(dataset, x):
+        ax.set_xscale("log")
+    ax.set(xlabel=_label(dataset, x), ylabel=_label(dataset, data.name))
+    ax.grid(True, alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="small")
+
+
+def _draw(fig: Figure, ax: Axes, data: Any, flags: Any, dataset: Any) -> None:
+    dims = _varying(data)
+    numeric = [d for d in dims if dataset[d].dtype.kind not in "US"]
+    if len(dims) == 2 and len(numeric) == 2:
+        _draw_map(fig, ax, data, flags, dims, dataset)
+    else:
+        _draw_curves(ax, data, flags, dims, dataset)
+
+
+def plot_sweep(
+    dataset: Any,
+    figure: str | None = None,
+    *,
+    select: Mapping[str, Any] | None = None,
+    title: str | None = None,
+) -> Figure:
+    """Draw one figure of a sweep (see the module docstring).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A sweep result (:func:`phdesign.sweep.sweep`, :func:`phdesign.sweep.open_sweep`).
+    figure : str, optional
+        The variable to draw (default: the job's first, e.g. ``spectral_abscissa``).
+    select : mapping, optional
+        Fix axes to values first, e.g. ``{"d": 0.2}`` (nearest value) or
+        ``{"sensors": "3,4"}``.
+    title : str, optional
+        Default: the figure, the job, the model and the fixed sensors and gain.
+
+    Returns
+    -------
+    Figure
+
+    Raises
+    ------
+    SweepError
+        An unknown figure or axis, a single point, or more than three varying axes (or a
+        third with more than :data:`MAX_PANELS` values): select values first.
+    """
+    from phdesign.plots import new_figure
+
+    names = [str(n) for n in dataset.data_vars]
+    name = figure or (names[0] if names else "")
+    if name not in names:
+        raise SweepError(f"the sweep has no figure {name!r}; its figures: {', '.join(names)}")
+    data = select_points(dataset, select)
+    dims = _varying(data[name])
+    if not dims:
+        raise SweepError("one point is left to plot; select fewer axes")
+    panels = [None]
+    if len(dims) >= 3 or (len(dims) == 2 and all(data[d].dtype.kind in "US" for d in dims)):
+        outer = dims[0]
+        if len(dims) > 3 or data.sizes[outer] > MAX_PANELS:
+            raise SweepError(
+                f"{len(dims)} axes vary ({', '.join(dims)}); select values of "
+                f"{dims[0]} first (at most {MAX_PANELS} panels), e.g. select={{'{outer}': ...}}"
+            )
+        panels = list(data[outer].values)
+    columns = min(len(panels), 3)
+    rows = math.ceil(len(panels) / columns)
+    fig, grid = new_figure(rows, columns, figsize=(6.2 * columns, 4.6 * rows))
+    axes = np.asarray(grid, dtype=object).reshape(-1)
+    for k, value in enumerate(panels):
+        ax = axes[k]
+        part = data if value is None else data.sel({dims[0]: value})
+        flags = _unconverged(part, name)
+        _draw(fig, ax, part[name], flags, part)
+        if value is not None:
+            ax.set_title(f"{dims[0]} = {value}", fontsize="medium")
+    for ax in axes[len(panels) :]:
+        ax.set_visible(False)
+    if title is None:
+        observer = dataset.attrs.get("sensors")
+        gain = dataset.attrs.get("gain")
+        title = f"{name}: {dataset.attrs.get('job', 'sweep')} on {dataset.attrs.get('model', '?')}"
+        if observer:
+            title += f", sensors {observer}, gain {gain}"
+    fig.suptitle(title)
+    return fig
+
+
+def save_plot(fig: Figure, path: str | os.PathLike[str], force: bool = False) -> None:
+    """Write ``fig`` atomically; its suffix picks the format (checked before drawing)."""
+    from phdesign.io import atomic_write
+    from phdesign.plots import check_plot_path
+
+    fmt = check_plot_path(path, force=force)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format=fmt, dpi=110)
+    atomic_write(path, buffer.getvalue(), force=force)

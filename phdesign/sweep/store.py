@@ -1,0 +1,186 @@
+"""A sweep stored in Zarr, written chunk by chunk, resumable, and marked when complete.
+
+Layout of ``map.zarr`` (Zarr format 2, consolidated metadata: every Zarr reader and
+``xarray.open_zarr`` open it; format 3 has no specified fixed-width text type yet)::
+
+    map.zarr/
+      .zgroup, .zattrs, .zmetadata     the Dataset's metadata and attributes
+      l1/, l2/, spectral_abscissa/ ... one array per coordinate and figure; one Zarr
+                                       chunk per sweep chunk
+      .phdesign/sweep.json             the description and the chunk layout
+      .phdesign/chunks/00000012        one marker per chunk whose figures are stored
+      .phdesign/complete.json          the completion marker, with the run's record
+
+Every marker is written through a temporary file and a rename, after the data it vouches
+for, so that a sweep killed at any instant resumes with exactly the chunks it had
+finished (a chunk written without its marker is computed again and overwritten).  A
+store is resumed only by the sweep it describes: any difference in the description (the
+model, job, options, axes, sensors, gain or phdesign version) is refused.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from phdesign.errors import OutputFileError, SweepError
+from phdesign.io import atomic_write
+from phdesign.sweep.description import SweepDescription
+from phdesign.sweep.plan import ChunkPlan
+
+__all__ = ["ZarrStore"]
+
+_MARKERS = ".phdesign"
+
+
+@dataclass(frozen=True)
+class ZarrStore:
+    """A sweep's Zarr store at ``path``."""
+
+    path: Path
+
+    @property
+    def _markers(self) -> Path:
+        return self.path / _MARKERS
+
+    @property
+    def is_zarr(self) -> bool:
+        """The folder holds a Zarr hierarchy (format 2 or 3)."""
+        return any((self.path / name).exists() for name in (".zgroup", "zarr.json"))
+
+    def stored(self) -> tuple[SweepDescription, ChunkPlan] | None:
+        """Return the stored description and chunk layout (``None``: not a sweep)."""
+        try:
+            data = json.loads((self._markers / "sweep.json").read_text())
+            description = SweepDescription.from_json(data["description"])
+            plan = ChunkPlan(description.shape, tuple(data["chunk_shape"]))
+        except (OSError, ValueError, KeyError, TypeError):
+            return None
+        return description, plan
+
+    @property
+    def complete(self) -> bool:
+        """The completion marker exists."""
+        return (self._markers / "complete.json").is_file()
+
+    def done(self) -> set[int]:
+        """Return the indices of the chunks whose figures are stored."""
+        folder = self._markers / "chunks"
+        if not folder.is_dir():
+            return set()
+        return {int(p.name) for p in folder.iterdir() if p.name.isdigit()}
+
+    def check(
+        self,
+        description: SweepDescription,
+        *,
+        resume: bool,
+        force: bool,
+        chunk_size: int | None,
+    ) -> str:
+        """Decide, before anything is written, what to do with the path.
+
+        Returns
+        -------
+        {"create", "replace", "resume", "complete"}
+
+        Raises
+        ------
+        OutputFileError
+            The path exists and neither ``resume`` nor ``force`` is given, is a folder that
+            is not a Zarr store, or its folder is missing.
+        SweepError
+            ``resume`` of something that is not this sweep, or both flags.
+        """
+        where = str(self.path)
+        if resume and force:
+            raise SweepError("choose one of resume (continue the store) and force (replace it)")
+        if not self.path.exists():
+            if not self.path.parent.is_dir():
+                raise OutputFileError(
+                    f"cannot write {where!r}: folder {str(self.path.parent)!r} does not exist"
+                )
+            return "create"
+        if force:
+            if self.path.is_dir() and not self.is_zarr:
+                raise OutputFileError(
+                    f"output {where!r} is a folder that is not a Zarr store; "
+                    "refusing to replace it"
+                )
+            return "replace"
+        if not resume:
+            raise OutputFileError(
+                f"output {where!r} exists; resume the sweep it holds (--resume) "
+                "or replace it (--force)"
+            )
+        stored = self.stored()
+        if stored is None:
+            raise SweepError(
+                f"cannot resume {where!r}: it is not a phdesign sweep store "
+                f"(no {_MARKERS}/sweep.json); replace it with --force"
+            )
+        old, plan = stored
+        difference = old.difference(description)
+        if difference is not None:
+            raise SweepError(
+                f"cannot resume {where!r}: it holds a different sweep ({difference}); "
+                "replace it with --force or choose another output"
+            )
+        if chunk_size is not None and chunk_size != plan.chunk_size:
+            raise SweepError(
+                f"cannot resume {where!r} with chunk size {chunk_size}: it was written in "
+                f"chunks of {plan.chunk_size} points (drop the chunk size)"
+            )
+        return "complete" if self.complete else "resume"
+
+    def plan(self) -> ChunkPlan:
+        """Return the stored chunk layout."""
+        stored = self.stored()
+        if stored is None:
+            raise SweepError(f"{str(self.path)!r} is not a phdesign sweep store")
+        return stored[1]
+
+    def create(
+        self, template: Any, description: SweepDescription, plan: ChunkPlan, replace: bool
+    ) -> None:
+        """Write the metadata (no figures yet), replacing what is at the path if asked."""
+        if replace:
+            if self.path.is_dir():
+                shutil.rmtree(self.path)
+            else:
+                self.path.unlink()
+        template.to_zarr(self.path, mode="w-", compute=False, zarr_format=2, consolidated=True)
+        (self._markers / "chunks").mkdir(parents=True)
+        record = {"description": description.to_json(), "chunk_shape": list(plan.chunk_shape)}
+        atomic_write(self._markers / "sweep.json", json.dumps(record, indent=1), force=True)
+
+    def writer(self) -> Any:
+        """Open the Zarr group once for the chunk writes."""
+        import zarr
+
+        return zarr.open_group(str(self.path), mode="r+", zarr_format=2, use_consolidated=True)
+
+    def write_chunk(
+        self, group: Any, index: int, region: tuple[slice, ...], arrays: dict[str, np.ndarray]
+    ) -> None:
+        """Store one chunk's figures, then its marker."""
+        for name, block in arrays.items():
+            group[name][region] = block
+        atomic_write(self._markers / "chunks" / f"{index:08d}", b"", force=True)
+
+    def mark_complete(self, record: dict[str, Any]) -> None:
+        """Write the completion marker (with the run's record)."""
+        atomic_write(self._markers / "complete.json", json.dumps(record, indent=1), force=True)
+
+    def dataset(self) -> Any:
+        """Open the stored sweep as an :class:`xarray.Dataset` (read lazily, no dask)."""
+        import xarray as xr
+
+        from phdesign.sweep.dataset import normalized
+
+        return normalized(xr.open_zarr(self.path, chunks=None, consolidated=True, zarr_format=2))
