@@ -5,7 +5,7 @@ between the two finest resolutions) in at most 2 s (wall, whole adaptive refinem
 Also prints, for the damped wave (k = 0.5, exact -0.5493061443), the largest real part
 over ALL finite-difference eigenvalues (tends to 0 like h^2) against the drift-filtered
 abscissa, and the throughput of the AbscissaEvaluator (a resolution pair prepared once:
-Cholesky-whitened, eigenvalues only) against the per-gain QZ with left and right
+shift and invert, eigenvalues only) against the per-gain QZ with left and right
 eigenvectors that tuning used before, on a 12 x 12 grid of beam gains, same process.
 
 Run:  python benchmarks/spectrum.py   (exit 1 if a target fails)
@@ -52,7 +52,7 @@ def evaluator_throughput(beam, C_m) -> None:
     print(
         f"AbscissaEvaluator: {len(gains) / fast:.0f} gains/s against {len(gains) / base:.0f} "
         f"gains/s for QZ with eigenvectors ({base / fast:.1f}x); largest difference of the "
-        f"two abscissas {agree:.1e} (round-off of the whitened Hessenberg QR)"
+        f"two abscissas {agree:.1e} (QZ against shift and invert)"
     )
 
 

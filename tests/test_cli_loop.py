@@ -90,12 +90,6 @@ def test_loop_simulate_writes_csv_and_a_figure_and_refuses_to_overwrite(tmp_path
     assert json.loads(out)["actuated"] == [3]
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the controlled plant's spectrum (QZ) agrees only to 4.1e-8 at the tuned K = 0.395 "
-    "(tip torque damper, stiff) and says so, while the assembled loop (shift-and-invert) has "
-    "11 digits: the spectrum's eigen stage is being moved to shift-and-invert",
-)
 def test_loop_tune_prints_both_gains(capsys):
     out, _ = run(
         ["loop", "tune", *BEAM_LOOP, "--tune", "feedback", "--starts", "1", "--json"], capsys

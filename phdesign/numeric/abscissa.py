@@ -22,10 +22,11 @@ each resolved or clustered eigenvalue :math:`\lambda_i` has a real part known to
    :math:`\alpha + u_\alpha`.  Eigenvalues that neither converge nor count but lie
    right of it (high frequencies whose real parts are round-off, e.g. :math:`10^{-8}`
    at :math:`|\lambda| = 6 \cdot 10^4`) are reported apart, never as the abscissa.  A
-   positive real part is round-off as well: a closed loop ũ = −Kỹ with
-   :math:`K + K^\top \succeq 0` of a port-Hamiltonian discretization dissipates energy,
-   so every exact eigenvalue has :math:`\operatorname{Re}\lambda \le 0`, and
-   :math:`u_i \ge \max(\operatorname{Re}\lambda_i, 0)`;
+   positive real part is round-off as well when the pencil is dissipative (a closed loop
+   ũ = −Kỹ with :math:`K + K^\top \succeq 0` of a port-Hamiltonian discretization,
+   whose invariants :mod:`phdesign.numeric.invariants` checks): every exact eigenvalue
+   has :math:`\operatorname{Re}\lambda \le 0`, and :math:`u_i \ge
+   \max(\operatorname{Re}\lambda_i, 0)` (:mod:`phdesign.numeric.drift`);
 4. when the real parts keep rising with frequency up to the top of the resolved band,
    the supremum is not attained by any resolved mode: the largest real parts up to each
    frequency (the running maximum, in the upper half plane) are fitted by
@@ -193,10 +194,11 @@ def high_frequency_limit(pair: PairSpectrum) -> HighFrequencyLimit | None:
     if cut >= 3:
         spread.append(abs(value - _fit(ww[:cut], rr[:cut], q)[0]))
     uncertainty = max(*spread, noise)
-    # the limit of rising real parts is at least the last of them, and at most 0: a
-    # dissipative closed loop has no eigenvalue with a positive real part
+    # the limit of rising real parts is at least the last of them, and at most 0 when the
+    # pencil is dissipative (no eigenvalue has a positive real part)
+    value = max(value, rr[-1])
     return HighFrequencyLimit(
-        value=float(min(max(value, rr[-1]), 0.0)),
+        value=float(min(value, 0.0) if pair.dissipative else value),
         uncertainty=float(uncertainty),
         exponent=q,
         modes=int(records.size),

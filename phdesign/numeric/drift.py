@@ -24,6 +24,19 @@ ill-conditioned (energy-norm condition number above 10): a genuine eigenvalue ne
 coalescence, whose members move by O((ε κ)^(1/m)) between resolutions; it is *kept*.  An
 isolated, well-conditioned in-band eigenvalue that does not reproduce is a round-off
 artefact (e.g. N >= 3 at high degree) and is discarded.
+
+The accuracy of a real part is its drift, at least the round-off floor.  For a
+*dissipative* pencil (``dissipative=True``) it is also at least :math:`\operatorname{Re}
+\lambda`: every exact eigenvalue has :math:`\operatorname{Re}\lambda \le 0`, so a
+positive computed real part is round-off.  That holds for the closed loops ũ = −Kỹ
+(sym K ⪰ 0) of a :class:`~phdesign.numeric.phs.DiscretePHS`, whose constructors check
+:math:`E \succ 0`, :math:`J = -J^\top`, :math:`R \succeq 0`, :math:`D = -D^\top`, of
+a model with :math:`P_0 + P_0^\top \preceq 0` and dampers :math:`K + K^\top \succeq 0`
+(:mod:`phdesign.numeric.invariants`: :math:`\operatorname{Re}\lambda\, x^*Ex =
+-x^*Rx - \tilde y^* \operatorname{sym}(G) \tilde y`), and for the assembled
+observer-based loop (block-triangular with two such blocks); the callers say so.  For
+eigenvalues of anything else (``dissipative=False``, the default) a positive real part is
+what it is.
 """
 
 from __future__ import annotations
@@ -152,12 +165,14 @@ class PairSpectrum:
         Unresolved, inside the resolved band, isolated and well conditioned: discarded.
     uncertainty : ndarray of float
         For resolved and clustered eigenvalues, the accuracy of the real part: the
-        drift, at least the round-off floor 8 ε κ max(s, |λ|) and at least Re λ (an exact
-        eigenvalue of a dissipative closed loop has Re λ <= 0); ``nan`` elsewhere.
+        drift, at least the round-off floor 8 ε κ max(s, |λ|) and, for a dissipative
+        pencil, at least Re λ (module docstring); ``nan`` elsewhere.
     condition : ndarray of float or None
         Energy-norm condition numbers (None when not computed).
     scale : float
         The problem's rate s.
+    dissipative : bool
+        Every exact eigenvalue has Re λ <= 0 (module docstring).
     """
 
     resolutions: tuple[int, int]
@@ -169,6 +184,7 @@ class PairSpectrum:
     uncertainty: np.ndarray
     condition: np.ndarray | None
     scale: float
+    dissipative: bool = False
 
     @property
     def candidates(self) -> np.ndarray:
@@ -201,8 +217,12 @@ def pair_spectrum(
     rtol: float,
     scale: float,
     kappa: np.ndarray | None = None,
+    dissipative: bool = False,
 ) -> PairSpectrum:
     """Run the drift test between two resolutions (module docstring).
+
+    ``dissipative=True`` states that every exact eigenvalue has Re λ <= 0, so that a
+    positive computed real part counts as round-off (module docstring).
 
     Examples
     --------
@@ -230,8 +250,9 @@ def pair_spectrum(
         drift = np.abs(fine[both].real - nearest[both].real)
         k = np.ones(both.size) if kappa is None else np.minimum(kappa[both], 1e300)
         floor = ROUNDOFF * k * np.maximum(scale, np.abs(fine[both]))
-        # a dissipative closed loop has Re λ <= 0 exactly: a positive real part is round-off
-        uncertainty[both] = np.maximum(np.maximum(drift, floor), fine[both].real)
+        uncertainty[both] = np.maximum(drift, floor)
+        if dissipative:  # Re λ <= 0 exactly: a positive real part is round-off
+            uncertainty[both] = np.maximum(uncertainty[both], fine[both].real)
     return PairSpectrum(
         resolutions=(int(resolutions[0]), int(resolutions[1])),
         eigenvalues=fine,
@@ -242,4 +263,5 @@ def pair_spectrum(
         uncertainty=uncertainty,
         condition=kappa,
         scale=float(scale),
+        dissipative=bool(dissipative),
     )

@@ -7,11 +7,11 @@ loop :math:`\tilde u = -C_m^\top L C_m \tilde y` of the discretization
 (``DiscretePHS.closed_matrix``, which also handles a feedthrough D ≠ 0).  The evaluator
 
 * discretizes the dimensionless model (:mod:`phdesign.numeric.scales`) at the two
-  resolutions of the pair once, and whitens each mass matrix once by Cholesky when that
-  pays (:func:`phdesign.numeric.eigen.prepare`);
-* per gain, computes eigenvalues only (no eigenvectors) at both resolutions, runs the
-  drift test (:mod:`phdesign.numeric.drift`) and takes the abscissa of
-  :mod:`phdesign.numeric.abscissa`;
+  resolutions of the pair once;
+* per gain, computes eigenvalues only (no eigenvectors) at both resolutions by the shift
+  and invert of :mod:`phdesign.numeric.eigen` (the eigen stage of ``spectrum``, so both
+  see the same eigenvalues), runs the drift test (:mod:`phdesign.numeric.drift`; the
+  closed loops are dissipative) and takes the abscissa of :mod:`phdesign.numeric.abscissa`;
 * computes condition numbers only when the rule needs them: when an unresolved eigenvalue
   inside the resolved band lies right of the resolved ones and is isolated, only its
   condition number tells a coalescence (kept) from a round-off artefact (discarded).
@@ -46,7 +46,7 @@ from phdesign.numeric.abscissa import Abscissa, estimate_abscissa
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize, feedback_matrix
 from phdesign.numeric.drift import CLUSTER, PairSpectrum, pair_spectrum
-from phdesign.numeric.eigen import PreparedSystem, prepare, rescaled
+from phdesign.numeric.eigen import SHIFT, PreparedSystem, prepare, rescaled
 from phdesign.numeric.scales import dimensionless_model
 from phdesign.numeric.threads import small_dense_threads
 
@@ -114,8 +114,8 @@ class AbscissaEvaluator:
         dimensionless, scales = dimensionless_model(nm)
         self.scales = scales
         self.systems: tuple[PreparedSystem, PreparedSystem] = (
-            prepare(discretize(dimensionless, method, p)),
-            prepare(discretize(dimensionless, method, p_fine)),
+            prepare(discretize(dimensionless, method, p), shift=SHIFT),
+            prepare(discretize(dimensionless, method, p_fine), shift=SHIFT),
         )
         self.evaluations = 0
 
@@ -161,6 +161,7 @@ class AbscissaEvaluator:
             rtol=self.rtol_resolved,
             scale=self.scales.rate,
             kappa=kappa,
+            dissipative=True,
         )
 
     def abscissa(self, L: np.ndarray | None = None) -> Abscissa:

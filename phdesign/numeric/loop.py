@@ -32,9 +32,9 @@ closed by :math:`u_a = -K y_a` (:mod:`phdesign.symbolic.loop` derives it); the l
 block vanishes to round-off, and :attr:`LoopSystem.triangular_residual` says by how much.
 
 :func:`phdesign.numeric.loop_spectrum.loop_spectrum` refines the assembled pencil with
-the two-resolution drift rule of :mod:`phdesign.numeric.spectrum` and reports it beside the
-converged spectra of the two blocks; :func:`loop_statespace` exports the loop to
-python-control.
+the refinement of :mod:`phdesign.numeric.spectrum` (its eigen stage, drift rule and choice
+of the pair) and reports it beside the converged spectra of the two blocks;
+:func:`loop_statespace` exports the loop to python-control.
 """
 
 from __future__ import annotations
@@ -43,19 +43,16 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.linalg as sl
 
 from phdesign.errors import LoopError, NumericError, check_shape
 from phdesign.numeric.discretize import DiscretePHS, feedback_matrix
 from phdesign.numeric.simulate import coupled_system
 
 __all__ = [
-    "SHIFT",
     "LoopSystem",
     "NumericLoop",
     "assemble",
     "loop_statespace",
-    "pencil_eigen",
 ]
 
 
@@ -208,51 +205,6 @@ def assemble(d: DiscretePHS, loop: NumericLoop) -> LoopSystem:
         D_yhat=d.D @ P,
         others=others,
     )
-
-
-#: Shift of the shift-and-invert eigensolve: every eigenvalue of the loop has Re λ <= 0
-#: (both blocks are dissipative), so a positive real shift is never one of them.
-SHIFT = 1.0
-
-
-def pencil_eigen(
-    A: np.ndarray, E: np.ndarray, condition: bool = True, shift: float = SHIFT
-) -> tuple[np.ndarray, np.ndarray | None]:
-    r"""Eigenvalues of the pencil (A, E) by shift and invert, and their condition numbers.
-
-    With :math:`S = (A - \sigma E)^{-1} E`, :math:`S v = 	heta v` iff
-    :math:`A v = (\sigma + 1/	heta) E v`, and the left eigenvectors are
-    :math:`y = (A - \sigma E)^{-*} w` for :math:`w^* S = 	heta w^*`.  The slow eigenvalues
-    are the large :math:`	heta`, computed with a backward error
-    :math:`\epsilon\|S\|`, so their error is about :math:`\epsilon |\lambda - \sigma|^2
-    \|S\| \kappa` whatever :math:`\|A\|` is.  This matters for the assembled loop: its
-    coupling block :math:`B_a K 	ilde C_a` carries the large entries of a damper on a
-    derivative trace, and the QZ algorithm on :math:`(A, E)` loses five to eight digits
-    on the slow modes (beam, tip torque, degree 30 to 100: 2e-8 to 4e-5 against 4e-13 to
-    9e-12 here).  The condition number is the energy-norm one of
-    :func:`phdesign.numeric.spectrum.eigen`,
-    :math:`\kappa = \|x\|_E \|y\|_E / |y^* E x|`.
-    """
-    shifted = A - shift * E
-    S = np.linalg.solve(shifted, E)
-    if not condition:
-        theta = np.linalg.eigvals(S)
-        return _unshift(theta, shift), None
-    theta, W, X = sl.eig(S, left=True, right=True)
-    Y = np.linalg.solve(shifted.conj().T, W)
-    EX = E @ X
-    num = np.sqrt(np.abs(np.einsum("ij,ij->j", X.conj(), EX)))
-    num *= np.sqrt(np.abs(np.einsum("ij,ij->j", Y.conj(), E @ Y)))
-    den = np.abs(np.einsum("ij,ij->j", Y.conj(), EX))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return _unshift(theta, shift), np.where(den > 0, num / den, np.inf)
-
-
-def _unshift(theta: np.ndarray, shift: float) -> np.ndarray:
-    out = np.full(theta.shape, complex(np.inf, 0.0))
-    finite = theta != 0
-    out[finite] = shift + 1.0 / theta[finite]
-    return out
 
 
 def loop_statespace(system: LoopSystem, name: str = "loop") -> Any:

@@ -1,81 +1,96 @@
 r"""The converged spectrum of the assembled observer-based loop, beside its two blocks.
 
 The assembled pencil :math:`(A, E_2)` of :func:`phdesign.numeric.loop.assemble` (plant and
-observer states together, in :math:`(\hat e, \hat e_{obs})`) is solved by shift and invert
-(:func:`~phdesign.numeric.loop.pencil_eigen`) at resolutions p and ⌈1.5 p⌉, and only the
-eigenvalues that agree are kept, with the drift rule of :mod:`phdesign.numeric.spectrum`
-(:func:`~phdesign.numeric.spectrum.match_resolved`; unresolved eigenvalues inside the
-resolved band kept when clustered or ill-conditioned, as near a coalescence).  The
-abscissa is the resolved eigenvalue with the largest real part less its drift; the pair
-refines until it agrees to ``tol``, until refinement stops helping an ill-conditioned
-abscissa, or up to the largest resolution.  The two blocks, the controlled plant and the
-error system, are refined on their own by :func:`~phdesign.numeric.spectrum.spectrum`;
-by separation the loop's abscissa is the larger of theirs, and the report says by how
-much it differs (``separation_gap``) and which block holds each eigenvalue.
+observer states together, in :math:`(\hat e, \hat e_{obs})`) goes through the same
+refinement as every spectrum (:func:`phdesign.numeric.spectrum_refinement.refine`: one
+drift rule, one abscissa rule, one choice of the pair), with :class:`AssembledLoopSolver`
+as its per-resolution solver: the loop assembled on the dimensionless model
+(:mod:`phdesign.numeric.scales`; K, C_m and L read the same there) and solved by the shift
+and invert of :mod:`phdesign.numeric.eigen`.  Shift and invert matters here: a damper on
+a derivative trace puts large entries in the coupling block :math:`B_a K \tilde C_a`, and
+the QZ algorithm on the assembled pencil lost five to eight digits on the slow modes.
+Every eigenvalue of the loop has :math:`\operatorname{Re}\lambda \le 0` (it is
+block-triangular with two dissipative blocks), so the shift is safe and a positive
+computed real part is round-off.
+
+The two blocks, the controlled plant and the error system, are refined on their own by
+:func:`~phdesign.numeric.spectrum.spectrum`; by separation the loop's abscissa is the
+larger of theirs, and the report says by how much it differs (``separation_gap``) and
+which block holds each eigenvalue.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Any
 
 import numpy as np
-import scipy.linalg as sl
 
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
-from phdesign.numeric.loop import LoopSystem, NumericLoop, assemble, pencil_eigen
+from phdesign.numeric.eigen import SHIFT, rescaled, shift_invert
+from phdesign.numeric.evaluator import default_tolerances
+from phdesign.numeric.loop import LoopSystem, NumericLoop, assemble
+from phdesign.numeric.scales import dimensionless_model
 from phdesign.numeric.spectrum import (
     SpectrumReport,
+    abscissa_digits,
     default_resolutions,
-    in_band_unresolved,
-    match_resolved,
+    report_warnings,
+    rightmost_indices,
     spectrum,
 )
+from phdesign.numeric.spectrum_refinement import (
+    PairResult,
+    choose_pair,
+    extinct_twice,
+    refine,
+)
+from phdesign.numeric.threads import small_dense_threads
 
-__all__ = ["ILL_CONDITION", "LoopSpectrum", "loop_spectrum"]
-
-ILL_CONDITION = 1e4  # condition number above which the rightmost eigenvalue is flagged
-
-
-@dataclass(frozen=True)
-class _Pair:
-    """One resolution pair of the assembled loop, through the drift test."""
-
-    resolutions: tuple[int, int]
-    lam: np.ndarray
-    kappa: np.ndarray
-    counted: np.ndarray  # indices of resolved and kept in-band eigenvalues
-    n_tight: int
-    alpha: float | None
-    d_alpha: float
-    lead_loose: bool
+__all__ = ["AssembledLoopSolver", "LoopSpectrum", "loop_spectrum"]
 
 
-def _drift_pair(
-    solve: Callable[[int], tuple[np.ndarray, np.ndarray | None]],
-    coarse: np.ndarray,
-    p: int,
-    rtol: float,
-) -> _Pair:
-    fine_res = math.ceil(1.5 * p)
-    fine, kappa = solve(fine_res)
-    assert kappa is not None  # solve computes condition numbers unless told otherwise
-    idx, _ = match_resolved(fine, coarse, rtol)
-    loose, _ = in_band_unresolved(fine, idx, kappa)
-    counted = np.concatenate([idx, loose]).astype(int)
-    alpha, d_alpha, lead_loose = None, math.inf, False
-    if idx.size:
-        lam = fine[counted]
-        nearest = coarse[np.argmin(np.abs(coarse[None, :] - lam[:, None]), axis=1)]
-        drifts = np.abs(lam.real - nearest.real)
-        # as spectrum(): the largest real part less its drift stands for the abscissa
-        j = int(np.argmax(lam.real - drifts))
-        alpha, d_alpha = float(lam.real[j]), float(drifts[j])
-        lead_loose = j >= idx.size
-    return _Pair((p, fine_res), fine, kappa, counted, int(idx.size), alpha, d_alpha, lead_loose)
+class AssembledLoopSolver:
+    """Eigenvalues of the assembled loop at each resolution (a refinement's solver).
+
+    Assembles the loop on the discretized dimensionless model and solves the pencil
+    :math:`(A, E_2)` by shift and invert at :data:`~phdesign.numeric.eigen.SHIFT` (module
+    docstring), with condition numbers; eigenvalues in the model's units.  The assembled
+    systems are kept (``systems[p]``) for the blocks and the triangular residual.
+    """
+
+    dissipative = True  # block-triangular with two dissipative blocks: Re λ <= 0
+
+    def __init__(self, nm: NumericModel, loop: NumericLoop, *, method: str) -> None:
+        self.dimensionless, self.scales = dimensionless_model(nm)
+        self.rate = self.scales.rate
+        self.loop, self.method = loop, method
+        self.systems: dict[int, LoopSystem] = {}
+        self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+        """Eigenvalues and energy-norm condition numbers of the loop at resolution ``p``."""
+        if p not in self._cache:
+            system = assemble(discretize(self.dimensionless, self.method, p), self.loop)
+            self.systems[p] = system
+            lam, kappa = shift_invert(system.A, system.E, shift=SHIFT, condition=True)
+            assert kappa is not None  # condition=True computes them
+            self._cache[p] = (rescaled(lam, self.rate), kappa)
+        return self._cache[p]
+
+    def blocks(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+        """Eigenvalues of the controlled plant's and the error system's blocks at ``p``."""
+        system = self.systems[p]
+        E = system.discrete.E
+        plant, error = (
+            rescaled(shift_invert(block, E, shift=SHIFT)[0], self.rate)
+            for block in system.blocks()
+        )
+        return plant, error
 
 
 @dataclass(frozen=True)
@@ -87,7 +102,8 @@ class LoopSpectrum:
     spectral_abscissa : float or None
         Of the assembled loop (plant and observer states together).
     converged : bool
-        The loop's abscissa agrees to ``tol`` between the last two resolutions.
+        The spectrum's convergence rule holds for the loop
+        (:func:`~phdesign.numeric.spectrum_refinement.convergence_rule`).
     digits : float or None
         Agreeing digits of the loop's abscissa.
     rightmost : list of complex
@@ -107,6 +123,9 @@ class LoopSpectrum:
     triangular_residual : float
         The lower-left block of the loop in (ê, ẽ), relative (round-off).
     warnings : list of str
+    model, design : str
+    uncertainty : float or None
+        Accuracy of ``spectral_abscissa`` (absolute; the spectrum's abscissa rule).
     """
 
     spectral_abscissa: float | None
@@ -128,6 +147,7 @@ class LoopSpectrum:
     warnings: list[str] = field(default_factory=list)
     model: str = ""
     design: str = ""
+    uncertainty: float | None = None
 
     @property
     def plant_abscissa(self) -> float | None:
@@ -147,6 +167,7 @@ class LoopSpectrum:
             "spectral_abscissa": _finite(self.spectral_abscissa),
             "converged": self.converged,
             "digits": _finite(self.digits),
+            "uncertainty": _finite(self.uncertainty),
             "plant_abscissa": _finite(self.plant_abscissa),
             "plant_converged": self.plant.converged,
             "error_abscissa": _finite(self.error_abscissa),
@@ -176,7 +197,14 @@ class LoopSpectrum:
         """Return the text ``phdesign loop spectrum`` prints."""
         lines = [f"model: {self.model}   loop: {self.design}   method: {self.method}"]
         if self.spectral_abscissa is None:
-            lines.append("loop spectral abscissa: unbounded below (no eigenvalue converges)")
+            lines.append(
+                "loop spectral abscissa: "
+                + (
+                    "unbounded below (no eigenvalue converges)"
+                    if self.unbounded_below
+                    else "not resolved at these resolutions"
+                )
+            )
         else:
             lines.append(
                 f"loop spectral abscissa: {self.spectral_abscissa:.12g}   converged: "
@@ -279,9 +307,8 @@ def loop_spectrum(
     The two blocks are refined by :func:`~phdesign.numeric.spectrum.spectrum` (the
     controlled plant as the discretization closed by :math:`S_a^\top K S_a`, the same
     matrix as the model closed by ``[feedback]``).  The assembled pencil
-    :math:`(A, E_2)` is refined from the finer of their starting resolutions with the same
-    drift rule (:func:`~phdesign.numeric.spectrum.match_resolved`, in-band clusters kept),
-    until its abscissa agrees to ``tol``.
+    :math:`(A, E_2)` is refined by the spectrum's own refinement (module docstring) from the
+    finer of their starting resolutions.
 
     Parameters
     ----------
@@ -311,77 +338,30 @@ def loop_spectrum(
         system="controlled plant (u_a = -K y_a)",
     )
     error = spectrum(nm, loop.C_m, loop.L, resolution=resolution, **options)
-    if tol is None:
-        tol = 1e-10 if method == "galerkin" else 1e-3
-    if rtol_resolved is None:
-        rtol_resolved = 1e-6 if method == "galerkin" else 1e-2
+    default_tol, default_rtol = default_tolerances(method)
+    tol = default_tol if tol is None else float(tol)
+    rtol_resolved = default_rtol if rtol_resolved is None else float(rtol_resolved)
     p0, pmax = default_resolutions(nm, method)
     if resolution is None:  # where both blocks converged: usually one pair suffices
         p0 = max(plant.resolutions[0], error.resolutions[0])
     p = int(resolution) if resolution is not None else p0
     pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
-    systems: dict[int, LoopSystem] = {}
-
-    def solve(res: int, condition: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        systems[res] = system = assemble(discretize(nm, method, res), loop)
-        return pencil_eigen(system.A, system.E, condition)
-
-    coarse = solve(p, condition=False)[0]
-    tried: list[_Pair] = []
-    previous = math.inf
-    while True:
-        pair = _drift_pair(solve, coarse, p, rtol_resolved)
-        relative = pair.d_alpha / max(1.0, abs(pair.alpha or 0.0))
-        if pair.alpha is not None:
-            tried.append(pair)
-        if relative <= tol or pair.resolutions[1] >= pmax or _stalled(pair, relative, previous):
-            break
-        p, coarse, previous = pair.resolutions[1], pair.lam, relative
-    chosen = _choose(tried) if tried else pair
-    fine_system = systems[chosen.resolutions[1]]
-    triangular = max(systems[r].triangular_residual for r in chosen.resolutions)
-    A_K, A_err = fine_system.blocks()
-    E = fine_system.discrete.E
-    blocks = (sl.eigvals(A_K, E), sl.eigvals(A_err, E))
-    return _report(nm, chosen, blocks, plant, error, tol, count, method, triangular, design)
-
-
-def _choose(tried: list[_Pair]) -> _Pair:
-    """Return the pair with the most accurate abscissa, unless an earlier one saw further.
-
-    As in :func:`phdesign.numeric.spectrum.spectrum`: an eigenvalue that agreed between
-    two resolutions is an eigenvalue, so a pair whose abscissa lies clearly right of the
-    most accurate pair's (by far more than both drifts) wins; the finer pair lost it.
-    """
-
-    def relative(pair: _Pair) -> float:
-        return pair.d_alpha / max(1.0, abs(pair.alpha or 0.0))
-
-    best = min(tried, key=relative)
-    assert best.alpha is not None  # tried holds pairs with an abscissa only
-    for pair in tried:
-        assert pair.alpha is not None
-        margin = 100.0 * (pair.d_alpha + best.d_alpha) + 1e-9 * max(1.0, abs(pair.alpha))
-        if pair.alpha > best.alpha + margin and relative(pair) <= 1e-6:
-            best = pair
-    return best
-
-
-def _stalled(pair: _Pair, relative: float, previous: float) -> bool:
-    """Refinement no longer helps: an ill-conditioned abscissa whose drift did not shrink.
-
-    Near a coalescence (a Jordan block of the loop: a plant and an error eigenvalue that
-    coincide, coupled by K ỹ_a) round-off, not resolution, limits the digits.
-    """
-    if pair.alpha is None or relative < 0.1 * previous:
-        return False
-    lead = int(np.argmax(pair.lam[pair.counted].real))
-    return bool(pair.lead_loose or pair.kappa[pair.counted][lead] > ILL_CONDITION)
+    solver = AssembledLoopSolver(nm, loop, method=method)
+    with small_dense_threads():
+        trail = refine(solver, start=p, stop=pmax, tol=tol, rtol_resolved=rtol_resolved)
+        chosen, notes = choose_pair(trail)
+        blocks = solver.blocks(chosen.pair.resolutions[1])
+    triangular = max(solver.systems[r].triangular_residual for r in chosen.pair.resolutions)
+    return _report(
+        nm, trail, chosen, notes, blocks, plant, error, tol, count, method, triangular, design
+    )
 
 
 def _report(
     nm: NumericModel,
-    pair: _Pair,
+    trail: list[PairResult],
+    chosen: PairResult,
+    notes: list[str],
     blocks_lam: tuple[np.ndarray, np.ndarray],
     plant: SpectrumReport,
     error: SpectrumReport,
@@ -391,85 +371,75 @@ def _report(
     triangular: float,
     design: str,
 ) -> LoopSpectrum:
-    blocks = [a for a in (plant.spectral_abscissa, error.spectral_abscissa) if a is not None]
     warnings = [f"controlled plant: {w}" for w in plant.warnings]
     warnings += [f"error system: {w}" for w in error.warnings]
-    if pair.alpha is None:
-        warnings.append(
-            f"no eigenvalue of the loop converges up to resolution {pair.resolutions[1]}: "
-            "its spectral abscissa is unbounded below"
-        )
-        return LoopSpectrum(
-            None,
-            False,
-            None,
-            [],
-            [],
-            [],
-            0,
-            int(pair.lam.size),
-            pair.resolutions,
-            method,
-            plant,
-            error,
-            None,
-            triangular,
-            True,
-            False,
-            warnings,
-            nm.name,
-            design,
-        )
-    lam, kappa = pair.lam[pair.counted], pair.kappa[pair.counted]
-    order = np.lexsort((np.abs(lam.imag), -np.round(lam.real, 12)))[:count]
-    rightmost = [complex(z) for z in lam[order]]
-    conds = [float(c) for c in kappa[order]]
-    alpha, d_alpha = pair.alpha, pair.d_alpha
-    converged = d_alpha <= tol * max(1.0, abs(alpha))
-    digits = float(-np.log10(max(d_alpha, 1e-17) / max(1.0, abs(alpha))))
-    ill = bool(conds and (conds[0] > ILL_CONDITION or pair.lead_loose))
-    if ill:
-        warnings.append(
-            f"the loop's rightmost eigenvalue {rightmost[0]:.6g} is ill-conditioned "
-            f"(condition number {conds[0]:.3g}): near a coalescence; few digits are reliable"
-        )
-    unresolved = np.setdiff1d(np.arange(pair.lam.size), pair.counted)
-    right = unresolved[pair.lam.real[unresolved] > alpha + 1e-9 * max(1.0, abs(alpha))]
-    band = np.max(np.abs(lam))
-    low = right[np.abs(pair.lam[right]) <= band]
-    if low.size:
-        warnings.append(
-            f"{low.size} unresolved eigenvalues of the loop lie right of its abscissa within "
-            f"the resolved band (max Re {float(np.max(pair.lam.real[low])):.3g}): check them"
-        )
-    if not converged:
-        warnings.append(
-            f"the loop's spectral abscissa did not converge to {tol:g}: it drifts by "
-            f"{d_alpha:.2g} between resolutions {pair.resolutions[0]} and {pair.resolutions[1]}"
-        )
-    gap = alpha - max(blocks) if blocks else None
-    if gap is not None and abs(gap) > max(10 * d_alpha, 1e-8) * max(1.0, abs(alpha)):
-        warnings.append(
-            f"the loop's abscissa differs from max(plant, error) by {gap:.2g}, beyond its "
-            "resolved digits: the separation structure is not reproduced (report this)"
-        )
-    return LoopSpectrum(
-        spectral_abscissa=alpha,
-        converged=bool(converged),
-        digits=digits,
-        rightmost=rightmost,
-        condition_numbers=conds,
-        origin=_tag(rightmost, blocks_lam),
-        n_resolved=pair.n_tight,
-        n_total=int(pair.lam.size),
+    a, pair = chosen.abscissa, chosen.pair
+    report = partial(  # what both outcomes share: the pair, the blocks, the labels
+        LoopSpectrum,
+        n_total=int(pair.eigenvalues.size),
         resolutions=pair.resolutions,
         method=method,
         plant=plant,
         error=error,
-        separation_gap=gap,
         triangular_residual=triangular,
-        ill_conditioned=ill,
-        warnings=warnings,
         model=nm.name,
         design=design,
+    )
+    if a.value is None or a.uncertainty is None or a.attained is None:
+        extinct = extinct_twice(trail)
+        q = pair.resolutions[1]
+        warnings.append(
+            f"loop: no eigenvalue converges up to resolution {q}"
+            + (
+                ", and every eigenvalue runs off from the origin: the spectrum is empty, its "
+                "spectral abscissa unbounded below"
+                if extinct
+                else ": the loop's spectrum is not resolved at these resolutions"
+            )
+        )
+        return report(
+            spectral_abscissa=None,
+            converged=False,
+            digits=None,
+            rightmost=[],
+            condition_numbers=[],
+            origin=[],
+            n_resolved=0,
+            separation_gap=None,
+            unbounded_below=extinct,
+            warnings=warnings,
+        )
+    own, ill, _ = report_warnings(chosen, a.value, a.uncertainty, a.attained, tol)
+    warnings += [f"loop: {w}" for w in notes + own]
+    lam = pair.eigenvalues
+    top = rightmost_indices(chosen, count)
+    kappa = pair.condition if pair.condition is not None else np.ones(lam.shape)
+    rightmost = [complex(z) for z in lam[top]]
+    slower = max(
+        (r for r in (plant, error) if r.spectral_abscissa is not None),
+        key=lambda r: r.spectral_abscissa or -math.inf,
+        default=None,
+    )
+    gap = None
+    if slower is not None and slower.spectral_abscissa is not None:
+        gap = a.value - slower.spectral_abscissa
+        scale = max(pair.scale, abs(a.value))
+        allowed = max(10.0 * (a.uncertainty + (slower.uncertainty or 0.0)), 1e-8 * scale)
+        if abs(gap) > allowed:
+            warnings.append(
+                f"the loop's abscissa differs from max(plant, error) by {gap:.2g}, beyond its "
+                "resolved digits: the separation structure is not reproduced (report this)"
+            )
+    return report(
+        spectral_abscissa=float(a.value),
+        converged=chosen.converged,
+        digits=abscissa_digits(chosen),
+        rightmost=rightmost,
+        condition_numbers=[float(c) for c in kappa[top]],
+        origin=_tag(rightmost, blocks_lam),
+        n_resolved=pair.n_resolved,
+        separation_gap=gap,
+        ill_conditioned=ill,
+        warnings=warnings,
+        uncertainty=float(a.uncertainty),
     )

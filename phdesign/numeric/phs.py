@@ -19,8 +19,9 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import ObserverError, check_shape
+from phdesign.errors import NumericError, ObserverError, check_shape
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.invariants import require_definite, require_semidefinite, require_skew
 
 __all__ = ["ClosedLoop", "DiscretePHS", "SensorLoop", "feedback_matrix"]
 
@@ -56,6 +57,14 @@ class DiscretePHS:
         ``project(x0) -> ê`` for a vectorized initial state ``x0(z) -> (m, n)``.
     displacement_basis : callable or None
         ``displacement_basis(z) -> (m, dim)``: w(z) = displacement_basis(z) @ ê.
+
+    Raises
+    ------
+    NumericError
+        If a shape does not fit, or an invariant fails beyond round-off
+        (:mod:`phdesign.numeric.invariants`): E not symmetric positive definite, J or D
+        not skew, R not symmetric positive semidefinite.  The message names the matrix
+        and gives what was found.
     """
 
     model: NumericModel
@@ -70,6 +79,27 @@ class DiscretePHS:
     project: Callable[[Callable[[np.ndarray], np.ndarray]], np.ndarray] = field(repr=False)
     displacement_basis: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
     info: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        """Check shapes and the port-Hamiltonian invariants (:mod:`.invariants`), to round-off.
+
+        E symmetric positive definite, J and D skew, R symmetric positive semidefinite:
+        what makes every closed loop ũ = −Kỹ with sym(K) ⪰ 0 dissipative.
+        """
+        n, m = np.shape(self.E)[0], np.shape(self.D)[0]
+        for name, matrix, shape in (
+            ("E", self.E, (n, n)),
+            ("J", self.J, (n, n)),
+            ("R", self.R, (n, n)),
+            ("B", self.B, (n, m)),
+            ("D", self.D, (m, m)),
+        ):
+            check_shape(name, np.asarray(matrix), shape, NumericError)
+        require_definite("E", self.E)
+        require_skew("J", self.J)
+        # R's round-off is relative to the operator J - R it is part of (a lossless R is 0)
+        require_semidefinite("R", self.R, reference=float(np.max(np.abs(self.J), initial=0.0)))
+        require_skew("D", self.D)
 
     @property
     def dim(self) -> int:

@@ -3,7 +3,9 @@ r"""Converged spectra: spectral abscissa and rightmost eigenvalues under refinem
 The eigenvalues of the generalized problem :math:`(J - R - B K_{cl} B^\top) v = \lambda E v`
 (closed plant, u = 0, or the observer error system, ũ = −C_mᵀ L C_m ỹ) are computed on the
 dimensionless model (:mod:`phdesign.numeric.scales`: tolerances and digits are relative
-to the problem's own rate s, whatever its units) in three stages:
+to the problem's own rate s, whatever its units) by shift and invert
+(:mod:`phdesign.numeric.eigen`: accurate on the slow modes whatever the norm of the
+Galerkin matrix), in three stages:
 
 1. **Refinement** (:func:`~phdesign.numeric.spectrum_refinement.refine`): resolution pairs
    (p, ⌈1.5 p⌉), p → ⌈1.5 p⌉, each through the drift test (:mod:`phdesign.numeric.drift`)
@@ -70,6 +72,7 @@ from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.scales import ProblemScales
 from phdesign.numeric.spectrum_refinement import (
     ILL_CONDITION,
+    ClosedLoopSolver,
     Discretizations,
     PairResult,
     choose_pair,
@@ -82,6 +85,7 @@ from phdesign.numeric.threads import small_dense_threads
 __all__ = [
     "PairResult",
     "SpectrumReport",
+    "abscissa_digits",
     "choose_pair",
     "default_resolutions",
     "eigen",
@@ -90,6 +94,7 @@ __all__ = [
     "refine",
     "report_warnings",
     "resolved_abscissa",
+    "rightmost_indices",
     "spectrum",
 ]
 
@@ -101,6 +106,9 @@ def eigen(
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Eigenvalues of ``E v' = closed_matrix(K) v`` and, optionally, condition numbers.
 
+    The eigen stage of :mod:`phdesign.numeric.eigen` (shift and invert at the rate of
+    ``d``'s model).
+
     Examples
     --------
     >>> from phdesign.models import load_builtin
@@ -111,7 +119,7 @@ def eigen(
     >>> bool(np.all(np.abs(lam.real) < 1e-12)), bool(np.all(kappa < 1 + 1e-9))  # lossless
     (True, True)
     """
-    system = prepare(d, whitened=False)
+    system = prepare(d)
     if not condition:
         return system.eigvals(K), None
     return system.eigen_condition(K)
@@ -124,14 +132,25 @@ def resolved_abscissa(
     kappa: np.ndarray | None = None,
     scale: float = 1.0,
     tol: float = 1e-10,
+    dissipative: bool = True,
 ) -> float | None:
     """Return the abscissa (:mod:`phdesign.numeric.abscissa`) of two sets of eigenvalues, or None.
 
     Kept for callers of earlier versions; :class:`phdesign.numeric.evaluator.AbscissaEvaluator`
     prepares a resolution pair once and evaluates it for many gains.  Without condition
     numbers ``kappa`` every in-band unresolved eigenvalue is kept (an upper bound).
+    ``dissipative=True`` (the default: a closed loop ũ = −Kỹ of a discretization) states
+    that every exact eigenvalue has Re λ <= 0 (:mod:`phdesign.numeric.drift`).
     """
-    pair = pair_spectrum(fine, coarse, resolutions=(0, 0), rtol=rtol, scale=scale, kappa=kappa)
+    pair = pair_spectrum(
+        fine,
+        coarse,
+        resolutions=(0, 0),
+        rtol=rtol,
+        scale=scale,
+        kappa=kappa,
+        dissipative=dissipative,
+    )
     return estimate_abscissa(pair, tol).value
 
 
@@ -145,6 +164,22 @@ def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
 
 def _rightmost_order(lam: np.ndarray) -> np.ndarray:
     return np.lexsort((np.abs(lam.imag), -np.round(lam.real, 12)))
+
+
+def rightmost_indices(chosen: PairResult, count: int) -> np.ndarray:
+    """Return the indices (into the pair's eigenvalues) of the ``count`` rightmost counted."""
+    lam = chosen.pair.eigenvalues
+    counted = np.flatnonzero(chosen.abscissa.counted)
+    return counted[_rightmost_order(lam[counted])[:count]]
+
+
+def abscissa_digits(chosen: PairResult) -> float:
+    """Digits of the chosen pair's abscissa, relative to max(rate, |α|), at most ε's."""
+    a = chosen.abscissa
+    if a.value is None or a.uncertainty is None:
+        raise NumericError("the pair has no abscissa: no digits")
+    scale = max(chosen.pair.scale, abs(a.value))
+    return -math.log10(max(a.uncertainty, np.finfo(float).eps * scale) / scale)
 
 
 def report_warnings(
@@ -350,17 +385,11 @@ def spectrum(
     pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
     system = "plant (u = 0)" if K is None else "observer error system"
     with small_dense_threads():
-        trail, scales = refine(
-            nm,
-            K,
-            method=method,
-            start=p,
-            stop=pmax,
-            tol=tol,
-            rtol_resolved=rtol_resolved,
-            basis=basis,
-            discretizations=discretizations,
+        solver = ClosedLoopSolver(
+            nm, K, method=method, basis=basis, discretizations=discretizations
         )
+        trail = refine(solver, start=p, stop=pmax, tol=tol, rtol_resolved=rtol_resolved)
+    scales = solver.scales
     sensors = None if C_m is None else np.atleast_2d(np.asarray(C_m, float)).tolist()
     gain = None if L is None else np.atleast_2d(np.asarray(L, float)).tolist()
     chosen, notes = choose_pair(trail)
@@ -369,11 +398,9 @@ def spectrum(
         return _unresolved_report(trail, method, system, nm.name, scales, sensors, gain)
     warnings, ill, no_decay = report_warnings(chosen, a.value, a.uncertainty, a.attained, tol)
     lam = pair.eigenvalues
-    counted = np.flatnonzero(a.counted)
-    top = counted[_rightmost_order(lam[counted])[:count]]
+    top = rightmost_indices(chosen, count)
     kappa = pair.condition if pair.condition is not None else np.ones(lam.shape)
-    scale = max(pair.scale, abs(a.value))
-    digits = -math.log10(max(a.uncertainty, np.finfo(float).eps * scale) / scale)
+    digits = abscissa_digits(chosen)
     return SpectrumReport(
         spectral_abscissa=float(a.value),
         rightmost=[complex(z) for z in lam[top]],

@@ -4,8 +4,14 @@ Stage 1, :func:`refine`: pairs (p, ⌈1.5 p⌉), p → ⌈1.5 p⌉, each through
 (:mod:`phdesign.numeric.drift`) and the abscissa rule (:mod:`phdesign.numeric.abscissa`),
 until a pair satisfies the convergence rule (:func:`convergence_rule`), the largest
 resolution is reached, or refinement stops helping (an ill-conditioned coalescence, an
-empty spectrum seen twice, a high-frequency limit extrapolated alike twice).  Each
-resolution is solved once (QZ, with condition numbers) and serves two pairs.
+empty spectrum seen twice, a high-frequency limit extrapolated alike twice).  The
+eigenvalues come from a *per-resolution solver* (:class:`ResolutionSolver`): the closed
+loop of one discretization (:class:`ClosedLoopSolver`, for
+:func:`phdesign.numeric.spectrum.spectrum`) or the assembled observer-based loop
+(:func:`phdesign.numeric.loop_spectrum.loop_spectrum`); both solve each resolution once,
+by the shift and invert of :mod:`phdesign.numeric.eigen`, with condition numbers, and
+each resolution serves two pairs.  So one refinement, one drift rule and one choice of
+the pair serve the spectrum and the loop.
 
 Stage 2, :func:`choose_pair`: the converged pair, else the most accurate pair that no finer
 pair contradicts, unless an earlier pair's resolved abscissa lies clearly to the right.
@@ -16,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -24,15 +31,17 @@ from phdesign.numeric.abscissa import MIN_MODES_ABOVE, Abscissa, estimate_abscis
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.drift import PairSpectrum, pair_spectrum
-from phdesign.numeric.eigen import PreparedSystem, prepare, rescaled
+from phdesign.numeric.eigen import SHIFT, PreparedSystem, prepare, rescaled
 from phdesign.numeric.evaluator import fine_resolution
-from phdesign.numeric.scales import ProblemScales, dimensionless_model
+from phdesign.numeric.scales import dimensionless_model
 from phdesign.numeric.spectrum_report import RefinementStep
 
 __all__ = [
     "ILL_CONDITION",
+    "ClosedLoopSolver",
     "Discretizations",
     "PairResult",
+    "ResolutionSolver",
     "choose_pair",
     "convergence_rule",
     "extinct_twice",
@@ -113,6 +122,25 @@ def convergence_rule(pair: PairSpectrum, a: Abscissa, tol: float) -> str:
     return ""
 
 
+class ResolutionSolver(Protocol):
+    """What :func:`refine` needs: the eigenvalues of the problem at a resolution.
+
+    Attributes
+    ----------
+    rate : float
+        The problem's rate s (:mod:`phdesign.numeric.scales`): the drift test's scale.
+    dissipative : bool
+        Every exact eigenvalue has Re λ <= 0 (:mod:`phdesign.numeric.drift`).
+    """
+
+    rate: float
+    dissipative: bool
+
+    def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+        """Eigenvalues (in the model's units) and energy-norm condition numbers at p."""
+        ...
+
+
 class Discretizations:
     """The dimensionless model's discretizations, once per resolution, for any gain.
 
@@ -138,74 +166,91 @@ class Discretizations:
         return self.model is nm and self.method == method and self.basis == basis
 
     def __call__(self, p: int) -> PreparedSystem:
-        """Return the discretization at resolution ``p``, prepared for QZ (cached)."""
+        """Return the discretization at resolution ``p``, prepared for the eigen stage (cached).
+
+        Shift and invert (:mod:`phdesign.numeric.eigen`) at
+        :data:`~phdesign.numeric.eigen.SHIFT`, the rate of the dimensionless model.
+        """
         if p not in self._cache:
-            # QZ, not the whitened Hessenberg QR: a report keeps every digit it can
             discrete = discretize(self.dimensionless, self.method, p, basis=self.basis)
-            self._cache[p] = prepare(discrete, whitened=False)
+            self._cache[p] = prepare(discrete, shift=SHIFT)
         return self._cache[p]
 
 
-class _Resolutions:
-    """Eigenvalues (with condition numbers) of the closed loop, once per resolution."""
+class ClosedLoopSolver:
+    r"""Eigenvalues of the closed loop ũ = −Kỹ of the dimensionless model, once per resolution.
 
-    def __init__(self, discretizations: Discretizations, K: np.ndarray | None) -> None:
+    Shift and invert (:mod:`phdesign.numeric.eigen`) on the discretizations of
+    :class:`Discretizations` (made here unless given: a gain map shares them), scaled back
+    by the rate.  The closed loop is dissipative: the model and its discretizations check
+    their invariants and ``K`` comes from
+    :func:`~phdesign.numeric.discretize.feedback_matrix` (:math:`L + L^\top \succ 0`).
+
+    Raises
+    ------
+    NumericError
+        If ``discretizations`` are not those of ``nm`` by ``method`` and ``basis``.
+    """
+
+    dissipative = True
+
+    def __init__(
+        self,
+        nm: NumericModel,
+        K: np.ndarray | None,
+        *,
+        method: str,
+        basis: str | None = None,
+        discretizations: Discretizations | None = None,
+    ) -> None:
+        if discretizations is None:
+            discretizations = Discretizations(nm, method, basis)
+        elif not discretizations.serves(nm, method, basis):
+            raise NumericError(
+                "discretizations: expected those of this model, method and basis; found "
+                f"{discretizations.model.name!r} by {discretizations.method!r} "
+                f"(basis {discretizations.basis!r})"
+            )
         self.discretizations, self.scales, self.K = discretizations, discretizations.scales, K
+        self.rate = self.scales.rate
         self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
-    def solve(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+    def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+        """Eigenvalues and condition numbers at resolution ``p`` (cached)."""
         if p not in self._cache:
             lam, kappa = self.discretizations(p).eigen_condition(self.K)
-            self._cache[p] = (rescaled(lam, self.scales.rate), kappa)
+            self._cache[p] = (rescaled(lam, self.rate), kappa)
         return self._cache[p]
 
 
 def refine(
-    nm: NumericModel,
-    K: np.ndarray | None,
-    *,
-    method: str,
-    start: int,
-    stop: int,
-    tol: float,
-    rtol_resolved: float,
-    basis: str | None = None,
-    discretizations: Discretizations | None = None,
-) -> tuple[list[PairResult], ProblemScales]:
+    solver: ResolutionSolver, *, start: int, stop: int, tol: float, rtol_resolved: float
+) -> list[PairResult]:
     """Stage 1: pairs (p, ⌈1.5 p⌉) from ``start`` until one converges or p_fine >= ``stop``.
 
-    ``basis`` is the Galerkin basis (default: the defaults table's, for the order);
-    ``discretizations`` those of ``nm`` by ``method`` and ``basis`` already made (a gain map).
+    ``solver(p)`` gives the eigenvalues and condition numbers at resolution p.
     """
-    if discretizations is None:
-        discretizations = Discretizations(nm, method, basis)
-    elif not discretizations.serves(nm, method, basis):
-        raise NumericError(
-            "discretizations: expected those of this model, method and basis; found "
-            f"{discretizations.model.name!r} by {discretizations.method!r} "
-            f"(basis {discretizations.basis!r})"
-        )
-    solver = _Resolutions(discretizations, K)
     trail: list[PairResult] = []
     p = int(start)
     while True:
         p_fine = fine_resolution(p)
-        coarse, _ = solver.solve(p)
-        fine, kappa = solver.solve(p_fine)
+        coarse, _ = solver(p)
+        fine, kappa = solver(p_fine)
         pair = pair_spectrum(
             fine,
             coarse,
             resolutions=(p, p_fine),
             rtol=rtol_resolved,
-            scale=solver.scales.rate,
+            scale=solver.rate,
             kappa=kappa,
+            dissipative=solver.dissipative,
         )
         a = estimate_abscissa(pair, tol)
         reason = convergence_rule(pair, a, tol)
         trail.append(PairResult(pair, a, not reason, reason))
         settled = _degrading(trail) or _limit_settled(trail) or extinct_twice(trail)
         if not reason or p_fine >= stop or settled:
-            return trail, solver.scales
+            return trail
         p = p_fine
 
 
