@@ -7,8 +7,8 @@ grid of (l1, l2), sensors y3, y4, in chunks of the default size.  Measured in on
 invocation, alternating the two so that a change of the machine's load hits both:
 
 * the synchronous run (this process): wall time, and the per-point cost (the chunks'
-  own compute time over the points; the fast path, answered from the prepared
-  resolution pair, separately as a median over single points);
+  own compute time over the points; a point that converges at the pair (20, 30), its
+  discretizations shared by the chunk, separately as a median over single points);
 * the same sweep on a ``LocalCluster`` of 2 single-threaded worker processes (started and
   warmed before the timing; its start-up is printed apart): wall time and speed-up over
   the synchronous run (target >= 1.6x on 2 cores);
@@ -177,7 +177,7 @@ def main(argv: list[str] | None = None) -> int:
     mean_chunk = statistics.median(sync_compute) / chunks
     print(f"beam gain map, {points} points in {chunks} chunks, options {options or 'default'}")
     print(f"converged: {converged} of {points} points")
-    print(f"per point: {mean_point:.1f} ms on average; {fast:.1f} ms (median) from the pair")
+    print(f"per point: {mean_point:.1f} ms on average; {fast:.1f} ms (median) at (20, 30)")
     print(f"synchronous: {s:.2f} s (runs: {', '.join(f'{t:.2f}' for t in sync_wall)})")
     print(
         f"2 workers:   {d:.2f} s (runs: {', '.join(f'{t:.2f}' for t in dask_wall)}); "
