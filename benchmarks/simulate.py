@@ -36,8 +36,9 @@ from scipy.integrate import solve_ivp
 from scipy.sparse.linalg import expm_multiply
 
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import initial_state_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretize import discretize, feedback_matrix
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.simulate import coupled_system, simulate, step_lti
 
 

@@ -30,8 +30,9 @@ from scipy.optimize import minimize
 
 from phdesign import plots
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import initial_state_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.evaluator import AbscissaEvaluator
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.simulate import simulate
 from phdesign.numeric.spectrum import spectrum
 from phdesign.numeric.tune import tune

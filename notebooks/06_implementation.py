@@ -44,8 +44,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import initial_state_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretize import discretize
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.order import balanced_truncation
 from phdesign.numeric.sampled import export_observer, verify_observer
 from phdesign.numeric.sampled_simulation import simulate_sampled

@@ -290,7 +290,7 @@ class Loop:
         ``x0``, ``xhat0`` and ``u`` may be text (``"x1: 0, x2: z - 0.9"``,
         ``"u1: sin(t)"``), read as on the command line, or callables.
         """
-        from phdesign.numeric.bridge import initial_state_function, input_function
+        from phdesign.numeric.inputs import initial_state_function, input_function
         from phdesign.numeric.loop_simulate import simulate_loop
 
         nm = self.numeric_model

@@ -129,7 +129,7 @@ class Plant:
                 f"{name} must be text such as 'x1: 0, x2: z - 0.9' or a function of z; "
                 f"found {type(x0).__name__}"
             )
-        from phdesign.numeric.bridge import initial_state_function
+        from phdesign.numeric.inputs import initial_state_function
 
         return initial_state_function(x0, self.numeric)
 

@@ -128,7 +128,8 @@ def test_parameters_reach_classification_and_numbers(beam):
 
 def test_initial_state_uses_the_parameters_of_the_numeric_model(wave):
     # issue 11 bug: rho = 4 gave x1(1) = 1; x1 = rho*z at z = 1 is 4
-    from phdesign.numeric.bridge import initial_state_function, to_numeric
+    from phdesign.numeric.bridge import to_numeric
+    from phdesign.numeric.inputs import initial_state_function
 
     nm = to_numeric(wave, {"rho": 4})
     x0 = initial_state_function("x1: rho*z", nm, model=wave)

@@ -58,7 +58,7 @@ def test_export_with_verification_passes_the_initial_state_text(string):
         dt=DT, order=12, verify=True, x0=x0, t_end=1.0, plant_resolution=24, sampler="point"
     )
     nm = phd.to_numeric(phd.load("wave"))
-    from phdesign.numeric.bridge import initial_state_function
+    from phdesign.numeric.inputs import initial_state_function
 
     direct = export_observer(
         nm,

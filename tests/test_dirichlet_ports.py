@@ -20,9 +20,10 @@ from dirichlet_models import beam, every_combination, string, timoshenko
 from numeric_models import numeric
 
 from phdesign.errors import NumericError
-from phdesign.numeric.bridge import initial_state_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretize import discretize, feedback_matrix
 from phdesign.numeric.galerkin import galerkin
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.simulate import simulate
 from phdesign.numeric.spectrum import match_resolved, spectrum
 

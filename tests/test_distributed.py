@@ -16,8 +16,9 @@ import scipy.linalg as sl
 import sympy
 
 from phdesign.errors import ExpressionError, ModelError
-from phdesign.numeric.bridge import initial_state_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretize import discretize
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.simulate import simulate
 from phdesign.numeric.spectrum import spectrum
 from phdesign.symbolic.model import BCPHS

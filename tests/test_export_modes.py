@@ -20,9 +20,10 @@ from numeric_models import FEEDTHROUGH, PAPER_SENSORS, numeric
 
 from phdesign.errors import NumericError
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import initial_state_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretize import discretize, feedback_matrix
 from phdesign.numeric.export import error_statespace, observer_statespace, plant_statespace
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.simulate import simulate
 from phdesign.symbolic.model import BCPHS
 

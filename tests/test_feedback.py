@@ -17,10 +17,11 @@ from hypothesis import strategies as st
 from phdesign.errors import ModelError
 from phdesign.io import model_from_toml, model_to_toml
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import initial_state_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.export import plant_statespace
 from phdesign.numeric.galerkin import galerkin
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.simulate import simulate
 from phdesign.numeric.spectrum import spectrum
 from phdesign.symbolic.classify import classify

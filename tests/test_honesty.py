@@ -16,7 +16,8 @@ import sympy
 
 from phdesign.cli import main
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import initial_state_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.simulate import ENERGY_BALANCE_RTOL, simulate
 from phdesign.numeric.spectrum import spectrum
 from phdesign.symbolic.classify import classify

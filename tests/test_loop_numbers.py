@@ -19,7 +19,8 @@ import scipy.linalg as sl
 from phdesign.errors import LoopError
 from phdesign.loop import Loop
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import NumericModel, constant_H, initial_state_function, to_numeric
+from phdesign.numeric.bridge import NumericModel, constant_H, to_numeric
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.loop import NumericLoop, assemble
 from phdesign.numeric.loop_simulate import simulate_loop
 from phdesign.numeric.loop_spectrum import loop_spectrum

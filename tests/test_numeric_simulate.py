@@ -13,9 +13,9 @@ from numeric_models import PAPER_SENSORS, TABLE_I, numeric
 
 from phdesign.errors import NumericError, ParameterError
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import initial_state_function
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.export import error_statespace, observer_statespace, plant_statespace
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.simulate import simulate
 from phdesign.numeric.spectrum import spectrum
 

@@ -271,7 +271,8 @@ def test_plot_simulation_without_displacement_draws_the_outputs():
 
 def test_plot_simulation_on_a_real_wave_simulation(tmp_path):
     from phdesign.models import load_builtin
-    from phdesign.numeric.bridge import initial_state_function, to_numeric
+    from phdesign.numeric.bridge import to_numeric
+    from phdesign.numeric.inputs import initial_state_function
     from phdesign.numeric.simulate import simulate
 
     wave = load_builtin("wave")

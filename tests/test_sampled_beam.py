@@ -18,8 +18,9 @@ import pytest
 from phdesign.errors import NumericError
 from phdesign.models import load_builtin
 from phdesign.numeric import order as order_module
-from phdesign.numeric.bridge import initial_state_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretize import discretize
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.order import balanced_truncation, select_order
 from phdesign.numeric.sampled import export_observer, verify_observer
 from phdesign.numeric.sampling import ContinuousObserver

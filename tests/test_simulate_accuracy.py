@@ -18,8 +18,8 @@ from characteristic import characteristic_determinant
 from numeric_models import PAPER_SENSORS, numeric
 
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import initial_state_function
 from phdesign.numeric.discretize import discretize, feedback_matrix
+from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.simulate import ResolutionWarning, coupled_system, simulate
 from phdesign.numeric.stepping import integrate
 

@@ -13,7 +13,8 @@ from phdesign.cli import main
 from phdesign.errors import ModelError
 from phdesign.io import model_from_toml, model_to_toml
 from phdesign.models import load_builtin
-from phdesign.numeric.bridge import input_function, to_numeric
+from phdesign.numeric.bridge import to_numeric
+from phdesign.numeric.inputs import input_function
 from phdesign.numeric.simulate import simulate
 from phdesign.symbolic.model import BCPHS
 

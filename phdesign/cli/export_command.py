@@ -135,7 +135,7 @@ def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
 
 def _export(args: argparse.Namespace) -> int:
     from phdesign.codegen import check_export_path
-    from phdesign.numeric.bridge import initial_state_function
+    from phdesign.numeric.inputs import initial_state_function
     from phdesign.numeric.sampled import export_observer, verification_plant_degree
     from phdesign.numeric.sampling import check_sampling
 

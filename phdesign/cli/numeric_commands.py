@@ -205,7 +205,7 @@ def _simulate(args: argparse.Namespace) -> int:
     import numpy as np
 
     from phdesign.design import Plant
-    from phdesign.numeric.bridge import input_function
+    from phdesign.numeric.inputs import input_function
 
     _check_positive("--resolution", args.resolution)
     _check_positive("--t-end", args.t_end)

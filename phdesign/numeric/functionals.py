@@ -30,7 +30,8 @@ import numpy as np
 from numpy.polynomial import legendre as leg
 
 from phdesign.errors import NumericError, ParameterError
-from phdesign.numeric.bridge import NumericModel, initial_state_function, trace_row
+from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.inputs import initial_state_function, trace_row
 from phdesign.numeric.phs import DiscretePHS
 
 __all__ = [

@@ -160,7 +160,8 @@ def simulate_loop(
     Examples
     --------
     >>> from phdesign.models import load_builtin
-    >>> from phdesign.numeric.bridge import initial_state_function, to_numeric
+    >>> from phdesign.numeric.bridge import to_numeric
+    >>> from phdesign.numeric.inputs import initial_state_function
     >>> beam = load_builtin("euler-bernoulli")
     >>> nm = to_numeric(beam)
     >>> loop = NumericLoop((2,), np.eye(1), np.array([[0, 0, 0, 1.0]]), np.eye(1))

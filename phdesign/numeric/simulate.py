@@ -331,7 +331,7 @@ def simulate(
         Sensors and gain (both or neither).
     x0, xhat0 : callable, optional
         Initial states ``f(z) -> (m, n)`` (see
-        :func:`phdesign.numeric.bridge.initial_state_function`); default zero.
+        :func:`phdesign.numeric.inputs.initial_state_function`); default zero.
     t_end : float
         Final time (> 0).
     samples : int

@@ -1,0 +1,327 @@
+r"""The user's expressions read against a model: initial states, input signals, traces.
+
+The second half of the crossing from the symbolic layer (:mod:`phdesign.numeric.bridge`):
+
+* :func:`initial_state_function`: ``"x1: 0, x2: z - 0.9"`` (state names, efforts
+  ``e1: ...`` through :math:`x = \mathcal H^{-1} e`, the model's parameters) as a
+  vectorized :math:`x_0(z)`;
+* :func:`input_function`: ``"u2: sin(2*t)"`` as :math:`u(t)` over the model's inputs;
+* :func:`trace_row`: a linear combination of boundary traces, ``"e1(1)"``, as a row over
+  the trace vector :math:`v` (:mod:`phdesign.numeric.bridge` gives the ordering).
+
+Every expression is read by the safe parser and evaluated without code generation; an
+unknown name, a symbol left free or a value that is not finite raises a phdesign error
+naming the item.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from functools import partial
+from typing import Any
+
+import numpy as np
+
+from phdesign.errors import ExpressionError, NumericError, ParameterError
+from phdesign.numeric.bridge import (
+    NumericModel,
+    _free_symbols_message,
+    _parameter_values,
+    trace_index,
+)
+
+__all__ = ["initial_state_function", "input_function", "trace_row"]
+
+
+def _evaluate_at(expr: Any, variable: Any, t: float) -> Any:
+    """``expr`` at ``variable = t`` (the safe evaluator: no code generation)."""
+    from phdesign.symbolic.evaluation import evaluate
+
+    return evaluate(expr, np.array(t), variable=variable)
+
+
+def trace_row(text: str, nm: NumericModel, model: Any = None) -> np.ndarray:
+    """Read a linear combination of boundary traces, ``"e1(1)"``, as a row over ``v``.
+
+    The text is parsed by the symbolic layer's trace grammar (points ``a``, ``b`` or the
+    endpoint values); parameters in coefficients take the values of ``model`` (the
+    defaults, or the overrides it carries).
+
+    Returns
+    -------
+    ndarray (2 N n,)
+        ``r`` with ``r @ v`` the combination, in the trace ordering of the module docstring.
+
+    Examples
+    --------
+    >>> from phdesign.numeric.bridge import NumericModel, constant_H
+    >>> P = (np.zeros((1, 1)), np.ones((1, 1)))
+    >>> nm = NumericModel("t", (0.0, 1.0), 1, 1, P, constant_H([[1.0]]), [[0, 1]], [[1, 0]])
+    >>> trace_row("2*e1(1) - e1(0)", nm).tolist()
+    [2.0, -1.0]
+    """
+    import sympy
+
+    from phdesign.symbolic import expressions as ex
+
+    values = _parameter_values(model, None) if model is not None else {}
+    if model is not None:  # exact endpoints, so that "e1(1)" names the endpoint 1
+        interval = tuple(
+            ex.exact_number(x, "interval endpoint").xreplace(values) for x in model.interval
+        )
+    else:
+        interval = tuple(sympy.Rational(repr(x)) for x in nm.interval)
+    expr = ex.parse_trace_expression(
+        text, interval, nm.order, nm.size, parameters=[str(s) for s in values]
+    )
+    row = np.zeros(2 * nm.order * nm.size)  # the trace vector of the open plant
+    for trace, coefficient in ex.linear_coefficients(expr).items():
+        value = coefficient.subs(values)
+        if value.free_symbols:
+            message = _free_symbols_message(f"trace expression {text!r}", value.free_symbols)
+            raise ParameterError(message)
+        index = trace_index(trace.component, trace.derivative, trace.side, nm.order, nm.size)
+        row[index] = float(value)
+    return row
+
+
+def initial_state_function(
+    text: str | None,
+    nm: NumericModel,
+    parameters: Mapping[str, Any] | None = None,
+    model: Any = None,
+    what: str = "initial state",
+) -> Callable[[np.ndarray], np.ndarray]:
+    """Parse an initial state ``'x1: 0, x2: z - 0.9'`` into a vectorized callable.
+
+    Syntax: comma-separated ``name: expression`` pairs.  A name is a state name of the
+    model (``x1``, ...) or ``e<i>`` for the effort ``(H x)_i``; an expression is a
+    formula in ``z`` and the model's parameters (``sin(pi*z)``, ``z - 0.9``).  Components
+    not mentioned are zero.  Expressions are parsed with the symbolic layer's safe parser
+    (no ``eval`` of user text).  Efforts and states cannot be mixed.
+
+    Returns
+    -------
+    callable
+        ``f(z) -> (m, n)``, the state x at the points z.
+
+    Examples
+    --------
+    >>> from phdesign.numeric.bridge import NumericModel, constant_H
+    >>> import numpy as np
+    >>> P = (np.zeros((1, 1)), np.ones((1, 1)))
+    >>> U = np.array([[0.0, 1.0]]); Y = np.array([[1.0, 0.0]])
+    >>> nm = NumericModel("t", (0.0, 1.0), 1, 1, P, constant_H([[2.0]]), U, Y)
+    >>> initial_state_function("e1: 2*z", nm)(np.array([0.5]))
+    array([[0.5]])
+    """
+    from phdesign.arguments import require_numeric_model
+
+    require_numeric_model(nm)
+    if text is not None and not isinstance(text, str):
+        raise ParameterError(
+            f"initial state must be text such as 'x1: z - 0.9'; found {type(text).__name__}"
+        )
+    n = nm.size
+    if text is None or not text.strip():
+        return lambda z: np.zeros((np.atleast_1d(z).size, n))
+
+    names = {s: i for i, s in enumerate(nm.state_names)}
+    names.update({f"x{i + 1}": i for i in range(n)})
+    efforts = {f"e{i + 1}": i for i in range(n)}
+    exprs: dict[int, Any] = {}
+    kind: str | None = None
+    for part in _split_top_level(text):
+        if ":" not in part:
+            raise ParameterError(
+                f"{what} item {part.strip()!r}: expected 'name: expression', "
+                f"e.g. '{nm.state_names[0]}: z - 0.9'"
+            )
+        key, expr_text = (s.strip() for s in part.split(":", 1))
+        if key in names:
+            this, idx = "x", names[key]
+        elif key in efforts:
+            this, idx = "e", efforts[key]
+        else:
+            known = ", ".join([*nm.state_names, *(f"x{i + 1}" for i in range(n)), *efforts])
+            raise ParameterError(f"{what}: unknown component {key!r}; expected one of {known}")
+        if kind is not None and this != kind:
+            raise ParameterError(f"{what}: give either state components or efforts, not both")
+        kind = this
+        if idx in exprs:
+            raise ParameterError(f"{what}: component {key!r} given twice")
+        exprs[idx] = _parse_z_expression(expr_text, nm, model, parameters, f"{what} expression")
+    from phdesign.symbolic.evaluation import evaluate
+
+    funcs = {i: (lambda zz, e=e: evaluate(e, zz)) for i, e in exprs.items()}
+
+    def x0(z: np.ndarray) -> np.ndarray:
+        zz = np.atleast_1d(np.asarray(z, dtype=float))
+        out = np.zeros((zz.size, n))
+        for i, f in funcs.items():
+            out[:, i] = np.broadcast_to(np.asarray(f(zz), dtype=float), zz.shape)
+        if kind == "e":
+            out = np.linalg.solve(nm.H_at(zz), out[:, :, None])[:, :, 0]
+        return out
+
+    return x0
+
+
+def _split_top_level(text: str) -> list[str]:
+    """Split on commas that are not inside parentheses or brackets."""
+    parts: list[str] = []
+    cur: list[str] = []
+    depth = 0
+    for ch in text:
+        if ch in "([":
+            depth += 1
+        elif ch in ")]":
+            depth -= 1
+        if ch == "," and depth == 0:
+            parts.append("".join(cur))
+            cur = []
+        else:
+            cur.append(ch)
+    parts.append("".join(cur))
+    return [p for p in parts if p.strip()]
+
+
+def _exact_value(value: Any) -> Any:
+    """Return a parameter value as an exact number (a float by its shortest decimal)."""
+    from phdesign.symbolic.expressions import exact_number
+
+    return exact_number(value, "parameter value") if isinstance(value, float) else value
+
+
+def _substituted_values(
+    nm: NumericModel, model: Any, parameters: Mapping[str, Any] | None
+) -> dict[str, Any]:
+    """Parameter values by name: those ``nm`` was built with, overridden by ``parameters``.
+
+    ``nm.parameters`` holds the defaults and the overrides given to :func:`to_numeric`;
+    a NumericModel built by hand has none, and then the model's defaults are used.
+    """
+    from phdesign.symbolic import expressions as ex
+
+    values: dict[str, Any] = dict(nm.parameters)
+    if not values and model is not None:
+        values = {str(s): v for s, v in model.parameter_defaults.items()}
+    for name, value in (parameters or {}).items():
+        if str(name) not in values:
+            known = ", ".join(values) or "none"
+            raise ParameterError(f"unknown parameter {name!r}; the model's parameters are {known}")
+        values[str(name)] = ex.exact_number(value, f"parameter {name}")
+    return values
+
+
+def _parse_z_expression(
+    text: str,
+    nm: NumericModel,
+    model: Any,
+    parameters: Mapping[str, Any] | None,
+    what: str = "initial state expression",
+) -> Any:
+    """Parse an expression in z (and parameters) safely and substitute the parameter values.
+
+    The values are those of :func:`_substituted_values`.
+    """
+    from phdesign.symbolic import expressions as ex
+    from phdesign.symbolic.model import Z
+
+    values = _substituted_values(nm, model, parameters)
+    expr = ex.parse_scalar(text, parameters=list(values), allow_z=True, what=what)
+    # parse_scalar builds its own z and parameter symbols; map them by name.
+    subs = {
+        s: (Z if str(s) == "z" else _exact_value(values[str(s)]))
+        for s in expr.free_symbols
+        if str(s) == "z" or str(s) in values
+    }
+    expr = expr.xreplace(subs)
+    free = set(expr.free_symbols) - {Z}
+    if free:
+        raise ParameterError(_free_symbols_message(f"{what} {text!r}", free))
+    return expr
+
+
+def input_function(
+    text: str | None,
+    nm: NumericModel,
+    parameters: Mapping[str, Any] | None = None,
+    model: Any = None,
+) -> Callable[[float], np.ndarray] | None:
+    """Parse plant inputs ``'u2: sin(2*t), u1: 0.1'`` into ``u(t) -> (n_ports,)``.
+
+    Syntax: comma-separated ``u<i>: expression`` items, ``i`` a 1-based index into the
+    model's external inputs and the expression a formula in the time ``t`` and the
+    model's parameters, read by the symbolic layer's safe parser (never evaluated as
+    Python).  Inputs not named are zero; ``None`` or empty text gives ``None`` (no input).
+
+    Raises
+    ------
+    ParameterError
+        On an unknown or repeated input name, or a missing ``:``.
+    ExpressionError
+        On a malformed expression or an unknown symbol (named in the message).
+
+    Examples
+    --------
+    >>> P = (np.zeros((1, 1)), np.ones((1, 1)))
+    >>> U = np.array([[0.0, 1.0]]); Y = np.array([[1.0, 0.0]])
+    >>> from phdesign.numeric.bridge import constant_H
+    >>> nm = NumericModel("t", (0.0, 1.0), 1, 1, P, constant_H([[1.0]]), U, Y)
+    >>> input_function("u1: 2*t", nm)(0.25)
+    array([0.5])
+    """
+    if text is None or not text.strip():
+        return None
+    import sympy
+
+    from phdesign.symbolic.parser import check_text, parse
+
+    check_text(text, "--u")
+    by_name = {
+        name: _exact_value(value)
+        for name, value in _substituted_values(nm, model, parameters).items()
+    }
+    time = sympy.Symbol("t", real=True)
+
+    def resolve(name: str, expression: str) -> Any:
+        if name == "t":
+            return time
+        if name in by_name:
+            return by_name[name]
+        known = ", ".join(["t", *sorted(by_name)])
+        raise ExpressionError(f"unknown symbol {name!r} in {expression!r}; expected {known}")
+
+    m = nm.n_ports
+    names = {f"u{i + 1}": i for i in range(m)}
+    funcs: dict[int, Callable[[float], Any]] = {}
+    for part in _split_top_level(text):
+        if ":" not in part:
+            raise ParameterError(
+                f"--u item {part.strip()!r}: expected 'u<i>: expression in t', e.g. 'u1: sin(2*t)'"
+            )
+        key, body = (x.strip() for x in part.split(":", 1))
+        if key not in names:
+            expected = ", ".join(names) if names else "none (every input is closed)"
+            raise ParameterError(f"--u: unknown input {key!r}; the model's inputs are {expected}")
+        if names[key] in funcs:
+            raise ParameterError(f"--u: input {key!r} given twice")
+        try:
+            expr = parse(body, resolve)
+        except ExpressionError as error:
+            raise ExpressionError(f"--u {key}: {error}") from None
+        funcs[names[key]] = partial(_evaluate_at, expr, time)
+
+    def u(t: float) -> np.ndarray:
+        out = np.zeros(m)
+        for i, f in funcs.items():
+            try:
+                out[i] = float(f(float(t)))
+            except (ArithmeticError, ValueError, TypeError):
+                out[i] = np.nan
+            if not np.isfinite(out[i]):
+                raise NumericError(f"--u: input u{i + 1} is not finite at t = {t:g}")
+        return out
+
+    return u
