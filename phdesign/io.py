@@ -51,8 +51,8 @@ import tomli_w
 from phdesign.errors import ModelFileError, PhdesignError
 from phdesign.limits import MAX_MODEL_FILE_BYTES, check_file_size
 from phdesign.outputs import atomic_write, check_output_path
-from phdesign.symbolic.expressions import format_expression
 from phdesign.symbolic.model import BCPHS, Displacement
+from phdesign.symbolic.printing import format_expression
 
 __all__ = [
     "atomic_write",

@@ -18,9 +18,9 @@ from phdesign.errors import PortError
 from phdesign.io import model_from_toml, model_to_toml
 from phdesign.models import builtin_names, load_builtin
 from phdesign.symbolic.conjugate import conjugate_outputs
-from phdesign.symbolic.expressions import format_expression
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.ports import coefficient_matrix, derive_ports, q_matrix, trace_vector
+from phdesign.symbolic.printing import format_expression
 
 
 @pytest.mark.parametrize("name", builtin_names())

@@ -14,7 +14,6 @@ from phdesign.symbolic.expressions import (
     Trace,
     Z,
     exact_number,
-    format_expression,
     linear_coefficients,
     parameter_symbol,
     parse_scalar,
@@ -22,6 +21,7 @@ from phdesign.symbolic.expressions import (
     trace_of,
     trace_symbol,
 )
+from phdesign.symbolic.printing import format_expression
 
 INTERVAL = (0, 1)
 

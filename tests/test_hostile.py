@@ -26,12 +26,12 @@ from phdesign.outputs import OutputFiles
 from phdesign.symbolic.expressions import (
     Trace,
     Z,
-    format_expression,
     parameter_symbol,
     parse_scalar,
     parse_trace_expression,
 )
 from phdesign.symbolic.model import BCPHS
+from phdesign.symbolic.printing import format_expression
 
 CANARY = "canary-of-test_hostile"
 

@@ -13,9 +13,9 @@ from hypothesis import strategies as st
 from phdesign.errors import ModelFileError, OutputFileError
 from phdesign.io import atomic_write, model_from_toml, model_to_toml, read_model, write_model
 from phdesign.models import builtin_names, builtin_toml, load_builtin
-from phdesign.symbolic.expressions import format_expression
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.ports import derive_ports, q_matrix, trace_vector
+from phdesign.symbolic.printing import format_expression
 
 
 @pytest.mark.parametrize("name", builtin_names())

@@ -36,7 +36,8 @@ that choice; the sign is fixed by :math:`W_C\Sigma W_B^\top = +I` (power
 
 Examples
 --------
->>> from phdesign.symbolic.expressions import parse_trace_expression, format_expression
+>>> from phdesign.symbolic.expressions import parse_trace_expression
+>>> from phdesign.symbolic.printing import format_expression
 >>> inputs = [parse_trace_expression(t, (0, 1), 1, 2) for t in ("e1(0)", "e2(1)")]
 >>> P = [sympy.zeros(2), sympy.Matrix([[0, 1], [1, 0]])]
 >>> [format_expression(y, (0, 1)) for y in conjugate_outputs(P, 1, inputs, (0, 1), {})]
@@ -50,7 +51,8 @@ from collections.abc import Mapping, Sequence
 import sympy
 
 from phdesign.errors import PortError
-from phdesign.symbolic.expressions import canonical, format_expression, vanishes
+from phdesign.symbolic.expressions import canonical, vanishes
+from phdesign.symbolic.printing import format_expression
 
 __all__ = ["conjugate_outputs", "inadmissible_inputs_message"]
 

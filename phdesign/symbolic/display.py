@@ -63,7 +63,7 @@ class ModelDisplay:
         return {str(s): int(v) if v.is_Integer else float(v) for s, v in self.parameters}
 
     def _port_text(self, exprs: tuple[sympy.Expr, ...], letter: str) -> str:
-        from phdesign.symbolic.expressions import format_expression
+        from phdesign.symbolic.printing import format_expression
 
         return ", ".join(
             f"{letter}{i + 1} = {format_expression(e, self.interval)}" for i, e in enumerate(exprs)
@@ -120,7 +120,7 @@ class PortsDisplay:
     model: Any
 
     def _traces(self) -> list[str]:
-        from phdesign.symbolic.expressions import format_expression
+        from phdesign.symbolic.printing import format_expression
 
         interval = None if self.model is None else self.model.interval
         return [format_expression(s, interval) for s in self.trace_vector]

@@ -8,14 +8,14 @@ endpoint of the ``k``-th :math:`z`-derivative (``k`` = number of primes) of the
 
 The text is read by a small recursive-descent parser: user text is never
 evaluated as Python (no :func:`eval`, no :func:`sympy.sympify` on raw text).
-Printing goes through sympy's ``str`` with each trace symbol renamed to the
-user syntax, so ``parse(format(expr)) == expr`` holds exactly.
+Printing (:mod:`phdesign.symbolic.printing`) goes through sympy's ``str`` with each trace
+symbol renamed to the user syntax, so ``parse(format(expr)) == expr`` holds exactly.
 
 The grammar and its limits live in :mod:`phdesign.symbolic.parser`.
 
 Examples
 --------
->>> from sympy import Rational
+>>> from phdesign.symbolic.printing import format_expression
 >>> expr = parse_trace_expression("(e1(0) - e2'(1))/sqrt(2)", interval=(0, 1), order=2, size=2)
 >>> format_expression(expr, interval=(0, 1))
 "sqrt(2)*(e1(0) - e2'(1))/2"
@@ -35,7 +35,6 @@ from functools import lru_cache
 from typing import Literal
 
 import sympy
-from sympy.printing.str import StrPrinter
 
 from phdesign.errors import ExpressionError
 from phdesign.limits import MAX_NUMBER_OPERATIONS
@@ -47,8 +46,6 @@ __all__ = [
     "canonical",
     "exact_matrix",
     "exact_number",
-    "format_expression",
-    "format_number",
     "linear_coefficients",
     "parameter_symbol",
     "parse_scalar",
@@ -384,6 +381,8 @@ def _point_text(interval: Sequence[object], side: Side) -> str:
     try:  # a model prints every trace at its interval: read the endpoints once
         return _cached_point_text(tuple(interval), side)
     except TypeError:  # an unhashable endpoint
+        from phdesign.symbolic.printing import format_expression
+
         return format_expression(_endpoints(interval)[0 if side == "a" else 1])
 
 
@@ -393,6 +392,8 @@ _POINT_TEXT_LIMIT = 40
 
 @lru_cache(maxsize=256)
 def _cached_point_text(interval: tuple[object, ...], side: Side) -> str:
+    from phdesign.symbolic.printing import format_expression  # printing reads traces here
+
     text = format_expression(_endpoints(interval)[0 if side == "a" else 1])
     # an endpoint too long to read back as a point (b = 1e300 has 301 digits) is its name
     return text if len(text) <= _POINT_TEXT_LIMIT and _POINT_NUMBER.match(text) else side
@@ -528,75 +529,3 @@ def linear_coefficients(expr: sympy.Expr, what: str = "expression") -> dict[Trac
     if not coefficients:
         raise ExpressionError(f"{what} contains no trace; expected a combination like e1(0)")
     return coefficients
-
-
-class _Printer(StrPrinter):
-    """sympy's printer, writing what sympy forms on its own in the parser's syntax.
-
-    Euler's number is ``exp(1)`` (``E`` is an ordinary name); sympy turns ``sqrt(x**2)``
-    into ``Abs(x)`` and ``tan(pi/2 - x)`` into ``cot(x)``: both are written back in the
-    form that builds them again, so reading the text gives the same expression.
-    """
-
-    def _print_Exp1(self, expr: sympy.Expr) -> str:
-        return "exp(1)"
-
-    def _print_Abs(self, expr: sympy.Expr) -> str:
-        return f"sqrt(({self._print(expr.args[0])})**2)"
-
-    def _print_cot(self, expr: sympy.Expr) -> str:
-        return f"tan(pi/2 - ({self._print(expr.args[0])}))"
-
-
-_PRINTER = _Printer()
-
-
-def format_number(value: object, width: int = 28) -> str:
-    """Print a number exactly when it is short, else with 6 digits in scientific notation.
-
-    Unlike a float, the scientific form never underflows or overflows: a κ* of 1e-500
-    prints as ``1.0e-500``, not ``0``.
-
-    Examples
-    --------
-    >>> format_number(sympy.Rational(1, 4))
-    '1/4'
-    >>> format_number(sympy.Rational(1, 10**500))
-    '1.0e-500'
-    """
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    if not isinstance(value, sympy.Expr):
-        return str(value)
-    text = format_expression(value)
-    if len(text) <= width or not value.is_number:
-        return text
-    import mpmath
-
-    approximation = sympy.N(value, 15)
-    if not approximation.is_Number:
-        return text
-    return str(mpmath.nstr(approximation._to_mpmath(53), 6))
-
-
-def format_expression(expr: sympy.Basic, interval: Sequence[object] | None = None) -> str:
-    """Print an expression in the syntax the parser reads, so that reading it gives it back.
-
-    Traces are written at the numeric endpoints of ``interval`` (or as ``a``/``b``
-    when no interval is given).
-
-    Examples
-    --------
-    >>> format_expression(sympy.exp(1) * Z)
-    'exp(1)*z'
-    """
-    if not isinstance(expr, sympy.Basic):
-        raise ExpressionError(
-            f"format_expression needs a sympy expression; found {type(expr).__name__}"
-        )
-    replacements = {}
-    for symbol in expr.free_symbols:
-        trace = trace_of(symbol)
-        if trace is not None:
-            replacements[symbol] = sympy.Symbol(trace.label(interval), real=True)
-    return str(_PRINTER.doprint(expr.xreplace(replacements)))

@@ -91,7 +91,8 @@ from typing import TYPE_CHECKING, Any
 import sympy
 
 from phdesign.errors import ModelError, PortError
-from phdesign.symbolic.expressions import canonical, format_expression, vanishes
+from phdesign.symbolic.expressions import canonical, vanishes
+from phdesign.symbolic.printing import format_expression
 
 if TYPE_CHECKING:  # the model imports this module: no import cycle at run time
     from phdesign.symbolic.model import BCPHS

@@ -92,8 +92,9 @@ import sympy
 
 from phdesign.errors import ExpressionError, LoopError, ModelError
 from phdesign.symbolic.classify import Classification, classify
-from phdesign.symbolic.expressions import exact_number, format_expression, vanishes
+from phdesign.symbolic.expressions import exact_number, vanishes
 from phdesign.symbolic.model import BCPHS
+from phdesign.symbolic.printing import format_expression
 
 __all__ = [
     "FEEDBACK_SOURCES",

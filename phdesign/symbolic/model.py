@@ -47,7 +47,6 @@ from phdesign.symbolic.expressions import (
     check_parameter_name,
     exact_number,
     exactify,
-    format_expression,
     parameter_symbol,
     parse_scalar,
     parse_trace_expression,
@@ -58,6 +57,7 @@ from phdesign.symbolic.feedback import (
     feedback_from_mapping,
 )
 from phdesign.symbolic.parser import check_expression
+from phdesign.symbolic.printing import format_expression
 from phdesign.symbolic.validation import validate
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
