@@ -213,7 +213,7 @@ def _targets():
     import phdesign
     from phdesign import limits
     from phdesign.io import model_from_dict, model_to_toml
-    from phdesign.symbolic import expressions
+    from phdesign.symbolic import expressions, printing
     from phdesign.symbolic.definiteness import check_definite
 
     wave = phdesign.load_builtin("wave")
@@ -237,7 +237,7 @@ def _targets():
         ("with_parameters", wave.with_parameters, ({"rho": 2},), {}),
         ("parse_scalar", expressions.parse_scalar, ("1/rho + z", ["rho"]), {}),
         ("parse_trace_expression", parse_trace_expression, ("-e2(0)", (0, 1), 1, 2), {}),
-        ("format_expression", expressions.format_expression, (Z_SYMBOL, (0, 1)), {}),
+        ("format_expression", printing.format_expression, (Z_SYMBOL, (0, 1)), {}),
         ("exact_number", expressions.exact_number, ("0.5", "x"), {}),
         ("exact_matrix", expressions.exact_matrix, ([[1, 0]], "M"), {}),
         ("Trace.label", expressions.Trace(1, 0, "a").label, ((0, 1),), {}),
