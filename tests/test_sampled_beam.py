@@ -179,6 +179,8 @@ def test_balanced_truncation_obeys_the_twice_the_tail_bound(wave):
     # Lyapunov solver, an independent computation
     import scipy.linalg as sl
 
+    pytest.importorskip("slycot", reason="balanced truncation needs slycot (extra 'reduce')")
+
     nm, C_m, L, *_ = wave
     observer = ContinuousObserver.from_discretization(discretize(nm, "galerkin", 6), C_m, L)
     _, sigma, reduce = balanced_truncation(observer)
