@@ -290,6 +290,10 @@ def test_simulation_prints_its_csv_and_plots_a_titled_figure(capsys, wave):
     assert status == 0
     assert "warning: no --gain given: the observer uses L = I" in err
     assert "warning: no --x0 given: the plant starts at rest" in err
+    # at rest but driven by an input: the series are not zero, and nothing says they are
+    status, _, err = run(capsys, "simulate", "wave", "--u", "u2: sin(2*t)", *options)
+    assert status == 0
+    assert "no --x0 given" not in err
 
 
 def test_kappa_reads_the_same_everywhere(capsys, wave):

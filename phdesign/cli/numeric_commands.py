@@ -263,7 +263,8 @@ def _simulate(args: argparse.Namespace) -> int:
         check_finite_series(res)
         commit(simulation_text(args, model.name, res), res)
     notices = []
-    if args.x0 is None:
+    driven = any(getattr(args, name, None) for name in ("u", "noise_intensity", "input_noise"))
+    if args.x0 is None and not driven:  # at rest and undriven: every series is zero
         notices.append(
             "no --x0 given: the plant starts at rest (x0 = 0), so without an input every "
             "series is zero"
