@@ -42,18 +42,19 @@ here.
 
 Examples
 --------
->>> sensor_matrix([3, 4], n_outputs=4)
+The string with the damper of the observer at its right end: with
+:math:`v = (e_1(1), e_2(1), e_1(0), e_2(0))`, inputs :math:`u = (e_1(0), e_2(1))`,
+outputs :math:`y = (-e_2(0), e_1(1))`, the sensor :math:`y_2` and :math:`L = 1/2`, the
+error boundary condition is :math:`e_1(0) = 0` and :math:`e_2(1) = -\tfrac12 e_1(1)`:
+
+>>> from phdesign.models import load_builtin
+>>> wave = load_builtin("wave")
+>>> U, Y = port_matrices(wave)
+>>> err = error_system(wave.order, wave.size, U, Y, sensor_matrix([2], 2), gain_matrix("1/2", 1))
+>>> err.boundary_matrix
 Matrix([
-[0, 0, 1, 0],
-[0, 0, 0, 1]])
->>> gain_matrix([0.1, 1], q=2)
-Matrix([
-[1/10, 0],
-[   0, 1]])
->>> gain_matrix("symbolic", q=2)
-Matrix([
-[l1,  0],
-[ 0, l2]])
+[  0, 0, 1, 0],
+[1/2, 1, 0, 0]])
 """
 
 from __future__ import annotations
