@@ -624,17 +624,20 @@ COMMAND_ROWS = [
     ),
     row(
         "loop classify euler-bernoulli --actuate 3 --feedback -1 --sensors 4",
-        r"feedback K \+ Kᵀ must be positive definite \(exact\); found eigenvalues \[-2\]",
+        # Sylvester on K + Kᵀ = -2 (1 x 1)
+        r"feedback K \+ Kᵀ must be positive definite; expected every leading principal "
+        r"minor > 0 but found minor 1 = -2",
         LoopError,
     ),
     row(
         "loop classify euler-bernoulli --actuate 3 --feedback 0 --sensors 4",
-        r"found eigenvalues \[0\]",
+        r"found minor 1 = 0",
         LoopError,
     ),
     row(
         "loop classify euler-bernoulli --actuate 3,4 --feedback [[1,3],[3,1]] --sensors 4",
-        r"positive definite \(exact\); found eigenvalues \[-4, 8\]",
+        # K + Kᵀ = [[2, 6], [6, 2]]: minor 1 = 2 > 0, minor 2 = 4 - 36 = -32
+        r"positive definite; expected every leading principal minor > 0 but found minor 2 = -32",
         LoopError,
     ),
     row(
@@ -644,7 +647,7 @@ COMMAND_ROWS = [
     ),
     row(
         "loop classify euler-bernoulli --actuate 3 --feedback nan --sensors 4",
-        "feedback K entry 1",
+        "feedback K: entry 1 must be a finite positive number",
         LoopError,
     ),
     row(

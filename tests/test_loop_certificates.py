@@ -133,11 +133,12 @@ def test_measured_feedback_needs_the_collocated_output_among_the_sensors():
         ({"actuate": [3, 3]}, "input u3 is repeated"),
         ({"actuate": []}, "at least one input"),
         ({"actuate": 3, "feedback": -1}, r"K \+ Kᵀ must be positive definite"),
-        ({"actuate": 3, "feedback": 0}, r"found eigenvalues \[0\]"),
-        ({"actuate": [3, 4], "feedback": [[1, 3], [3, 1]]}, r"eigenvalues \[-4, 8\]"),
+        ({"actuate": 3, "feedback": 0}, r"found minor 1 = 0"),  # K + Kᵀ = 0
+        # K + Kᵀ = [[2, 6], [6, 2]]: its second leading minor is 4 - 36 = -32
+        ({"actuate": [3, 4], "feedback": [[1, 3], [3, 1]]}, r"found minor 2 = -32"),
         ({"actuate": [3, 4], "feedback": [1, 2, 3]}, "expected 2 diagonal values"),
         ({"actuate": 3, "feedback": [[1, 0]]}, r"expected \(1, 1\)"),
-        ({"actuate": 3, "feedback": float("nan")}, "must be a finite number"),
+        ({"actuate": 3, "feedback": float("nan")}, "entry 1 must be a finite positive number"),
         ({"actuate": 3, "feedback_outputs": 4}, "y4 = -e1\\(1\\) is not collocated with"),
         ({"actuate": 3, "feedback_source": "model"}, "feedback_source must be one of"),
     ],

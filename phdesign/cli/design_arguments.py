@@ -85,13 +85,13 @@ def parse_rows_text(text: str, option: str) -> Any:
         raise ObserverError(f"{option}: the rows are nested too deeply") from None
 
 
-def parse_gain_text(text: str) -> Any:
-    """Read ``--gain``: ``"symbolic"``, JSON rows, or comma-separated diagonal entries."""
+def parse_gain_text(text: str, option: str = "--gain") -> Any:
+    """Read ``--gain`` (or ``--feedback``): ``"symbolic"``, JSON rows, or diagonal entries."""
     text = str(text).strip()
     if text == "symbolic":
         return text
     if text.startswith("["):
-        return parse_rows_text(text, "--gain")
+        return parse_rows_text(text, option)
     return [p.strip() for p in text.split(",")]
 
 

@@ -133,6 +133,7 @@ def _positive(name: str, value: float | int | None) -> None:
 
 
 def _loop(args: argparse.Namespace, numeric: bool = True) -> Any:
+    from phdesign.cli.design_arguments import parse_gain_text
     from phdesign.loop import Loop
     from phdesign.symbolic.loop import parse_indices
 
@@ -146,7 +147,7 @@ def _loop(args: argparse.Namespace, numeric: bool = True) -> Any:
         observer.C_m,
         observer.L,
         actuate=parse_indices(args.actuate, "--actuate"),
-        feedback=args.feedback,
+        feedback=parse_gain_text(args.feedback, "--feedback"),
         feedback_source=args.feedback_source,
         feedback_outputs=None if outputs is None else parse_indices(outputs, "--feedback-outputs"),
         method=args.method if numeric else "galerkin",

@@ -83,18 +83,18 @@ Examples
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import sympy
 
-from phdesign.errors import ExpressionError, LoopError, ModelError
+from phdesign.errors import LoopError, ObserverError
 from phdesign.symbolic.classify import Classification, classify
-from phdesign.symbolic.expressions import exact_number, vanishes
+from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.printing import format_expression
+from phdesign.symbolic.sensors import gain_matrix
 
 __all__ = [
     "FEEDBACK_SOURCES",
@@ -160,29 +160,24 @@ def actuated_indices(actuate: Any, model: BCPHS) -> tuple[int, ...]:
     return tuple(seen)
 
 
-def _entry(value: Any, what: str) -> sympy.Expr:
-    try:
-        return exact_number(getattr(value, "item", lambda v=value: v)(), what)
-    except ExpressionError as error:
-        raise LoopError(str(error)) from None
-
-
 def feedback_gain(value: Any, k: int) -> sympy.ImmutableMatrix:
     r"""Return the feedback gain :math:`K` (``k x k``), exact, with :math:`K + K^\top \succ 0`.
 
+    Read by the observer gain's reader (:func:`~phdesign.symbolic.sensors.gain_matrix`),
+    whose messages then name ``feedback K``.
+
     Parameters
     ----------
-    value : number, sequence of numbers, matrix, or text
-        As ``--gain``: one number (:math:`K = kI`), one per actuated input (the
-        diagonal), the matrix in full (nested lists, numpy or sympy), or the command-line
-        text ``"1"``, ``"1,2"``, ``"[[1, 0], [0, 2]]"``.  Entries are read exactly.
+    value : number, sequence of numbers or matrix
+        One number (:math:`K = kI`), one per actuated input (the diagonal), or the matrix
+        in full (nested lists, numpy or sympy).  Entries are read exactly.
     k : int
         The number of actuated inputs.
 
     Raises
     ------
     LoopError
-        Wrong shape or count, an entry that is not a finite number, or
+        Wrong shape or count, an entry that is not a finite number, a symbolic gain, or
         :math:`K + K^\top` not positive definite (checked exactly, Sylvester).
 
     Examples
@@ -192,63 +187,19 @@ def feedback_gain(value: Any, k: int) -> sympy.ImmutableMatrix:
     [1/2,   0],
     [  0, 1/2]])
     """
-    if isinstance(value, str):
-        text = value.strip()
-        if text == "symbolic":
-            raise LoopError(
-                "--feedback: symbolic feedback gains are not supported (the controlled plant "
-                "is a model whose K has values); give numbers such as 1 or 1,2"
-            )
-        if text.startswith("["):
-            try:
-                value = json.loads(text)
-            except json.JSONDecodeError as error:
-                raise LoopError(
-                    f"--feedback: expected a JSON list of rows like [[1, 0], [0, 2]]; found "
-                    f"{text!r} ({error.msg} at character {error.pos})"
-                ) from None
-        else:
-            value = [part.strip() for part in text.split(",")]
-    if isinstance(value, sympy.MatrixBase) or hasattr(value, "tolist"):
-        value = value.tolist()
-    if not isinstance(value, Sequence) or isinstance(value, str):
-        value = [value]
-    rows = list(value)
-    if rows and all(isinstance(r, Sequence) and not isinstance(r, str) for r in rows):
-        shape = (len(rows), len(rows[0])) if len({len(r) for r in rows}) == 1 else None
-        if shape != (k, k):
-            found = shape if shape is not None else f"rows of lengths {[len(r) for r in rows]}"
-            raise LoopError(
-                f"Incompatible dimensions of feedback gain K matrix; expected {(k, k)} (one "
-                f"row and column per actuated input) but found {found}"
-            )
-        K = sympy.Matrix(
-            k,
-            k,
-            [
-                _entry(x, f"feedback K[{i + 1}][{j + 1}]")
-                for i, r in enumerate(rows)
-                for j, x in enumerate(r)
-            ],
-        )
-    else:
-        diagonal = [_entry(x, f"feedback K entry {i + 1}") for i, x in enumerate(rows)]
-        if len(diagonal) == 1:
-            diagonal *= k
-        if len(diagonal) != k:
-            raise LoopError(
-                f"feedback K: expected {k} diagonal values (one per actuated input) or a "
-                f"single one; found {len(diagonal)}"
-            )
-        K = sympy.diag(*diagonal)
-    from phdesign.symbolic.definiteness import check_definite
-
-    try:
-        check_definite(K + K.T, "feedback K + Kᵀ", (0, 1), {}, sign=1, strict=True)
-    except ModelError as error:
+    if isinstance(value, str) and value.strip() == "symbolic":
         raise LoopError(
-            f"{error}: u_a = -K ŷ_a damps the plant only for K + Kᵀ positive definite"
-        ) from None
+            "feedback K: symbolic feedback gains are not supported (the controlled plant "
+            "is a model whose K has values); give numbers such as 1 or [1, 2]"
+        )
+    try:
+        K = gain_matrix(value, k, "actuated input", name="feedback K", symbol="K")
+    except ObserverError as error:
+        message = str(error)
+        if not message.startswith("feedback K"):  # K + Kᵀ: the matrix, named as the gain
+            message = f"feedback {message}"
+        reason = ": u_a = -K ŷ_a damps the plant only then" if "definite" in message else ""
+        raise LoopError(f"{message}{reason}") from None
     return sympy.ImmutableMatrix(K)
 
 

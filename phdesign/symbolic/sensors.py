@@ -176,7 +176,9 @@ def gain_symbols(q: int) -> tuple[sympy.Symbol, ...]:
     return tuple(sympy.Symbol(f"l{i + 1}", positive=True) for i in range(q))
 
 
-def gain_matrix(gain: Any, q: int, per: str = "sensor") -> sympy.ImmutableMatrix:
+def gain_matrix(
+    gain: Any, q: int, per: str = "sensor", *, name: str = "gain", symbol: str = "L"
+) -> sympy.ImmutableMatrix:
     r"""Return the observer gain :math:`L` (``q x q``), exact and checked.
 
     Parameters
@@ -191,6 +193,9 @@ def gain_matrix(gain: Any, q: int, per: str = "sensor") -> sympy.ImmutableMatrix
         The number of sensors.
     per : str
         What one diagonal entry belongs to, for messages (``"sensor"`` or ``"output"``).
+    name, symbol : str
+        The argument and the matrix the messages name: ``"gain"`` and ``"L"``; the
+        observer-based loop reads its feedback gain ``K`` with the same rules.
 
     Raises
     ------
@@ -202,52 +207,54 @@ def gain_matrix(gain: Any, q: int, per: str = "sensor") -> sympy.ImmutableMatrix
     if isinstance(gain, str):
         text = gain.strip()
         if text == "symbolic":
-            return _check_gain(sympy.diag(*gain_symbols(q)), q)
+            return _check_gain(sympy.diag(*gain_symbols(q)), q, symbol)
         if "," in text or text.startswith("["):
             raise ObserverError(
-                f"gain: expected a number, a list of numbers, a matrix or 'symbolic'; found "
-                f"the text {gain!r} (write gain=[0.1, 1] for a diagonal)"
+                f"{name}: expected a number, a list of numbers, a matrix or 'symbolic'; found "
+                f"the text {gain!r} (write {name.split()[0]}=[0.1, 1] for a diagonal)"
             )
         gain = [text]
     if _is_scalar(gain):
         gain = [gain]
     if isinstance(gain, sympy.MatrixBase) or getattr(gain, "ndim", 1) == 2:
-        rows = _rows(gain, "gain")
+        rows = _rows(gain, name)
     elif isinstance(gain, Iterable) and not isinstance(gain, Mapping | set | frozenset):
         entries = list(gain.tolist() if hasattr(gain, "tolist") else gain)
         if entries and all(_is_scalar(x) for x in entries):
-            return _check_gain(sympy.diag(*diagonal_values(entries, q, per)), q)
-        rows = _rows(entries, "gain")
+            return _check_gain(sympy.diag(*diagonal_values(entries, q, per, name)), q, symbol)
+        rows = _rows(entries, name)
     else:
         raise ObserverError(
-            "gain: expected a number, a list of numbers, a matrix or 'symbolic'; found "
+            f"{name}: expected a number, a list of numbers, a matrix or 'symbolic'; found "
             f"{type(gain).__name__} {gain!r}"
         )
-    L = _exact(rows, "gain")
+    L = _exact(rows, symbol)
     if L.shape != (q, q):
         raise ObserverError(
-            f"gain: Incompatible dimensions of L matrix; expected {(q, q)} "
+            f"{name}: Incompatible dimensions of {symbol} matrix; expected {(q, q)} "
             f"(one row and column per {per}) but found {L.shape}"
         )
-    return _check_gain(L, q)
+    return _check_gain(L, q, symbol)
 
 
-def diagonal_values(entries: list[Any], count: int, per: str) -> list[sympy.Expr]:
+def diagonal_values(
+    entries: list[Any], count: int, per: str, name: str = "gain"
+) -> list[sympy.Expr]:
     """Read diagonal gain entries exactly; a single entry is used ``count`` times.
 
-    ``per`` is what one entry belongs to, for messages (``"sensor"``).
+    ``per`` is what one entry belongs to and ``name`` the argument, for messages.
     """
     for i, entry in enumerate(entries):
         if str(entry).strip().lower().lstrip("+-") in ("nan", "inf", "infinity"):
             raise ObserverError(
-                f"gain: entry {i + 1} must be a finite positive number; found {entry!r}"
+                f"{name}: entry {i + 1} must be a finite positive number; found {entry!r}"
             )
-    values = [_number(x, f"gain entry {x!r}") for x in entries]
+    values = [_number(x, f"{name} entry {x!r}") for x in entries]
     if len(values) == 1:
         values = values * count
     if len(values) != count:
         raise ObserverError(
-            f"gain: expected {count} diagonal values (one per {per}) or a single one; "
+            f"{name}: expected {count} diagonal values (one per {per}) or a single one; "
             f"found {len(values)}"
         )
     return values
@@ -266,9 +273,9 @@ def caller_matrix(value: object, what: str) -> sympy.ImmutableMatrix:
         raise ObserverError(str(error)) from None
 
 
-def _check_gain(L: sympy.MatrixBase, q: int) -> sympy.ImmutableMatrix:
-    L = caller_matrix(L, "L")
-    check_shape("L", L, (q, q), error=ObserverError)
+def _check_gain(L: sympy.MatrixBase, q: int, symbol: str = "L") -> sympy.ImmutableMatrix:
+    L = caller_matrix(L, symbol)
+    check_shape(symbol, L, (q, q), error=ObserverError)
     sym = (L + L.T) / 2
     if L.free_symbols:
         # Symbolic gains: only a diagonal of positive expressions is decidable for all values.
@@ -284,8 +291,8 @@ def _check_gain(L: sympy.MatrixBase, q: int) -> sympy.ImmutableMatrix:
         minor = sympy.expand(sym[:k, :k].det()) if k > 1 else sym[0, 0]
         if not minor.is_positive:
             raise ObserverError(
-                f"L + Lᵀ must be positive definite; expected every leading principal minor "
-                f"> 0 but found minor {k} = {2**k * minor}"
+                f"{symbol} + {symbol}ᵀ must be positive definite; expected every leading "
+                f"principal minor > 0 but found minor {k} = {2**k * minor}"
             )
     return L
 
@@ -334,8 +341,7 @@ def _rows(value: Any, what: str) -> list[list[Any]]:
     return rows
 
 
-def _exact(rows: list[list[Any]], what: str) -> sympy.ImmutableMatrix:
-    name = "L" if what == "gain" else what
+def _exact(rows: list[list[Any]], name: str) -> sympy.ImmutableMatrix:
     return sympy.ImmutableMatrix(
         [
             [_number(x, f"{name}[{i + 1}][{j + 1}]") for j, x in enumerate(row)]
