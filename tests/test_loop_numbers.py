@@ -106,10 +106,11 @@ def test_estimated_tip_rotation_damps_the_undamped_beam_that_only_its_tip_veloci
     assert report.origin[0] == "plant"
 
 
-#: The blocks are refined by ``spectrum``, whose QZ eigensolve leaves the slow eigenvalues
-#: a bias of a few 1e-12 that its drift test cannot see (both resolutions share it): on the
-#: beam below it is 4.3e-12 against the mpmath root, the loop's shift-and-invert 1.5e-13.
-QZ_BIAS = 1e-11
+#: Round-off the drift test cannot see (both resolutions share it). The blocks and the loop
+#: are solved by the same shift and invert: on the beam below, against the mpmath root, the
+#: plant's abscissa is off by 4.7e-15 and the loop's by 1.5e-13 (the QZ stage used before
+#: left the plant 4.3e-12 off); 1e-12 keeps a margin of about 7 over the larger.
+EIGEN_ROUNDOFF = 1e-12
 
 
 def _assert_union(report, count):
@@ -118,7 +119,7 @@ def _assert_union(report, count):
     union += [w.conjugate() for w in union]  # real matrices: the lists cut pairs at the end
     scale = max(1.0, abs(report.spectral_abscissa))
     digits = min(report.digits, report.plant.digits, report.error.digits)
-    tolerance = 10 * 10 ** (-digits) * scale + QZ_BIAS
+    tolerance = 10 * 10 ** (-digits) * scale + EIGEN_ROUNDOFF
     for z in report.rightmost:
         assert min(abs(w - z) for w in union) <= tolerance * max(1.0, abs(z)), z
     # and the rightmost of the union are all there: the loop does not lose an eigenvalue
@@ -144,7 +145,7 @@ def test_assembled_spectrum_is_the_union_of_the_two_blocks_on_the_beam():
     )
     assert abs(_beam_determinant(root, torque=0.5, damping=0.2)) < 1e-20
     assert abs(report.spectral_abscissa - float(root.real)) < 1e-12
-    assert abs(report.plant_abscissa - float(root.real)) < QZ_BIAS
+    assert abs(report.plant_abscissa - float(root.real)) < EIGEN_ROUNDOFF
 
 
 def test_assembled_spectrum_is_the_union_of_the_two_blocks_on_timoshenko():

@@ -164,7 +164,7 @@ def truncate_to_resolved(
 
     A = d.close(K).A
     finer = discretize(d.model, d.method, math.ceil(1.5 * d.resolution), basis=_basis(d))
-    reference = np.linalg.eigvals(np.linalg.solve(finer.E, finer.close(K).A))
+    reference, _ = eigen(finer, K)  # the eigen stage of the spectrum, at 1.5 p
     lam, kappa = eigen(d, K, condition=True)
     rtol = defaults_for(d.method, d.model.order).resolved_rtol
     mask = resolved_mask(lam, reference, rtol, kappa)
