@@ -117,6 +117,12 @@ def emit_json(value: Any) -> None:
     emit(dumps_json(value))
 
 
+def check_positive(option: str, value: float | int | None) -> None:
+    """Refuse a given option value that is not positive (``None``: not given, accepted)."""
+    if value is not None and not value > 0:
+        raise NumericError(f"{option} must be positive; found {value}")
+
+
 def emit_result(args: argparse.Namespace, result: Any, model: str | None = None) -> int:
     """Print a result as JSON with ``--json``, else the text it prints itself; return 0.
 

@@ -18,6 +18,7 @@ from typing import Any
 from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
+    check_positive,
     emit,
     emit_json,
     load_model,
@@ -227,10 +228,7 @@ def sampled_simulation(
         check_sampling(args.dt, args.sampler or "average", dt_name="--dt")
     if args.scheme != "expm":
         raise NumericError("a sampled or lower-order observer is stepped exactly: drop --scheme")
-    if args.observer_resolution is not None and not args.observer_resolution > 0:
-        raise NumericError(
-            f"--observer-resolution must be positive; found {args.observer_resolution}"
-        )
+    check_positive("--observer-resolution", args.observer_resolution)
     return simulate_sampled(
         nm,
         C_m,

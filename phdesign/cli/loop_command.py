@@ -15,6 +15,7 @@ from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
     check_finite_series,
+    check_positive,
     emit_result,
     load_model,
     run_outputs,
@@ -127,11 +128,6 @@ def _numeric_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--resolution", type=int, metavar="N", help="degree / nodes per group")
 
 
-def _positive(name: str, value: float | int | None) -> None:
-    if value is not None and not value > 0:
-        raise NumericError(f"{name} must be positive; found {value}")
-
-
 def _loop(args: argparse.Namespace, numeric: bool = True) -> Any:
     from phdesign.cli.design_arguments import parse_gain_text
     from phdesign.loop import Loop
@@ -165,16 +161,16 @@ def _classify(args: argparse.Namespace) -> int:
 
 
 def _spectrum(args: argparse.Namespace) -> int:
-    _positive("--resolution", args.resolution)
-    _positive("--tol", args.tol)
-    _positive("--count", args.count)
+    check_positive("--resolution", args.resolution)
+    check_positive("--tol", args.tol)
+    check_positive("--count", args.count)
     loop = _loop(args)
     return _print(args, loop.spectrum(tol=args.tol, count=args.count), loop.model.name)
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    _positive("--resolution", args.resolution)
-    _positive("--t-end", args.t_end)
+    check_positive("--resolution", args.resolution)
+    check_positive("--t-end", args.t_end)
     if args.samples < 2:
         raise NumericError(f"--samples must be at least 2; found {args.samples}")
     import numpy as np
@@ -198,7 +194,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _tune(args: argparse.Namespace) -> int:
-    _positive("--starts", args.starts)
+    check_positive("--starts", args.starts)
     loop = _loop(args, numeric=False)
     result = loop.tune(args.tune, full=args.full, starts=args.starts, seed=args.seed)
     return _print(args, result, loop.model.name)

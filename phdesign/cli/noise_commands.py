@@ -28,6 +28,7 @@ from typing import Any
 from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
+    check_positive,
     emit,
     emit_result,
     write_output,
@@ -207,10 +208,8 @@ def _noise_inputs(args: argparse.Namespace, nm: Any, model: Any, q: int) -> dict
 def _noise(args: argparse.Namespace) -> int:
     from phdesign.numeric.noise import noise
 
-    for name in ("resolution", "tol"):
-        value = getattr(args, name)
-        if value is not None and not value > 0:
-            raise NumericError(f"--{name} must be positive; found {value}")
+    check_positive("--resolution", args.resolution)
+    check_positive("--tol", args.tol)
     model, nm, C_m, L = _observer(args, "noise")
     if args.plot:
         from phdesign.plots import check_plot_path

@@ -21,6 +21,7 @@ from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
     check_finite_series,
+    check_positive,
     emit_result,
     load_model,
     non_negative_int,
@@ -175,18 +176,13 @@ def _numeric_setup(args: argparse.Namespace, command: str) -> tuple[Any, Any, An
     return model, observer.plant.numeric, C_m, L
 
 
-def _check_positive(name: str, value: float | int | None) -> None:
-    if value is not None and not value > 0:
-        raise NumericError(f"{name} must be positive; found {value}")
-
-
 def _spectrum(args: argparse.Namespace) -> int:
     from phdesign.numeric.spectrum import spectrum
 
-    _check_positive("--resolution", args.resolution)
-    _check_positive("--tol", args.tol)
-    _check_positive("--count", args.count)
-    _check_positive("--max-resolution", args.max_resolution)
+    check_positive("--resolution", args.resolution)
+    check_positive("--tol", args.tol)
+    check_positive("--count", args.count)
+    check_positive("--max-resolution", args.max_resolution)
     _model, nm, C_m, L = _numeric_setup(args, "spectrum")
     rep = spectrum(
         nm,
@@ -207,9 +203,9 @@ def _simulate(args: argparse.Namespace) -> int:
     from phdesign.design import Plant
     from phdesign.numeric.inputs import input_function
 
-    _check_positive("--resolution", args.resolution)
-    _check_positive("--t-end", args.t_end)
-    _check_positive("--tol", args.tol)
+    check_positive("--resolution", args.resolution)
+    check_positive("--t-end", args.t_end)
+    check_positive("--tol", args.tol)
     if args.samples < 2:
         raise NumericError(f"--samples must be at least 2; found {args.samples}")
     model = load_model(args)
@@ -326,7 +322,7 @@ def _tune(args: argparse.Namespace) -> int:
 
     if (noisy := noise_tuning(args)) is not None:  # --max-rms / --objective rms
         return noisy
-    _check_positive("--starts", args.starts)
+    check_positive("--starts", args.starts)
     robust = _robust_fraction(args.robust)
     model = load_model(args)
     observer = observer_from_args(args, model)  # argparse requires --sensors or --cm here
