@@ -23,7 +23,7 @@ from phdesign.numeric.discretize import discretize
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.order import balanced_truncation, select_order
 from phdesign.numeric.sampled import export_observer, verify_observer
-from phdesign.numeric.sampling import ContinuousObserver
+from phdesign.numeric.sampling import ContinuousObserver, run_against_continuous
 
 SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
 GAIN = np.diag([0.1, 1.0])
@@ -83,11 +83,57 @@ def test_averaged_samples_at_10_ms_do_not_alias(runs):
     "artefacts right of -2.5): 1.7x already on a plant equal to the observer's model; and "
     "the plant's modes the degree-16 model does not reproduce fold into the band, "
     "attenuated only by |sinc(ω dt / 2)|. The ratio grows with the observer's degree "
-    "(1.30x at 12, 2.36x at 20, 2.65x at 24)",
+    "(1.30x at 12, 2.36x at 20, 2.65x at 24). With the plant's own model as the observer "
+    "it is 6.8x (test_the_10_ms_gap_is_the_sampled_error_systems_slow_decay_not_the_order): "
+    "the gap is the 10 ms average's slow modes, not the order",
 )
 def test_averaged_samples_at_10_ms_within_2x_of_the_continuous_observer(runs):
     v = runs["average 10 ms"]
     assert v.floor <= 2 * v.continuous_floor, (v.floor, v.continuous_floor)
+
+
+def test_the_10_ms_gap_is_the_sampled_error_systems_slow_decay_not_the_order(beam):
+    # Why the 2x above cannot hold at 10 ms with this gain: let the observer run the
+    # plant's own model (degree 48, no truncation, so no unmodeled content to alias). The
+    # error then obeys the sampled error recursion exactly (module docstring of
+    # sampled_discretization: e_{k+1} = (Phi - Gamma M K C_s) e_k, the observer's own A),
+    # so any gap to the continuous observer is the 10 ms average itself. Measured: floor
+    # 2.68e-5 at T = 5 s against 3.9e-6 continuous (6.8x); at T = 10 s, 1.68e-5 against
+    # 1.3e-9. The floor is a transient: it falls like exp(sigma T), sigma the slowest
+    # decay rate ln|mu| / dt of that recursion (-0.102 1/s; its next poles are -0.104 to
+    # -0.107 1/s, whose beats in the envelope allow the 0.03 1/s tolerance; measured
+    # ln(0.627) / 5 = -0.093). These are the modes near 2 pi j / dt, damped only through
+    # their interval means; the continuous observer damps them at its abscissa.
+    _, plant, _, e0 = beam
+    exact = ContinuousObserver.from_discretization(plant, SENSORS, GAIN, (1.0,))
+    floors = {}
+    for t_end in (5.0, 10.0):
+        n = round(t_end / 1e-2)
+        _, _, floors[t_end], _ = run_against_continuous(
+            plant, exact, SENSORS, sampler="average", x0=e0, dt=1e-2, n_steps=n, stride=2
+        )
+    sampled_5, continuous_5 = floors[5.0]
+    assert sampled_5 > 5 * continuous_5, floors
+    mu = np.linalg.eigvals(exact.sampled(1e-2, "average").A)
+    sigma = float(np.max(np.log(np.abs(mu)))) / 1e-2
+    assert -0.2 < sigma < 0, sigma  # the slowest sampled mode: ten times slower than -2.9
+    observed = math.log(floors[10.0][0] / sampled_5) / 5.0
+    assert abs(observed - sigma) < 0.03, (observed, sigma)
+
+
+def test_a_higher_order_at_10_ms_reaches_the_degree_16_continuous_floor(beam, runs):
+    # The design answer the verification's hint gives ("a smaller dt or a higher order"):
+    # averaged at 10 ms, a degree-20 observer (42 states, within the degree-48 plant's
+    # half) reaches the degree-16 continuous observer's floor within 2x (measured 3.15e-5
+    # against 2.54e-5, 1.24x), where the degree-16 one itself is at 2.04x.
+    nm, plant, _, e0 = beam
+    higher = ContinuousObserver.from_discretization(
+        discretize(nm, "galerkin", 20), SENSORS, GAIN, (1.0,)
+    )
+    v = verify_observer(plant, higher, SENSORS, dt=1e-2, sampler="average", x0=e0, t_end=5.0)
+    reference = runs["average 10 ms"].continuous_floor
+    assert v.floor <= 2 * reference, (v.floor, reference)
+    assert v.warnings == ()
 
 
 def test_averaged_samples_at_10_ms_keep_the_continuous_accuracy_on_resolved_content(beam):
