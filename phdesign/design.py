@@ -38,6 +38,7 @@ import sympy
 from phdesign._display import REPR_LIMIT, html_table, matrix_text, sensors_text, shorten
 from phdesign.arguments import choice
 from phdesign.errors import ArgumentError, ObserverError
+from phdesign.numeric.defaults import EXPORT
 from phdesign.plant import Plant, numeric_matrix
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import gain_matrix, measurement_matrix, sensor_matrix
@@ -437,14 +438,14 @@ class Observer:
         self,
         *,
         dt: float,
-        sampler: str = "average",
+        sampler: str = EXPORT.sampler,
         order: int | None = None,
         reduction: str = "none",
-        tol: float = 1e-6,
-        output_tol: float = 1e-3,
+        tol: float = EXPORT.tol,
+        output_tol: float = EXPORT.output_tol,
         verify: bool = False,
         x0: str | Callable[[Any], Any] | None = None,
-        t_end: float = 5.0,
+        t_end: float = EXPORT.t_end,
         plant_resolution: int | None = None,
         points: float | Sequence[float] | None = None,
     ) -> SampledObserver:

@@ -179,3 +179,25 @@ def test_import_stays_light_and_the_new_names_load_on_first_use():
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "False"]
     assert {"Loop", "NoiseReport", "Tradeoff", "SampledObserver"} <= set(phd.__all__)
+
+
+def test_the_library_the_design_object_and_the_cli_share_the_export_defaults():
+    # one row of defaults (phdesign.numeric.defaults.EXPORT) serves the three entry points:
+    # a change of policy there reaches every one of them
+    import inspect
+
+    from phdesign.cli import build_parser
+    from phdesign.numeric.defaults import EXPORT
+    from phdesign.numeric.order import select_order
+
+    expected = {"sampler": "average", "tol": 1e-6, "output_tol": 1e-3, "t_end": 5.0}
+    assert vars(EXPORT) == expected
+    for function in (export_observer, phd.Observer.export):
+        parameters = inspect.signature(function).parameters
+        assert {k: parameters[k].default for k in expected} == expected, function
+    parameters = inspect.signature(select_order).parameters
+    assert (parameters["tol"].default, parameters["output_tol"].default) == (1e-6, 1e-3)
+    args = build_parser().parse_args(
+        ["export", "wave", "--sensors", "2", "--dt", "0.01", "--format", "json", "-o", "x.json"]
+    )
+    assert {k: getattr(args, k) for k in expected} == expected

@@ -142,3 +142,19 @@ def test_a_model_whose_energy_is_not_positive_is_refused():
         r"at z = 0$",
     ):
         dataclasses.replace(WAVE, H=H, H_constant=False)
+
+
+def test_an_observer_gain_without_positive_symmetric_part_is_refused_with_its_eigenvalue():
+    # L = [[1, 3], [-3, -1]] (both diagonal entries would not save it): L + Lᵀ = diag(2, -2),
+    # smallest eigenvalue -2 by hand; L = [[1, 2], [2, 1]]: L + Lᵀ = [[2, 4], [4, 2]],
+    # eigenvalues 2 ± 4, smallest -2 although the diagonal is positive
+    from phdesign.errors import ObserverError
+    from phdesign.numeric.phs import feedback_matrix
+
+    C_m = np.eye(2)
+    for L in ([[1.0, 3.0], [-3.0, -1.0]], [[1.0, 2.0], [2.0, 1.0]]):
+        with pytest.raises(ObserverError, match=r"L \+ L\^T must be symmetric positive "
+                           r"definite; found smallest eigenvalue -2$"):  # fmt: skip
+            feedback_matrix(C_m, np.array(L), 2)
+    K = feedback_matrix(C_m, np.array([[1.0, 5.0], [-5.0, 1.0]]), 2)  # sym(L) = I
+    assert np.array_equal(K, [[1.0, 5.0], [-5.0, 1.0]])

@@ -20,6 +20,7 @@ from phdesign.errors import LoopError
 from phdesign.loop import Loop
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import NumericModel, constant_H, to_numeric
+from phdesign.numeric.discretize import discretize
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.loop import NumericLoop, assemble
 from phdesign.numeric.loop_simulate import simulate_loop
@@ -340,3 +341,20 @@ def test_results_print_as_the_command_line_and_stay_json():
     free = loop.simulate(u="u4: 0.1*sin(t)", t_end=0.5, samples=6)
     assert "energy_balance_residual_loop" not in free.info  # not autonomous: not audited
     assert free.info["energy_balance_residual_error_system"] < 1e-12
+
+
+def test_a_hand_built_numeric_loop_refuses_a_feedback_gain_without_positive_symmetric_part():
+    # K = [[1, 3], [-3, -1]]: K + Kᵀ = diag(2, -2), smallest eigenvalue -2 (by hand); the
+    # loop's dissipation -ỹᵀ sym(K) ỹ needs sym(K) ≻ 0, so assemble must refuse it as the
+    # symbolic reader does, naming the matrix and the eigenvalue found
+    d = discretize(to_numeric(BEAM), "galerkin", 8)
+    C_m = np.array([[0, 0, 1.0, 0], [0, 0, 0, 1.0]])
+    bad = NumericLoop((2, 3), np.array([[1.0, 3.0], [-3.0, -1.0]]), C_m, np.eye(2))
+    with pytest.raises(LoopError, match=r"K \+ K\^T must be symmetric positive definite; found "
+                       r"smallest eigenvalue -2"):  # fmt: skip
+        assemble(d, bad)
+    singular = NumericLoop((2,), np.zeros((1, 1)), C_m, np.eye(2))  # K = 0: open loop
+    with pytest.raises(LoopError, match="smallest eigenvalue 0"):
+        assemble(d, singular)
+    skew_part = NumericLoop((2, 3), np.array([[1.0, 5.0], [-5.0, 1.0]]), C_m, np.eye(2))
+    assert assemble(d, skew_part).A.shape == (2 * d.dim, 2 * d.dim)  # sym(K) = I is enough

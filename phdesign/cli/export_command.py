@@ -25,6 +25,7 @@ from phdesign.cli.common import (
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
 from phdesign.errors import NumericError, ObserverError, OutputFileError
+from phdesign.numeric.defaults import EXPORT
 
 __all__ = ["add_sampling_arguments", "register", "sampled_simulation"]
 
@@ -45,7 +46,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     ex.add_argument(
         "--sampler",
         choices=SAMPLER_CHOICES,
-        default="average",
+        default=EXPORT.sampler,
         help="the controller's front end: mean of the outputs over each period (default) "
         "or point samples",
     )
@@ -62,14 +63,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     ex.add_argument(
         "--tol",
         type=float,
-        default=1e-6,
-        help="relative accuracy of the rightmost error eigenvalues (default 1e-6)",
+        default=EXPORT.tol,
+        help="relative accuracy of the rightmost error eigenvalues (default %(default)g)",
     )
     ex.add_argument(
         "--output-tol",
         type=float,
-        default=1e-3,
-        help="error floor of the performance outputs, relative to their peak (default 1e-3)",
+        default=EXPORT.output_tol,
+        help="error floor of the performance outputs, relative to their peak (default "
+        "%(default)g)",
     )
     ex.add_argument(
         "--format", choices=FORMAT_CHOICES, required=True, help="what to write to -o PATH"
@@ -90,7 +92,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "every x_i = (z-a)/(b-a) - 0.9)",
     )
     ex.add_argument(
-        "--t-end", type=float, default=5.0, metavar="T", help="verification time (default 5)"
+        "--t-end",
+        type=float,
+        default=EXPORT.t_end,
+        metavar="T",
+        help="verification time (default %(default)g)",
     )
     ex.add_argument(
         "--plant-resolution",

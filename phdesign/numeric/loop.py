@@ -46,6 +46,7 @@ import numpy as np
 
 from phdesign.errors import LoopError, NumericError, check_shape
 from phdesign.numeric.discretize import DiscretePHS, feedback_matrix
+from phdesign.numeric.invariants import require_definite
 from phdesign.numeric.simulate import coupled_system
 
 __all__ = [
@@ -87,7 +88,11 @@ class NumericLoop:
         k = len(self.actuated)
         if k == 0 or len(set(self.actuated)) != k or not all(0 <= a < m for a in self.actuated):
             raise LoopError(f"actuated ports must be distinct indices in 0..{m - 1}")
-        check_shape("feedback gain K", np.asarray(self.K), (k, k))
+        K = np.asarray(self.K, dtype=float)
+        check_shape("feedback gain K", K, (k, k))
+        # the loop's stability rests on sym(K) > 0 (Le Gorrec, Zwart, Maschke 2005), which
+        # the symbolic reader checks exactly; a NumericLoop built by hand is checked here
+        require_definite("K + K^T", K + K.T, LoopError)
         if self.source not in ("estimate", "measured"):
             raise LoopError(f"source must be 'estimate' or 'measured'; found {self.source!r}")
         if self.source == "measured":  # y_a = F y_m: the unit rows lie in the rows of C_m

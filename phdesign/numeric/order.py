@@ -53,6 +53,7 @@ import scipy.linalg as sl
 
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.defaults import EXPORT
 from phdesign.numeric.discretize import discretize, feedback_matrix
 from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.sampling import ContinuousObserver, error_floor, run_loop
@@ -353,8 +354,8 @@ def select_order(
     points: tuple[float, ...] = (),
     order: int | None = None,
     reduction: str = "none",
-    tol: float = 1e-6,
-    output_tol: float = 1e-3,
+    tol: float = EXPORT.tol,
+    output_tol: float = EXPORT.output_tol,
     count: int = 6,
 ) -> tuple[OrderSelection, ContinuousObserver]:
     """Choose the exported observer (module docstring) and report the choice.

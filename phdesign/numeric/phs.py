@@ -337,6 +337,6 @@ def feedback_matrix(C_m: np.ndarray, L: np.ndarray, n_outputs: int) -> np.ndarra
     check_shape("L", Lm, (q, q))
     if not np.all(np.isfinite(Lm)):
         raise ObserverError("L must be finite")
-    if q and np.min(np.linalg.eigvalsh(Lm + Lm.T)) <= 0:
-        raise ObserverError("L + L^T must be positive definite; found a non-positive eigenvalue")
+    if q:
+        require_definite("L + L^T", Lm + Lm.T, ObserverError)
     return C.T @ Lm @ C

@@ -42,6 +42,7 @@ from phdesign.arguments import positive_number
 from phdesign.errors import ArgumentError, NumericError
 from phdesign.numeric.arguments import check_initial_state
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.defaults import EXPORT
 from phdesign.numeric.order import REDUCTIONS, OrderSelection, check_order, select_order
 from phdesign.numeric.sampling import (
     ContinuousObserver,
@@ -458,15 +459,15 @@ def export_observer(
     L: np.ndarray,
     *,
     dt: float,
-    sampler: str = "average",
+    sampler: str = EXPORT.sampler,
     order: int | None = None,
     reduction: str = "none",
-    tol: float = 1e-6,
-    output_tol: float = 1e-3,
+    tol: float = EXPORT.tol,
+    output_tol: float = EXPORT.output_tol,
     verify: bool = False,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     x0_text: str | None = None,
-    t_end: float = 5.0,
+    t_end: float = EXPORT.t_end,
     plant_resolution: int | None = None,
     points: float | Sequence[float] | None = None,
     model_name: str | None = None,
