@@ -47,7 +47,13 @@ from typing import Any
 
 from phdesign.errors import OutputFileError
 
-__all__ = ["OutputFiles", "Terminated", "atomic_write", "check_output_path"]
+__all__ = [
+    "OutputFiles",
+    "Terminated",
+    "atomic_write",
+    "check_output_path",
+    "remove_stale_temporaries",
+]
 
 
 class Terminated(KeyboardInterrupt):
@@ -271,9 +277,53 @@ def _identity(path: Path) -> tuple[Any, ...]:
         return (os.path.realpath(path.parent), path.name)
 
 
+#: How the staged files are named (``.phd-`` and eight hex digits, ``.tmp``).
+TEMPORARY_PREFIX, TEMPORARY_SUFFIX = ".phd-", ".tmp"
+#: A staged file older than this (seconds) belongs to no live write: a write stages and
+#: links in milliseconds, so only a process killed by SIGKILL leaves one this old.
+STALE_AFTER = 60.0
+
+
+def _is_temporary(name: str) -> bool:
+    core = name[len(TEMPORARY_PREFIX) : -len(TEMPORARY_SUFFIX)]
+    return (
+        name.startswith(TEMPORARY_PREFIX)
+        and name.endswith(TEMPORARY_SUFFIX)
+        and len(core) == 8
+        and all(c in "0123456789abcdef" for c in core)
+    )
+
+
+def remove_stale_temporaries(folder: Path, now: float | None = None) -> int:
+    """Delete the staged files a killed write left in ``folder``; return how many.
+
+    Only names of the staging pattern (``.phd-XXXXXXXX.tmp``, :func:`_create_temporary`)
+    older than :data:`STALE_AFTER` seconds are removed: SIGTERM and interrupts clean their
+    own, SIGKILL cannot, and a younger one may belong to a write in progress.
+    """
+    import time
+
+    limit = (time.time() if now is None else now) - STALE_AFTER
+    removed = 0
+    try:
+        entries = list(folder.iterdir())
+    except OSError:
+        return 0
+    for entry in entries:
+        if not _is_temporary(entry.name):
+            continue
+        try:
+            if entry.is_file() and entry.stat().st_mtime < limit:
+                entry.unlink()
+                removed += 1
+        except OSError:  # gone meanwhile, or not ours to delete: leave it
+            continue
+    return removed
+
+
 def _create_temporary(folder: Path, target: Path) -> Path:
     for _ in range(100):
-        temporary = folder / f".phd-{secrets.token_hex(4)}.tmp"
+        temporary = folder / f"{TEMPORARY_PREFIX}{secrets.token_hex(4)}{TEMPORARY_SUFFIX}"
         _LIVE.add(temporary)
         try:
             os.close(os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))

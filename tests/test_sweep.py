@@ -320,6 +320,36 @@ def test_a_killed_sweep_resumes_to_the_same_result(tmp_path):
     same_figures(resumed, phdesign.sweep("wave", chunk_size=7, **kwargs))
 
 
+def test_resuming_deletes_the_stale_half_written_markers_of_a_killed_sweep(tmp_path):
+    # SIGKILL can land between staging a marker (.phd-XXXXXXXX.tmp) and linking it; the
+    # resumed sweep deletes such a file once it is older than any live write could make
+    # it (STALE_AFTER), keeps a young one (it may be a write in progress) and anything
+    # not of the staging pattern, and recomputes exactly the chunks without a marker
+    from phdesign.outputs import STALE_AFTER
+
+    store = tmp_path / "map.zarr"
+    kwargs = {"sensors": [2], "grid": {"l1": "0.1:0.9:6"}, "chunk_size": 1, **SYNC}
+    first = phdesign.sweep("wave", output=store, **kwargs)
+    chunks = store / ".phdesign" / "chunks"
+    (store / ".phdesign" / "complete.json").unlink()
+    for index in (2, 5):
+        (chunks / f"{index:08d}").unlink()
+    stale, young = chunks / ".phd-0123abcd.tmp", store / ".phdesign" / ".phd-89abcdef.tmp"
+    other = chunks / ".phd-notmine.tmp"
+    for path in (stale, young, other):
+        path.write_bytes(b"")
+    old = time.time() - 2 * STALE_AFTER
+    os.utime(stale, (old, old))
+    os.utime(other, (old, old))
+    resumed = phdesign.sweep("wave", output=store, resume=True, **kwargs)
+    record = json.loads(resumed.attrs["phdesign_run"])
+    assert (record["reused"], record["computed"]) == (4, 2)
+    assert not stale.exists()
+    assert young.exists()
+    assert other.exists()
+    same_figures(resumed, first)
+
+
 # --------------------------------------------------------------------- command line
 def test_cli_sweep_json_summary_and_plot(tmp_path, capsys):
     out = tmp_path / "k.nc"

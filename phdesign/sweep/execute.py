@@ -191,6 +191,8 @@ def run(
                 store.create(
                     template(description, plan, lazy=True), description, plan, action == "replace"
                 )
+            else:
+                store.remove_stale_markers()
             done = store.done()
             group = store.writer()
         else:

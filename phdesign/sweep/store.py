@@ -30,6 +30,7 @@ import numpy as np
 
 from phdesign.errors import OutputFileError, SweepError
 from phdesign.io import atomic_write
+from phdesign.outputs import remove_stale_temporaries
 from phdesign.sweep.description import SweepDescription
 from phdesign.sweep.plan import ChunkPlan
 
@@ -74,6 +75,11 @@ class ZarrStore:
         if not folder.is_dir():
             return set()
         return {int(p.name) for p in folder.iterdir() if p.name.isdigit()}
+
+    def remove_stale_markers(self) -> int:
+        """Delete the half-written markers a killed sweep left (they vouch for nothing)."""
+        folders = (self._markers, self._markers / "chunks")
+        return sum(remove_stale_temporaries(folder) for folder in folders)
 
     def check(
         self,
