@@ -114,8 +114,13 @@ def test_beam_with_a_tip_damper_is_exponential_with_the_tip_rotation_sensor_alon
     assert result.verdict == "exponential"
     (gain,) = result.L.free_symbols
     kappa = result.result("3.4", 3).kappa
-    for value in (sympy.Rational(1, 3), 1, 3):  # min(1, l/(1 + l²)) = l/(1 + l²) here
-        assert sympy.simplify(kappa.subs(gain, value) - value / (1 + value**2)) == 0
+    # min(1, l/(1 + l²)) = l/(1 + l²) for every l > 0 (1 - l/(1 + l²) = (l² - l + 1)/(1 + l²)
+    # has no real root): the dominated branch is dropped, exactly
+    assert kappa == gain / (1 + gain**2)
+    # variant 2 of 3.1: min(1/2, l/(1 + l²)), and 1/2 - l/(1 + l²) = (l - 1)²/(2 (1 + l²)) ≥ 0
+    assert result.result("3.1", 2).kappa == gain / (1 + gain**2)
+    # variant 4 of 3.4: min(1/2, 1/l) changes branch at l = 2, so both stay
+    assert result.result("3.4", 4).kappa == sympy.Min(sympy.Rational(1, 2), 1 / gain)
     open_beam = classify(load_builtin("euler-bernoulli"), sensor_matrix([3], 4), sympy.eye(1))
     assert open_beam.verdict == "inconclusive"
 

@@ -296,8 +296,61 @@ def _symbolic_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> tuple[sympy
         )
     if not branches:
         return None, f"holds for all positive {names}; RHS vanishes on K"
+    branches = _undominated(branches)
     kappa = branches[0] if len(branches) == 1 else sympy.Min(*branches)
     return kappa, f"holds for all positive {names}"
+
+
+def _nonnegative_for_positive(expr: sympy.Expr) -> bool:
+    r"""Prove :math:`f \ge 0` for every positive value of f's one symbol (False: not proved).
+
+    f = p/q with polynomials p, q of rational coefficients in one symbol s: p and q keep
+    their sign on :math:`s > 0` when every positive real root has even multiplicity
+    (``sympy.roots`` of a univariate polynomial, exact), and that sign is read at a point
+    beyond the roots.  No symbol: the sign of the number.
+    """
+    symbols = expr.free_symbols
+    if not symbols:
+        return bool(expr.is_nonnegative)
+    if len(symbols) != 1:
+        return False
+    (s,) = symbols
+    numerator, denominator = sympy.fraction(sympy.together(expr))
+    signs = []
+    for part in (numerator, denominator):
+        try:
+            poly = sympy.Poly(part, s, domain="QQ")
+        except (sympy.PolynomialError, sympy.CoercionFailed, sympy.GeneratorsNeeded):
+            return False
+        if poly.is_zero:
+            return part is numerator  # f = 0
+        positive = []
+        for root, multiplicity in sympy.roots(poly, filter="R").items():
+            if root.is_positive:
+                if multiplicity % 2:
+                    return False  # a sign change on s > 0
+                positive.append(root)
+        if sum(sympy.roots(poly).values()) != poly.degree():
+            return False  # roots without closed form: no proof attempted
+        beyond = 1 + max(positive, default=sympy.Integer(0))
+        signs.append(sympy.sign(poly.eval(beyond)))
+    return signs[0] * signs[1] > 0
+
+
+def _undominated(branches: list[sympy.Expr]) -> list[sympy.Expr]:
+    """Drop every branch that another is proved not to exceed for all positive gains.
+
+    ``Min(1, l/(1 + l²))`` is ``l/(1 + l²)`` (``1 - l/(1 + l²) = (l² - l + 1)/(1 + l²)``);
+    branches in several gains, or with pieces, are kept as they are.
+    """
+    kept = list(branches)
+    for branch in branches:
+        if isinstance(branch, sympy.Piecewise):
+            continue
+        others = [b for b in kept if b is not branch and not isinstance(b, sympy.Piecewise)]
+        if any(_nonnegative_for_positive(branch - other) for other in others):
+            kept.remove(branch)
+    return kept
 
 
 def _top_eig(A: Any, B: Any) -> tuple[float, Any]:
