@@ -181,6 +181,51 @@ def test_evaluator_closes_the_loop_through_the_feedthrough():
         assert pair.resolved[nearest]
 
 
+def _feedthrough_quadratic(k1, k2):
+    """(a, b, c) of E * det = a E² + b E + c, E = e^λ (det: wave_feedthrough_characteristic).
+
+    By hand: E det = (2 + k1 (E - ½)) (k2 - 1 - 2 k2 E) - ((2 + k1/2) E - k1) ((1 + k2) E - 2 k2),
+    so a = -2 k1 k2 - (2 + k1/2)(1 + k2), b = 4 k1 k2, c = (2 - k1/2)(k2 - 1) - 2 k1 k2.
+    The eigenvalues are ln E_i + 2πm i for the two roots E_i: abscissa ln max |E_i|.
+    """
+    a = -2 * k1 * k2 - (2 + k1 / 2) * (1 + k2)
+    return a, 4 * k1 * k2, (2 - k1 / 2) * (k2 - 1) - 2 * k1 * k2
+
+
+def _feedthrough_abscissa(k1, k2):
+    return max(math.log(abs(E)) for E in np.roots(_feedthrough_quadratic(k1, k2)))
+
+
+def test_tune_says_no_optimum_where_the_abscissa_falls_without_bound():
+    # FEEDTHROUGH with both sensors: as (k1, k2) -> (0, 1), a -> -4 while b, c -> 0, so
+    # both roots E_i -> 0 and the abscissa -> -inf; k1 = 0 is not a positive gain, so no
+    # gain attains the infimum. Nelder-Mead crawls along the narrow valley toward that
+    # point and stops at its iteration limit; before, tune called where it stopped
+    # "optimum at a coalescence" (-4.5147 at diag(0.022, 1.022), while diag(0.002, 1.002)
+    # gives -6.2, converged). Now its restarts keep improving and it says so.
+    k1, k2 = 0.5, 2.0
+    E = np.roots(_feedthrough_quadratic(k1, k2))
+    mp.mp.dps = 30
+    for root in E:  # the hand derivation against the determinant of the boundary conditions
+        lam = mp.log(mp.mpc(complex(root)))
+        assert abs(wave_feedthrough_characteristic(lam, k1, k2)) < 1e-12
+    result = tune(to_numeric(FEEDTHROUGH), np.eye(2))
+    assert result.status == "descending"
+    assert not result.at_coalescence
+    assert "no optimum located" in str(result)
+    assert result.to_dict()["status"] == "descending"
+    assert not result.starts[0].settled  # the local searches hit their iteration limit
+    g1, g2 = np.diag(result.gain)
+    # the reported abscissa is the closed form's at the reported gain (the spectrum's own
+    # drift there is 2e-8, flagged: it says not converged near the coalescence)
+    assert abs(result.spectral_abscissa - _feedthrough_abscissa(g1, g2)) < 1e-6
+    assert result.spectral_abscissa < -5.0  # past the old false optimum -4.5147
+    # and the abscissa falls further: a tenth of k1 on the valley c = 0 is lower by > 1
+    k1_next = g1 / 10
+    k2_next = (2 - k1_next / 2) / (2 - k1_next / 2 - 2 * k1_next)  # c = 0
+    assert _feedthrough_abscissa(k1_next, k2_next) < result.spectral_abscissa - 1.0
+
+
 def test_single_start_improves_on_the_natural_gain():
     res = tune(numeric("euler-bernoulli"), PAPER_SENSORS, starts=1, resolution=16, maxiter=60)
     start = spectrum(numeric("euler-bernoulli"), PAPER_SENSORS, np.eye(2)).spectral_abscissa

@@ -66,6 +66,10 @@ __all__ = ["ROBUSTNESS_BOX", "LocalSearch", "TuneResult", "tune"]
 
 #: Relative half-width of the box of gains of the robustness figure beside every optimum.
 ROBUSTNESS_BOX = 0.05
+#: Restarts of Nelder-Mead from a local search stopped by its iteration limit.
+CONTINUATIONS = 6
+#: A restart that improves the abscissa by less than this (relative to the rate) settles it.
+CONTINUATION_GAIN = 1e-6
 _DECADE = math.log(10.0)
 
 
@@ -195,6 +199,39 @@ def _grid(search: _Search, log_range: tuple[float, float], seed: int) -> np.ndar
         points = rng.uniform(log_range[0], log_range[1], size=(256, q))
         points = np.concatenate([np.zeros((1, q)), points])
     return points
+
+
+def _continue(
+    search: _Search,
+    ev: AbscissaEvaluator,
+    x: np.ndarray,
+    f: float,
+    penalty: float,
+    options: dict[str, float],
+    rate: float,
+) -> tuple[np.ndarray, float, bool]:
+    """Restart Nelder-Mead from a search its iteration limit stopped; return (x, f, descending).
+
+    A fresh simplex crawls along a narrow valley that a collapsed one cannot follow.  The
+    search has settled when a restart converges (simplex below ``xatol``) or no longer
+    improves the abscissa by :data:`CONTINUATION_GAIN` of the rate; ``descending`` is
+    True when every one of :data:`CONTINUATIONS` restarts still improved it: the abscissa
+    then falls further than the search went (toward a boundary of the gains, or without
+    bound), and no optimum was located.
+    """
+    for _ in range(CONTINUATIONS):
+        res = minimize(
+            lambda y: _bounded(search.value(ev, y), penalty),
+            x,
+            method="Nelder-Mead",
+            options=options,
+        )
+        gain = f - float(res.fun)
+        if res.fun < f:
+            x, f = np.asarray(res.x), float(res.fun)
+        if res.success or gain <= CONTINUATION_GAIN * max(rate, abs(f)):
+            return x, f, False
+    return x, f, True
 
 
 def _polish(
@@ -340,6 +377,7 @@ def _tune(
     penalty = 1e6 * scales.rate
     records: list[LocalSearch] = []
     extinct: np.ndarray | None = None
+    descending = False
     x_best = np.zeros(search.n_params)
     L_best = L0
     polished: Coalescence | None = None
@@ -355,6 +393,7 @@ def _tune(
         # locates that point exactly
         options = {"maxiter": maxiter * npar, "xatol": 1e-5, "fatol": math.inf}
         best_f = math.inf
+        best_settled = True
         for i in order[: max(1, starts)]:
             x0 = search.diagonal_params(grid[i])
             before = search.evaluations
@@ -370,10 +409,16 @@ def _tune(
                     gain=search.gain(res.x),
                     spectral_abscissa=float(res.fun) if res.fun < penalty else None,
                     evaluations=search.evaluations - before,
+                    settled=bool(res.success),
                 )
             )
             if res.fun < best_f:
-                best_f, x_best = float(res.fun), np.asarray(res.x)
+                best_f, x_best, best_settled = float(res.fun), np.asarray(res.x), res.success
+        if not best_settled:
+            search.stage = "continuation"
+            x_best, best_f, descending = _continue(
+                search, ev_search, x_best, best_f, penalty, options, scales.rate
+            )
         if ev_verify is not ev_search:
             search.stage = "refinement at the verification pair"
             res = minimize(
@@ -384,7 +429,7 @@ def _tune(
             )
             x_best = np.asarray(res.x)
         search.stage = "coalescence"
-        found = _polish(search, ev_search, x_best)
+        found = None if descending else _polish(search, ev_search, x_best)
         if found is not None:
             x_best, polished = found
         L_best = search.gain(x_best)
@@ -411,6 +456,10 @@ def _tune(
     status = "optimum"
     if extinct is not None and report.unbounded_below:
         status = "extinction"
+    elif extinct is not None or descending:
+        # still improving when stopped, or an empty spectrum at the search pair that the
+        # verification does not confirm: the abscissa falls further than the search went
+        status = "descending"
     elif report.no_decay:
         status = "no decay"
     search.stage = "robustness"

@@ -30,6 +30,8 @@ class LocalSearch:
     gain: np.ndarray
     spectral_abscissa: float | None
     evaluations: int
+    #: Nelder-Mead converged (its simplex shrank below the tolerance within its iterations).
+    settled: bool = True
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary."""
@@ -38,6 +40,7 @@ class LocalSearch:
             "gain": self.gain.tolist(),
             "spectral_abscissa": finite_or_none(self.spectral_abscissa),
             "evaluations": self.evaluations,
+            "settled": self.settled,
         }
 
 
@@ -66,9 +69,12 @@ class TuneResult:
         The spectrum at ``gain``.
     starts : list of LocalSearch
         Every local search.
-    status : {"optimum", "extinction", "no decay"}
+    status : {"optimum", "extinction", "descending", "no decay"}
         An optimum; finite-time extinction at ``gain`` (the spectrum is empty: no better
-        gain exists); or no exponential decay found (the abscissa is 0 within accuracy).
+        gain exists); no optimum located, the abscissa still falling where the search
+        stopped (``gain`` is the best found, a direction rather than an optimum:
+        :func:`phdesign.numeric.tune.tune`); or no exponential decay found (the abscissa
+        is 0 within accuracy).
     evaluations : int
         Gains evaluated (each two eigenvalue problems, at the search or verification pair).
     robustness : Robustness or None
@@ -154,6 +160,13 @@ class TuneResult:
             return (
                 "finite-time extinction at this gain: the error system's spectrum is empty and "
                 "its abscissa unbounded below, so no gain does better (no optimum to refine)"
+            )
+        if self.status == "descending":
+            return (
+                "no optimum located: the abscissa was still decreasing where the search "
+                "stopped (every restart of the local search improved it); the gain below is "
+                "the best found, not an optimum (the abscissa may fall without bound toward a "
+                "boundary of the gains; a larger maxiter searches further)"
             )
         if self.status == "no decay":
             return (
