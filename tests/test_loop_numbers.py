@@ -358,3 +358,18 @@ def test_a_hand_built_numeric_loop_refuses_a_feedback_gain_without_positive_symm
         assemble(d, singular)
     skew_part = NumericLoop((2, 3), np.array([[1.0, 5.0], [-5.0, 1.0]]), C_m, np.eye(2))
     assert assemble(d, skew_part).A.shape == (2 * d.dim, 2 * d.dim)  # sym(K) = I is enough
+
+
+def test_loop_tune_passes_on_a_tuning_that_located_no_optimum():
+    # the error-system tuning of the wave with dampers at both ends has no optimum (its
+    # abscissa falls without bound toward L = diag(0, 1): test_numeric_tune); the loop's
+    # result must say so, not print the last gain as tuned without comment
+    from numeric_models import FEEDTHROUGH
+
+    nm = to_numeric(FEEDTHROUGH)
+    loop = NumericLoop((0,), np.array([[1.0]]), np.eye(2), np.eye(2))
+    result = tune_loop(nm, loop, target="gain", starts=1, maxiter=100)
+    assert result.error is not None
+    assert result.error.status == "descending"
+    assert any(w.startswith("the tuned error system: no optimum located") for w in result.warnings)
+    assert "no optimum located" in str(result)

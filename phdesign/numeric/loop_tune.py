@@ -75,9 +75,11 @@ class LoopTuneResult:
 
     @property
     def warnings(self) -> list[str]:
-        """The loop report's warnings and the coalescence notes of the tunings."""
+        """The loop report's warnings, and what each tuning found when not an optimum."""
         out = list(self.report.warnings)
         for name, result in (("controlled plant", self.plant), ("error system", self.error)):
+            if result is not None and result.status != "optimum":
+                out.append(f"the tuned {name}: {result.status_text()}")
             if result is not None and result.at_coalescence:
                 out.append(
                     f"the tuned {name} sits at a coalescence of eigenvalues: its abscissa is "
