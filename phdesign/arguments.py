@@ -25,12 +25,19 @@ from collections.abc import Sequence
 from phdesign.errors import ArgumentError, NumericError, PhdesignError
 
 __all__ = [
+    "DISCRETIZATION_METHODS",
     "choice",
     "positive_int",
     "positive_number",
     "require_model",
     "require_numeric_model",
 ]
+
+
+#: The values of a ``method`` argument: Legendre-Galerkin and staggered finite differences
+#: (:func:`phdesign.numeric.discretize.discretize`).  Here, so that a design object checks
+#: its method without loading the numeric layer.
+DISCRETIZATION_METHODS = ("galerkin", "fd")
 
 
 def _found(value: object) -> str:

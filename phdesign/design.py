@@ -38,7 +38,7 @@ import sympy
 from phdesign._display import REPR_LIMIT, html_table, matrix_text, sensors_text, shorten
 from phdesign.arguments import choice
 from phdesign.errors import ArgumentError, ObserverError
-from phdesign.numeric.defaults import EXPORT
+from phdesign.export_defaults import EXPORT
 from phdesign.plant import Plant, numeric_matrix
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import gain_matrix, measurement_matrix, sensor_matrix

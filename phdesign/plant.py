@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import sympy
 
 from phdesign._display import REPR_LIMIT, matrix_text, shorten
-from phdesign.arguments import choice, positive_int, require_model
+from phdesign.arguments import DISCRETIZATION_METHODS, choice, positive_int, require_model
 from phdesign.errors import ArgumentError, ObserverError, ParameterError
 from phdesign.symbolic.model import BCPHS
 
@@ -94,9 +94,7 @@ class Plant:
                 "parameters must be a mapping of names to values such as {'d': 0.5}; found "
                 f"{type(self.parameters).__name__}"
             )
-        from phdesign.numeric.discretize import METHODS
-
-        choice(self.method, "method", METHODS)
+        choice(self.method, "method", DISCRETIZATION_METHODS)
         if self.resolution is not None:
             positive_int(self.resolution, "resolution")
         object.__setattr__(self, "parameters", dict(self.parameters))

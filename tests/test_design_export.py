@@ -182,12 +182,12 @@ def test_import_stays_light_and_the_new_names_load_on_first_use():
 
 
 def test_the_library_the_design_object_and_the_cli_share_the_export_defaults():
-    # one row of defaults (phdesign.numeric.defaults.EXPORT) serves the three entry points:
+    # one row of defaults (phdesign.export_defaults.EXPORT) serves the three entry points:
     # a change of policy there reaches every one of them
     import inspect
 
     from phdesign.cli import build_parser
-    from phdesign.numeric.defaults import EXPORT
+    from phdesign.export_defaults import EXPORT
     from phdesign.numeric.order import select_order
 
     expected = {"sampler": "average", "tol": 1e-6, "output_tol": 1e-3, "t_end": 5.0}
@@ -201,3 +201,22 @@ def test_the_library_the_design_object_and_the_cli_share_the_export_defaults():
         ["export", "wave", "--sensors", "2", "--dt", "0.01", "--format", "json", "-o", "x.json"]
     )
     assert {k: getattr(args, k) for k in expected} == expected
+
+
+def test_the_symbolic_commands_never_load_the_numeric_layer():
+    # the symbolic layer never imports the numeric one, and the command line builds every
+    # subcommand's parser (export's defaults included) without it: classify and ports
+    # start fast (benchmarks/cli_startup.py prints the same probe)
+    probe = (
+        "import contextlib, io, sys\n"
+        "from phdesign.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    main(sys.argv[1:])\n"
+        "heavy = ('phdesign.numeric', 'scipy', 'control', 'matplotlib')\n"
+        "print(sorted(m for m in heavy if m in sys.modules))\n"
+    )
+    for argv in (["ports", "euler-bernoulli", "--json"], ["classify", "wave", "--sensors", "2"]):
+        out = subprocess.run(
+            [sys.executable, "-c", probe, *argv], capture_output=True, text=True, check=True
+        )
+        assert out.stdout.strip() == "[]", (argv, out.stdout, out.stderr)

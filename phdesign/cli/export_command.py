@@ -25,7 +25,7 @@ from phdesign.cli.common import (
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
 from phdesign.errors import NumericError, ObserverError, OutputFileError
-from phdesign.numeric.defaults import EXPORT
+from phdesign.export_defaults import EXPORT
 
 __all__ = ["add_sampling_arguments", "register", "sampled_simulation"]
 

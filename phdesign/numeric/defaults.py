@@ -53,11 +53,9 @@ from types import MappingProxyType
 from phdesign.errors import NumericError
 
 __all__ = [
-    "EXPORT",
     "FD",
     "GALERKIN",
     "METHODS",
-    "ExportDefaults",
     "MethodDefaults",
     "defaults_for",
     "spectrum_resolutions",
@@ -147,32 +145,3 @@ def spectrum_resolutions(order: int, method: str, basis: str | None = None) -> t
     if basis == "legendre" and row.legendre_max is not None:
         top = row.legendre_max
     return row.spectrum_start, top
-
-
-@dataclass(frozen=True)
-class ExportDefaults:
-    """Defaults of the exported observer, shared by the library, the design object and the CLI.
-
-    Attributes
-    ----------
-    sampler : str
-        ``"average"``: the mean of the sensors over each period, whose sampled error system
-        is dissipative for every period (:mod:`phdesign.numeric.sampled_discretization`);
-        point samples alias a boundary velocity's unresolved content.
-    tol : float
-        Relative accuracy of the rightmost error eigenvalues the order must reproduce.
-    output_tol : float
-        Error floor of the performance outputs, relative to their peak.
-    t_end : float
-        Length (s) of the performance and verification runs: five seconds hold several
-        periods of the paper's beam's slowest modes and its error's decay to the floor.
-    """
-
-    sampler: str = "average"
-    tol: float = 1e-6
-    output_tol: float = 1e-3
-    t_end: float = 5.0
-
-
-#: The one row of export defaults (:class:`ExportDefaults`).
-EXPORT = ExportDefaults()

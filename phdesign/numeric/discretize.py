@@ -35,6 +35,7 @@ Methods
 from __future__ import annotations
 
 from phdesign import limits
+from phdesign.arguments import DISCRETIZATION_METHODS
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.defaults import defaults_for
@@ -43,7 +44,7 @@ from phdesign.numeric.phs import ClosedLoop, DiscretePHS, feedback_matrix
 
 __all__ = ["METHODS", "ClosedLoop", "DiscretePHS", "discretize", "feedback_matrix"]
 
-METHODS = ("galerkin", "fd")
+METHODS = DISCRETIZATION_METHODS
 
 
 def discretize(

@@ -52,8 +52,8 @@ import numpy as np
 import scipy.linalg as sl
 
 from phdesign.errors import NumericError
+from phdesign.export_defaults import EXPORT
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.defaults import EXPORT
 from phdesign.numeric.discretize import discretize, feedback_matrix
 from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.sampling import ContinuousObserver, error_floor, run_loop

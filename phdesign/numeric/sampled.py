@@ -40,9 +40,9 @@ import numpy as np
 
 from phdesign.arguments import positive_number
 from phdesign.errors import ArgumentError, NumericError
+from phdesign.export_defaults import EXPORT
 from phdesign.numeric.arguments import check_initial_state
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.defaults import EXPORT
 from phdesign.numeric.order import REDUCTIONS, OrderSelection, check_order, select_order
 from phdesign.numeric.sampling import (
     ContinuousObserver,
