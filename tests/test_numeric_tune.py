@@ -13,6 +13,7 @@ from numeric_models import FEEDTHROUGH, PAPER_SENSORS, numeric
 
 from phdesign.cli import main
 from phdesign.errors import NumericError, ObserverError
+from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.evaluator import AbscissaEvaluator
@@ -272,3 +273,36 @@ def test_blas_threads_are_limited_inside_and_restored_after():
             assert set(blas_threads()) == {1}
         assert set(blas_threads()) == {1}
     assert blas_threads() == before
+
+
+def test_tune_on_a_model_with_its_own_boundary_feedback():
+    # beam-tip-damper closes u4 = -k y4 itself (k = 1): its sensors index the 3 external
+    # ports. The natural gain scale was computed over all 4 ports, and tune (CLI and
+    # library) crashed in a matrix product. The error system is the undamped cantilever
+    # with tip shear u4 = -y4 and tip torque u3 = -l y3: its eigenvalues are the roots of
+    # test_loop_numbers._beam_determinant(λ, torque=l, shear=1), polished here in mpmath
+    # from the reported rightmost eigenvalue (agreement 1e-10: measured 2e-14 to 7e-14).
+    # The optimum is local: the abscissa at l (1 ± 2 %), polished the same way, is larger.
+    from test_loop_numbers import _beam_determinant
+
+    nm = to_numeric(load_builtin("beam-tip-damper"))
+    C = np.array([[0.0, 0.0, 1.0]])
+    result = tune(nm, C)
+    assert result.status == "optimum"
+    assert result.converged
+    (tuned_gain,) = np.diag(result.gain)
+    mp.mp.dps = 30
+
+    def polished_abscissa(gain):
+        z = complex(spectrum(nm, C, np.array([[gain]])).rightmost[0])
+        f = lambda x: _beam_determinant(x, torque=gain, shear=1.0)  # noqa: E731
+        root = mp.findroot(f, mp.mpc(z), tol=1e-40, verify=False)
+        assert abs(f(root)) < 1e-25
+        assert abs(complex(root) - z) < 1e-10
+        return complex(root).real
+
+    best = polished_abscissa(tuned_gain)
+    assert abs(best - result.spectral_abscissa) < 1e-10
+    for factor in (0.98, 1.02):
+        assert polished_abscissa(factor * tuned_gain) > best + 0.1
+    assert main(["tune", "beam-tip-damper", "--sensors", "3", "--json"]) == 0

@@ -71,7 +71,8 @@ class ProblemScales:
     effort : ndarray
         The diagonal of S (one entry per component of e).
     input_scale, output_scale : ndarray
-        :math:`\sigma_u` and :math:`\sigma_y`, one entry per port.
+        :math:`\sigma_u` and :math:`\sigma_y`, one entry per external port (the ports the
+        plant's own feedback closes are not sensed, and have none).
 
     Examples
     --------
@@ -119,12 +120,16 @@ def problem_scales(nm: NumericModel) -> ProblemScales:
     speeds = np.abs(np.linalg.eigvals(nm.P[nm.order][None, :, :] @ Hs))
     rate = float(np.max(speeds)) / length**nm.order
     D = _trace_scales(nm, effort, length)
+    # the ports a sensor set indexes are the external ones: the plant's own feedback has
+    # closed the rest (bridge.NumericModel.n_ports), in the order of feedback.close_ports
+    closed = set() if nm.feedback is None else {int(c) for c in nm.feedback.closed}
+    external = [j for j in range(nm.order * nm.size) if j not in closed]
     return ProblemScales(
         length=length,
         rate=rate,
         effort=effort,
-        input_scale=np.max(np.abs(nm.U * D), axis=1),
-        output_scale=np.max(np.abs(nm.Y * D), axis=1),
+        input_scale=np.max(np.abs(nm.U * D), axis=1)[external],
+        output_scale=np.max(np.abs(nm.Y * D), axis=1)[external],
     )
 
 
