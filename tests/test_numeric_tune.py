@@ -211,7 +211,7 @@ def test_tune_says_no_optimum_where_the_abscissa_falls_without_bound():
         lam = mp.log(mp.mpc(complex(root)))
         assert abs(wave_feedthrough_characteristic(lam, k1, k2)) < 1e-12
     result = tune(to_numeric(FEEDTHROUGH), np.eye(2))
-    assert result.status == "descending"
+    assert (result.status, result.descent) == ("descending", "restarts")
     assert not result.at_coalescence
     assert "no optimum located" in str(result)
     assert result.to_dict()["status"] == "descending"
@@ -306,3 +306,18 @@ def test_tune_on_a_model_with_its_own_boundary_feedback():
     for factor in (0.98, 1.02):
         assert polished_abscissa(factor * tuned_gain) > best + 0.1
     assert main(["tune", "beam-tip-damper", "--sensors", "3", "--json"]) == 0
+
+
+def test_an_empty_spectrum_at_the_search_resolution_that_verification_refutes_is_no_optimum():
+    # Airy with its three sensors: at a corner of the search grid, diag(0.01, 0.01, 4.64),
+    # the low search resolution resolves no eigenvalue (it looks like finite-time
+    # extinction), but the verified spectrum there is finite (-80.2, converged). That is
+    # not an optimum (tune used to call it one): diag(0.01, 0.01, 2) gives -119 (converged)
+    nm = to_numeric(load_builtin("airy"))
+    result = tune(nm, np.eye(3))
+    assert (result.status, result.descent) == ("descending", "empty spectrum")
+    assert result.to_dict()["descent"] == "empty spectrum"
+    assert "finite-time extinction may lie near" in str(result)
+    better = spectrum(nm, np.eye(3), np.diag([0.01, 0.01, 2.0]))
+    assert better.converged
+    assert better.spectral_abscissa < result.spectral_abscissa - 10

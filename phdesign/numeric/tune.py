@@ -378,6 +378,7 @@ def _tune(
     records: list[LocalSearch] = []
     extinct: np.ndarray | None = None
     descending = False
+    descent = ""
     x_best = np.zeros(search.n_params)
     L_best = L0
     polished: Coalescence | None = None
@@ -460,6 +461,7 @@ def _tune(
         # still improving when stopped, or an empty spectrum at the search pair that the
         # verification does not confirm: the abscissa falls further than the search went
         status = "descending"
+        descent = "empty spectrum" if extinct is not None else "restarts"
     elif report.no_decay:
         status = "no decay"
     search.stage = "robustness"
@@ -479,4 +481,5 @@ def _tune(
         search_resolutions=ev_search.resolutions,
         robust=robust,
         seconds=time.perf_counter() - start_time,
+        descent=descent,
     )

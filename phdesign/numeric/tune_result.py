@@ -88,6 +88,11 @@ class TuneResult:
     seconds : float
         Wall time of the tuning.
     model : str
+    descent : str
+        Why the status is ``"descending"``: ``"restarts"`` (every restart of a local search
+        that its iteration limit stopped still improved the abscissa) or ``"empty
+        spectrum"`` (the search's low resolution found no resolved eigenvalue at
+        ``gain``, and the verification a finite abscissa); empty otherwise.
     """
 
     gain: np.ndarray
@@ -105,6 +110,7 @@ class TuneResult:
     robust: float | None = None
     seconds: float = 0.0
     model: str = ""
+    descent: str = ""
 
     @classmethod
     def from_report(
@@ -121,6 +127,7 @@ class TuneResult:
         search_resolutions: tuple[int, int],
         robust: float | None,
         seconds: float,
+        descent: str = "",
     ) -> TuneResult:
         """Assemble the result from the verified spectrum at ``gain``."""
         alpha = report.spectral_abscissa
@@ -150,6 +157,7 @@ class TuneResult:
             robust=robust,
             seconds=seconds,
             model=model,
+            descent=descent,
         )
 
     # -- text -------------------------------------------------------------------------
@@ -160,6 +168,13 @@ class TuneResult:
             return (
                 "finite-time extinction at this gain: the error system's spectrum is empty and "
                 "its abscissa unbounded below, so no gain does better (no optimum to refine)"
+            )
+        if self.status == "descending" and self.descent == "empty spectrum":
+            return (
+                "no optimum located: at the gain below the search's low resolution found no "
+                "resolved eigenvalue, while the verification finds the abscissa below: the "
+                "abscissa falls steeply here (finite-time extinction may lie near), so the "
+                "gain is a direction, not an optimum"
             )
         if self.status == "descending":
             return (
@@ -250,6 +265,7 @@ class TuneResult:
             "starts": [s.to_dict() for s in self.starts],
             "warnings": list(rep.warnings),
             "status": self.status,
+            "descent": self.descent or None,
             "unbounded_below": rep.unbounded_below,
             "no_decay": self.status == "no decay",
             "evaluations": self.evaluations,
