@@ -211,7 +211,9 @@ def test_tune_says_no_optimum_where_the_abscissa_falls_without_bound():
         lam = mp.log(mp.mpc(complex(root)))
         assert abs(wave_feedthrough_characteristic(lam, k1, k2)) < 1e-12
     result = tune(to_numeric(FEEDTHROUGH), np.eye(2))
-    assert (result.status, result.descent) == ("descending", "restarts")
+    # the restarts crawl down the valley until, at diag(0.008, 1.008), the search's low
+    # resolution resolves no eigenvalue, which the verification refutes (-5.52, finite)
+    assert (result.status, result.descent) == ("descending", "empty spectrum")
     assert not result.at_coalescence
     assert "no optimum located" in str(result)
     assert result.to_dict()["status"] == "descending"
