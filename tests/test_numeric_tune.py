@@ -323,3 +323,18 @@ def test_an_empty_spectrum_at_the_search_resolution_that_verification_refutes_is
     better = spectrum(nm, np.eye(3), np.diag([0.01, 0.01, 2.0]))
     assert better.converged
     assert better.spectral_abscissa < result.spectral_abscissa - 10
+
+
+def test_a_local_search_cut_short_is_restarted_and_says_when_it_never_settled():
+    # the paper's beam with a tiny iteration budget: maxiter 15 (30 Nelder-Mead steps for
+    # two gains) stops the local search early, the restarts settle it, and the coalescence
+    # polish still finds the triple root -5.8333507598 (mpmath: triple_root() above);
+    # maxiter 2 leaves every restart improving: no optimum is claimed
+    beam = numeric("euler-bernoulli")
+    settled = tune(beam, PAPER_SENSORS, starts=1, resolution=16, maxiter=15)
+    assert not settled.starts[0].settled
+    assert settled.status == "optimum"
+    assert abs(settled.spectral_abscissa - (-5.833350759830179)) < 1e-9
+    short = tune(beam, PAPER_SENSORS, starts=1, resolution=16, maxiter=2)
+    assert (short.status, short.descent) == ("descending", "restarts")
+    assert short.spectral_abscissa > -5.8333507598
