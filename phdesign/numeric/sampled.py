@@ -98,6 +98,9 @@ class Verification:
     floor, continuous_floor : float
         Largest error over the last fifth of the run, absolute.
     warnings : tuple of str
+    plant_gap : float or None
+        How far the plant's own performance outputs move over that window when its degree
+        is raised by half (:mod:`phdesign.numeric.plant_resolution`); None when unchecked.
     """
 
     plant_degree: int
@@ -113,6 +116,7 @@ class Verification:
     floor: float
     continuous_floor: float
     warnings: tuple[str, ...] = ()
+    plant_gap: float | None = None
 
     @property
     def ratio(self) -> float:
@@ -139,6 +143,7 @@ class Verification:
             "relative_floor": self.floor / self.peak if self.peak > 0 else None,
             "continuous_floor": self.continuous_floor,
             "ratio": ratio if math.isfinite(ratio) else None,
+            "plant_gap": self.plant_gap,
             "warnings": list(self.warnings),
         }
 
@@ -555,9 +560,14 @@ def export_observer(
     discrete = continuous.sampled(dt, sampler)
     verification = None
     if verify:
+        from phdesign.numeric.plant_resolution import check_plant_resolution
+        from phdesign.numeric.spectrum import default_resolutions
+
         verification = verify_observer(
             plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=float(t_end), x0_text=text
         )
+        largest = default_resolutions(nm, "galerkin")[1]
+        verification = check_plant_resolution(plant, continuous, initial, verification, largest)
     return SampledObserver(
         model=model_name or nm.name,
         dt=dt,

@@ -306,7 +306,7 @@ class LoopRun:
         return self.target - self.yhat[:, list(observer.performance)]
 
 
-def _plant_targets(plant: DiscretePHS, observer: ContinuousObserver) -> np.ndarray:
+def plant_targets(plant: DiscretePHS, observer: ContinuousObserver) -> np.ndarray:
     """Rows mapping plant efforts to the plant's values of the performance outputs."""
     if observer.points and plant.displacement_basis is not None:
         return plant.displacement_basis(np.array(observer.points))
@@ -394,7 +394,7 @@ def run_loop(
     x, xhat = X[:, :n], X[:, n:]
     measured = (x @ Cs.T + U @ Ds.T) @ C.T
     v = np.hstack([U, measured])
-    target = x @ _plant_targets(plant, observer).T
+    target = x @ plant_targets(plant, observer).T
     if not observer.points:
         target = target + U @ Dp.T
     return LoopRun(
