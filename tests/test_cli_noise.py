@@ -171,3 +171,18 @@ def test_stochastic_simulation_is_seeded_and_exact_in_time(capsys):
     quiet = run(capsys, *args)[1]  # zero intensities give the deterministic run
     zero = run(capsys, *args, "--noise-intensity", "0", "--seed", "1")[1]
     assert zero == quiet
+
+
+def test_a_noise_tuning_cut_short_by_its_iteration_limit_says_so():
+    # two gains, maxiter 1: Nelder-Mead gets 2 steps, cannot settle, and the result must
+    # not pass for an optimum
+    res = tune_noise(
+        numeric("wave"),
+        np.eye(2),
+        objective="rms",
+        min_decay=0.3,
+        performance=["x2: 1"],
+        model=load_builtin("wave"),
+        maxiter=1,
+    )
+    assert any("stopped at its iteration limit (2 steps)" in w for w in res.warnings)

@@ -244,6 +244,7 @@ def tune_noise(
     scores = [merit(x) for x in grid]
     order = np.argsort(scores)
     best_x, best_f = grid[int(order[0])], float(scores[int(order[0])])
+    unsettled = False  # the best point came from a search stopped by its iteration limit
     if q == 1:  # Brent between the grid neighbours of the best start
         k = int(order[0])
         lo, hi = grid[max(k - 1, 0)][0], grid[min(k + 1, len(grid) - 1)][0]
@@ -264,7 +265,7 @@ def tune_noise(
                 options={"maxiter": maxiter * q, "xatol": 1e-5, "fatol": 1e-9},
             )
             if found.fun < best_f:
-                best_x, best_f = found.x, float(found.fun)
+                best_x, best_f, unsettled = found.x, float(found.fun), not found.success
     L = np.diag(np.exp(best_x))
     spec = spectrum(nm, C, L)
     report = noise(nm, C, L, intensity=sigma, input_intensity=w_in, performance=functionals)
@@ -283,6 +284,12 @@ def tune_noise(
         )
     if rms is None:
         warnings.append("the error variance did not converge at the tuned gain")
+    if unsettled:
+        warnings.append(
+            f"the local search stopped at its iteration limit ({maxiter * q} steps) while "
+            "still moving: the gain is the best found, possibly not a local optimum; raise "
+            "maxiter"
+        )
     return NoiseTuneResult(
         objective=objective,
         bound=bound,
