@@ -277,10 +277,10 @@ def _symbolic_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> tuple[sympy
             unresolved = True
             continue
         for root in sympy.roots(sympy.Poly(factor, _MU)):
-            root = sympy.simplify(root)
+            root = _tidy(root)
             if root == 0:
                 continue
-            branch = sympy.simplify(1 / root)
+            branch = _tidy(1 / root)
             numerator, _ = sympy.fraction(sympy.together(root))
             if not numerator.is_positive and not numerator.is_negative:
                 # μ_i vanishes at some gains (e.g. (l - 1)²/(2 l) at l = 1): there the
@@ -299,6 +299,19 @@ def _symbolic_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> tuple[sympy
     branches = _undominated(branches)
     kappa = branches[0] if len(branches) == 1 else sympy.Min(*branches)
     return kappa, f"holds for all positive {names}"
+
+
+def _tidy(expr: sympy.Expr) -> sympy.Expr:
+    """Return a compact exact form: ``simplify``, or for radicals one common denominator.
+
+    ``simplify`` of the root of a quadratic factor in two gains (a square root of a
+    polynomial of degree 8) costs about 0.15 s and shortens it by 5 %; the common
+    denominator with the common factors pulled out costs a sixth of that, for the same
+    size (measured on the random models of tests/test_classify_properties.py).
+    """
+    if any(not p.exp.is_Integer for p in expr.atoms(sympy.Pow)):
+        return sympy.factor_terms(sympy.together(expr))
+    return sympy.simplify(expr)
 
 
 def _nonnegative_for_positive(expr: sympy.Expr) -> bool:
