@@ -330,3 +330,33 @@ def test_library_errors_name_the_argument():
         noise(nm, np.zeros((0, 4)), np.zeros((0, 0)))
     with pytest.raises(NumericError, match="outside the interval"):
         noise(nm, PAPER_SENSORS, np.eye(2), performance=["w(1.5)"])
+
+
+def test_the_l2_gain_of_a_wave_with_dampers_at_both_ends_is_its_closed_form():
+    r"""FEEDTHROUGH (H = I, P1 = [[0, 1], [1, 0]]), both sensors, L = diag(0.5, 2).
+
+    At frequency ω the error obeys iω e = P1 e', so e(z) = exp(iω P1 z) e(0), a unitary
+    matrix (P1 is symmetric, P1² = I): exp(iω P1) = cos ω I + i sin ω P1, and the energy
+    norm of e is |e(0)|. The boundary conditions u = -L (y + n), with u1 = 2 e1(0),
+    u2 = e2(1), y1 = -e2(0)/2 + e2(1), y2 = e1(1) - 2 e1(0), give
+    e(0) = -(U + L Y)⁻¹ L n, hence G(ω) = σ_max((U + L Y)⁻¹ L), 2π-periodic in ω: the L²
+    gain is its maximum over one period (here at ω = 0: sqrt((70 + sqrt(4500))/50) by hand
+    from the static 2 x 2 system). The report's figure must be that supremum.
+    """
+    L = np.diag([0.5, 2.0])
+
+    def gain(w):
+        E1 = math.cos(w) * np.eye(2) + 1j * math.sin(w) * np.array([[0.0, 1.0], [1.0, 0.0]])
+        U = np.array([[2.0, 0.0], [E1[1, 0], E1[1, 1]]])
+        Y = np.array([[E1[1, 0], -0.5 + E1[1, 1]], [E1[0, 0] - 2.0, E1[0, 1]]])
+        return np.linalg.svd(np.linalg.solve(U + L @ Y, L), compute_uv=False)[0]
+
+    omegas = np.linspace(0.0, 2 * math.pi, 4001)
+    values = np.array([gain(w) for w in omegas])
+    assert abs(values[0] - math.sqrt((70 + math.sqrt(4500)) / 50)) < 1e-14
+    sup = float(values.max())
+    assert omegas[int(values.argmax())] == 0.0  # the grid's maximum is the static gain
+    report = noise(to_numeric(FEEDTHROUGH), np.eye(2), L)
+    figure = report.to_dict()["l2_gain"]
+    assert figure["converged"]
+    assert abs(figure["value"] - sup) < 1e-10 * sup
