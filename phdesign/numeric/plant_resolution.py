@@ -24,9 +24,7 @@ dampers at both ends from the default initial state, 2.6 times it.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg as sl
@@ -34,10 +32,7 @@ import scipy.linalg as sl
 from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.sampling import FLOOR_WINDOW, ContinuousObserver, plant_targets
 
-if TYPE_CHECKING:
-    from phdesign.numeric.sampled import Verification
-
-__all__ = ["GAP_RATIO", "check_plant_resolution", "free_outputs"]
+__all__ = ["GAP_RATIO", "free_outputs", "gap_warning", "plant_resolution_gap"]
 
 #: The plant's own resolution gap, relative to the continuous floor, above which it is said.
 GAP_RATIO = 0.5
@@ -58,38 +53,42 @@ def free_outputs(
     return out
 
 
-def check_plant_resolution(
+def plant_resolution_gap(
     plant: DiscretePHS,
     observer: ContinuousObserver,
     initial: Callable[[np.ndarray], np.ndarray],
-    verification: Verification,
+    t: np.ndarray,
     largest: int,
-) -> Verification:
-    """Return ``verification`` with the plant's resolution gap, and a warning when large.
+) -> tuple[float, int] | None:
+    """Return g (module docstring) over the last fifth of the records ``t``, and the finer degree.
 
-    ``largest`` bounds the finer degree (the model's largest Galerkin resolution); when the
-    verification plant is already there, no finer plant exists and nothing is checked.
+    ``largest`` bounds the finer degree (the model's largest Galerkin resolution); None when
+    the plant is already there and no finer plant exists.
     """
     from phdesign.numeric.discretize import discretize
 
     finer_degree = min(-(-3 * plant.resolution // 2), largest)
     if finer_degree <= plant.resolution:
-        return verification
+        return None
     finer = discretize(plant.model, "galerkin", finer_degree)
-    t = verification.t
     gap_series = free_outputs(plant, observer, plant.project(initial), t) - free_outputs(
         finer, observer, finer.project(initial), t
     )
     window = t >= t[0] + (1.0 - FLOOR_WINDOW) * (t[-1] - t[0]) - 1e-12 * max(1.0, abs(t[-1]))
-    gap = float(np.max(np.abs(gap_series[window])))
-    warnings = verification.warnings
-    if gap > GAP_RATIO * verification.continuous_floor:
-        warnings += (
-            f"the verification plant does not resolve its own outputs from {verification.x0}: "
-            f"at degrees {plant.resolution} and {finer_degree} they differ by {gap:.3g} over "
-            f"the last fifth, against the continuous observer's floor "
-            f"{verification.continuous_floor:.3g}, so the floors measure the plant's "
-            "unresolved content as much as the observer; give an initial state that meets "
-            "the boundary conditions (--x0) or a higher --plant-resolution",
-        )
-    return dataclasses.replace(verification, plant_gap=gap, warnings=warnings)
+    return float(np.max(np.abs(gap_series[window]))), finer_degree
+
+
+def gap_warning(
+    gap: float, degrees: tuple[int, int], continuous_floor: float, x0_text: str
+) -> str | None:
+    """Return the verification's warning when ``gap`` exceeds GAP_RATIO x the floor."""
+    if not gap > GAP_RATIO * continuous_floor:
+        return None
+    return (
+        f"the verification plant does not resolve its own outputs from {x0_text}: at "
+        f"degrees {degrees[0]} and {degrees[1]} they differ by {gap:.3g} over the last "
+        f"fifth, against the continuous observer's floor {continuous_floor:.3g}, so the "
+        "floors measure the plant's unresolved content as much as the observer; give an "
+        "initial state that meets the boundary conditions (--x0) or a higher "
+        "--plant-resolution"
+    )

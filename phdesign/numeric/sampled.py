@@ -31,6 +31,7 @@ matrix in the efforts, or :math:`V^\top E V` after a reduction x = V x_r).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -392,6 +393,22 @@ class SampledObserver:
         return self.verification.plot(ax)
 
 
+def _with_plant_gap(
+    nm: NumericModel, plant: Any, observer: ContinuousObserver, initial: Any, v: Verification
+) -> Verification:
+    """Add the plant's own resolution gap (:mod:`phdesign.numeric.plant_resolution`)."""
+    from phdesign.numeric.plant_resolution import gap_warning, plant_resolution_gap
+    from phdesign.numeric.spectrum import default_resolutions
+
+    largest = default_resolutions(nm, "galerkin")[1]
+    found = plant_resolution_gap(plant, observer, initial, v.t, largest)
+    if found is None:
+        return v
+    warning = gap_warning(found[0], (plant.resolution, found[1]), v.continuous_floor, v.x0)
+    extra = () if warning is None else (warning,)
+    return dataclasses.replace(v, plant_gap=found[0], warnings=v.warnings + extra)
+
+
 def verification_plant_degree(
     nm: NumericModel, order: int | None, plant_resolution: int | None, reduction: str = "none"
 ) -> int:
@@ -560,14 +577,10 @@ def export_observer(
     discrete = continuous.sampled(dt, sampler)
     verification = None
     if verify:
-        from phdesign.numeric.plant_resolution import check_plant_resolution
-        from phdesign.numeric.spectrum import default_resolutions
-
         verification = verify_observer(
             plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=float(t_end), x0_text=text
         )
-        largest = default_resolutions(nm, "galerkin")[1]
-        verification = check_plant_resolution(plant, continuous, initial, verification, largest)
+        verification = _with_plant_gap(nm, plant, continuous, initial, verification)
     return SampledObserver(
         model=model_name or nm.name,
         dt=dt,
