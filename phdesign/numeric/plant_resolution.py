@@ -1,6 +1,6 @@
 r"""Whether the verification plant resolves its own performance outputs from the initial state.
 
-The verification (:func:`phdesign.numeric.sampled.verify_observer`) measures the observer
+The verification (:func:`phdesign.numeric.verification.verify_observer`) measures the observer
 against a Galerkin plant of high degree.  Its floor means something only if that plant
 resolves the outputs it compares from the given initial state: an initial state that
 violates the boundary conditions excites the plant's top frequencies, which a Galerkin
@@ -32,7 +32,7 @@ import scipy.linalg as sl
 from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.sampling import FLOOR_WINDOW, ContinuousObserver, plant_targets
 
-__all__ = ["GAP_RATIO", "free_outputs", "gap_warning", "plant_resolution_gap"]
+__all__ = ["GAP_RATIO", "free_outputs", "gap_warning", "plant_resolution_gap", "target_warning"]
 
 #: The plant's own resolution gap, relative to the continuous floor, above which it is said.
 GAP_RATIO = 0.5
@@ -59,9 +59,10 @@ def plant_resolution_gap(
     initial: Callable[[np.ndarray], np.ndarray],
     t: np.ndarray,
     largest: int,
-) -> tuple[float, int] | None:
-    """Return g (module docstring) over the last fifth of the records ``t``, and the finer degree.
+) -> tuple[float, int, float] | None:
+    """Return g (module docstring) over the last fifth of ``t``, the finer degree, the peak.
 
+    The peak is the largest magnitude of the plant's performance outputs over ``t``.
     ``largest`` bounds the finer degree (the model's largest Galerkin resolution); None when
     the plant is already there and no finer plant exists.
     """
@@ -71,11 +72,30 @@ def plant_resolution_gap(
     if finer_degree <= plant.resolution:
         return None
     finer = discretize(plant.model, "galerkin", finer_degree)
-    gap_series = free_outputs(plant, observer, plant.project(initial), t) - free_outputs(
-        finer, observer, finer.project(initial), t
-    )
+    coarse = free_outputs(plant, observer, plant.project(initial), t)
+    gap_series = coarse - free_outputs(finer, observer, finer.project(initial), t)
     window = t >= t[0] + (1.0 - FLOOR_WINDOW) * (t[-1] - t[0]) - 1e-12 * max(1.0, abs(t[-1]))
-    return float(np.max(np.abs(gap_series[window]))), finer_degree
+    gap = float(np.max(np.abs(gap_series[window])))
+    return gap, finer_degree, float(np.max(np.abs(coarse)))
+
+
+def target_warning(
+    gap: float, peak: float, degrees: tuple[int, int], output_tol: float, x0_text: str
+) -> str | None:
+    """Return the order selection's warning when the plant's gap exceeds the target itself.
+
+    The performance target asks for a floor of ``output_tol`` of the peak; a plant whose
+    own outputs move by more than GAP_RATIO times that when refined cannot show it met.
+    """
+    if not (peak > 0 and gap > GAP_RATIO * output_tol * peak):
+        return None
+    return (
+        f"the verification plant does not resolve its own outputs from {x0_text} to the "
+        f"performance target: at degrees {degrees[0]} and {degrees[1]} they differ by "
+        f"{gap / peak:.3g} of their peak over the last fifth (target {output_tol:g}), so no "
+        "observer can be shown to meet it; give an initial state that meets the boundary "
+        "conditions (--x0) or a higher --plant-resolution"
+    )
 
 
 def gap_warning(
