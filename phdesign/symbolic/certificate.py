@@ -314,13 +314,32 @@ def _tidy(expr: sympy.Expr) -> sympy.Expr:
     return sympy.simplify(expr)
 
 
+def _sign_for_positive(poly: sympy.Poly) -> int | None:
+    """Return the sign (+1 or -1) a polynomial keeps on s > 0, zeros aside; None if it changes.
+
+    Its square-free factors of odd multiplicity (``sqf_list``) must have no root in
+    (0, ∞) (``count_roots``, exact Sturm counting); the sign is then read at the first
+    positive integer that is not a root.
+    """
+    _, factors = poly.sqf_list()
+    for factor, multiplicity in factors:
+        if multiplicity % 2 and factor.degree() > 0:
+            inside = factor.count_roots(0, None) - (1 if factor.eval(0) == 0 else 0)
+            if inside > 0:
+                return None
+    point = 1
+    while poly.eval(point) == 0:
+        point += 1
+    return 1 if poly.eval(point) > 0 else -1
+
+
 def _nonnegative_for_positive(expr: sympy.Expr) -> bool:
     r"""Prove :math:`f \ge 0` for every positive value of f's one symbol (False: not proved).
 
-    f = p/q with polynomials p, q of rational coefficients in one symbol s: p and q keep
-    their sign on :math:`s > 0` when every positive real root has even multiplicity
-    (``sympy.roots`` of a univariate polynomial, exact), and that sign is read at a point
-    beyond the roots.  No symbol: the sign of the number.
+    f = p/q with polynomials p, q of rational coefficients in one symbol s: each keeps its
+    sign on :math:`s > 0` when no factor of odd multiplicity has a root there (exact root
+    counting, :func:`_sign_for_positive`), and f ≥ 0 when those signs agree.  No symbol:
+    the sign of the number.
     """
     symbols = expr.free_symbols
     if not symbols:
@@ -337,16 +356,10 @@ def _nonnegative_for_positive(expr: sympy.Expr) -> bool:
             return False
         if poly.is_zero:
             return part is numerator  # f = 0
-        positive = []
-        for root, multiplicity in sympy.roots(poly, filter="R").items():
-            if root.is_positive:
-                if multiplicity % 2:
-                    return False  # a sign change on s > 0
-                positive.append(root)
-        if sum(sympy.roots(poly).values()) != poly.degree():
-            return False  # roots without closed form: no proof attempted
-        beyond = 1 + max(positive, default=sympy.Integer(0))
-        signs.append(sympy.sign(poly.eval(beyond)))
+        sign = _sign_for_positive(poly)
+        if sign is None:
+            return False
+        signs.append(sign)
     return signs[0] * signs[1] > 0
 
 
