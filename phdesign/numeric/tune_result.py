@@ -171,17 +171,16 @@ class TuneResult:
             )
         if self.status == "descending" and self.descent == "empty spectrum":
             return (
-                "no optimum located: at the gain below the search's low resolution found no "
-                "resolved eigenvalue, while the verification finds the abscissa below: the "
-                "abscissa falls steeply here (finite-time extinction may lie near), so the "
-                "gain is a direction, not an optimum"
+                "no optimum located: at the gain below the search's low resolution resolved "
+                "no eigenvalue, where the verification finds the abscissa below; the search "
+                "stopped there, so the gain is the best found, not an optimum"
             )
         if self.status == "descending":
             return (
-                "no optimum located: the abscissa was still decreasing where the search "
-                "stopped (every restart of the local search improved it); the gain below is "
-                "the best found, not an optimum (the abscissa may fall without bound toward a "
-                "boundary of the gains; a larger maxiter searches further)"
+                "no optimum located: the local search did not settle within its budget "
+                "(every restart of Nelder-Mead still improved the abscissa); the gain below "
+                "is the best found, not an optimum: the abscissa may keep falling (toward a "
+                "boundary of the gains, or without bound), or the search needs a larger maxiter"
             )
         if self.status == "no decay":
             return (

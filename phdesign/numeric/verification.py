@@ -194,7 +194,8 @@ def with_plant_gap(
     found = plant_resolution_gap(plant, observer, initial, v.t, largest)
     if found is None:
         return v
-    warning = gap_warning(found[0], (plant.resolution, found[1]), v.continuous_floor, v.x0)
+    degrees = (plant.resolution, found[1])
+    warning = gap_warning(found[0], degrees, v.continuous_floor, v.peak, v.x0)
     extra = () if warning is None else (warning,)
     return dataclasses.replace(v, plant_gap=found[0], warnings=v.warnings + extra)
 
