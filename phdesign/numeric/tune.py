@@ -34,7 +34,12 @@ Questions without an optimum get an answer that says so: when the search meets a
 spectrum (finite-time extinction, the string with the matched damper k = √(ρT)), the
 result is that gain with ``status = "extinction"``; when the abscissa at the best gain is 0
 within its accuracy (Timoshenko with one sensor: the real parts approach 0 at high
-frequency for every gain), ``status = "no decay"``.
+frequency for every gain), ``status = "no decay"``.  A local search that its iteration
+limit stops is restarted (up to :data:`CONTINUATIONS` times); when every restart still
+improves the abscissa (a wave with dampers at both ends, whose abscissa falls without
+bound toward the boundary gain diag(0, 1)), or the search stops at an empty spectrum of
+its low resolution that the verification refutes, ``status = "descending"``: no optimum
+was located, and the gain is the best found.
 
 ``robust=δ`` minimizes the worst abscissa over the ±δ box instead (its grid points only
 during the search).
@@ -215,9 +220,10 @@ def _continue(
     A fresh simplex crawls along a narrow valley that a collapsed one cannot follow.  The
     search has settled when a restart converges (simplex below ``xatol``) or no longer
     improves the abscissa by :data:`CONTINUATION_GAIN` of the rate; ``descending`` is
-    True when every one of :data:`CONTINUATIONS` restarts still improved it: the abscissa
-    then falls further than the search went (toward a boundary of the gains, or without
-    bound), and no optimum was located.
+    True when every one of :data:`CONTINUATIONS` restarts still improved it: the search
+    did not settle within its budget, and no optimum was located (the abscissa may keep
+    falling, toward a boundary of the gains or without bound, or lie in a valley too
+    steep for the budget).
     """
     for _ in range(CONTINUATIONS):
         res = minimize(
@@ -458,8 +464,8 @@ def _tune(
     if extinct is not None and report.unbounded_below:
         status = "extinction"
     elif extinct is not None or descending:
-        # still improving when stopped, or an empty spectrum at the search pair that the
-        # verification does not confirm: the abscissa falls further than the search went
+        # still improving when stopped, or stopped at an empty spectrum of the search pair
+        # that the verification refutes: in neither case was an optimum located
         status = "descending"
         descent = "empty spectrum" if extinct is not None else "restarts"
     elif report.no_decay:
