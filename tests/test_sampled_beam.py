@@ -305,3 +305,13 @@ def test_the_verification_says_when_its_plant_does_not_resolve_its_own_outputs()
     assert v.plant_gap < GAP_RATIO * v.continuous_floor
     assert not any("does not resolve" in w for w in v.warnings)
     assert v.to_dict()["plant_gap"] == v.plant_gap
+
+
+def test_a_verification_plant_at_the_largest_resolution_says_its_resolution_is_unchecked(wave):
+    # the wave's largest Galerkin degree is 100 (spectrum_resolutions): no finer plant
+    # exists to check the verification plant against, and the report must say so rather
+    # than leave plant_gap None in silence
+    nm, C_m, L, *_ = wave
+    v = export_observer(nm, C_m, L, dt=1e-2, order=12, verify=True, plant_resolution=100)
+    assert v.verification.plant_gap is None
+    assert any("largest Galerkin resolution" in w for w in v.verification.warnings)

@@ -193,7 +193,12 @@ def with_plant_gap(
     largest = default_resolutions(nm, "galerkin")[1]
     found = plant_resolution_gap(plant, observer, initial, v.t, largest)
     if found is None:
-        return v
+        unchecked = (
+            f"the verification plant (degree {plant.resolution}) is at this model's largest "
+            "Galerkin resolution: whether it resolves its own outputs from the initial "
+            "state is not checked"
+        )
+        return dataclasses.replace(v, warnings=(*v.warnings, unchecked))
     degrees = (plant.resolution, found[1])
     warning = gap_warning(found[0], degrees, v.continuous_floor, v.peak, v.x0)
     extra = () if warning is None else (warning,)
