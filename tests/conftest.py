@@ -2,9 +2,21 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
+from threadpoolctl import threadpool_limits
+
+# The suite's matrices are small: on one BLAS thread it runs about a fifth faster here
+# (17.9 s against 22.8 s on four of its numeric files) and its timings stay steady.
+# numpy is already loaded when this runs (a pytest plugin imports it), so the limit is
+# set through threadpoolctl for this process, and through the environment for the
+# command lines the tests start; a value the caller exported wins.
+if "OPENBLAS_NUM_THREADS" not in os.environ:
+    os.environ["OPENBLAS_NUM_THREADS"] = "1"
+    _ONE_BLAS_THREAD = threadpool_limits(limits=1, user_api="blas")
 
 # CI runs a bounded budget; set HYPOTHESIS_PROFILE=nightly for the long fuzzing run.
 settings.register_profile(
