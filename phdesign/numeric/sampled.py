@@ -51,6 +51,7 @@ from phdesign.numeric.sampling import (
 )
 from phdesign.numeric.verification import (
     Verification,
+    plant_gap,
     verify_observer,
     with_plant_gap,
     with_target_check,
@@ -402,15 +403,21 @@ def export_observer(
         tol=tol,
         output_tol=output_tol,
     )
-    if selection.floor > selection.output_tol:  # missed: is it the plant's own resolution?
-        selection = with_target_check(nm, plant, continuous, initial, selection, t_end, text)
     discrete = continuous.sampled(dt, sampler)
     verification = None
+    missed = selection.floor > selection.output_tol  # is it the plant's own resolution?
     if verify:
         verification = verify_observer(
             plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=float(t_end), x0_text=text
         )
-        verification = with_plant_gap(nm, plant, continuous, initial, verification)
+    if verification is not None or missed:
+        # one finer plant serves both checks, on the verification's records when there are any
+        t = np.linspace(0.0, float(t_end), 501) if verification is None else verification.t
+        found = plant_gap(nm, plant, continuous, initial, t)
+        if verification is not None:
+            verification = with_plant_gap(verification, found, plant.resolution)
+        if missed:
+            selection = with_target_check(selection, found, plant.resolution, text)
     return SampledObserver(
         model=model_name or nm.name,
         dt=dt,

@@ -20,7 +20,7 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.order import OrderSelection, check_order
 from phdesign.numeric.sampling import ContinuousObserver, check_sampling, run_against_continuous
 
-__all__ = ["Verification", "verify_observer", "with_plant_gap", "with_target_check"]
+__all__ = ["Verification", "plant_gap", "verify_observer", "with_plant_gap", "with_target_check"]
 
 
 def _fmt(value: float | None) -> str:
@@ -183,49 +183,53 @@ def verify_observer(
     )
 
 
-def with_plant_gap(
-    nm: NumericModel, plant: Any, observer: ContinuousObserver, initial: Any, v: Verification
-) -> Verification:
-    """Add the plant's own resolution gap (:mod:`phdesign.numeric.plant_resolution`)."""
-    from phdesign.numeric.plant_resolution import gap_warning, plant_resolution_gap
+def plant_gap(
+    nm: NumericModel, plant: Any, observer: ContinuousObserver, initial: Any, t: np.ndarray
+) -> tuple[float, int, float] | None:
+    """Return the plant's own resolution gap over ``t``, the finer degree and the peak.
+
+    :func:`~phdesign.numeric.plant_resolution.plant_resolution_gap` with this model's
+    largest Galerkin resolution; None when the plant is already there.
+    """
+    from phdesign.numeric.plant_resolution import plant_resolution_gap
     from phdesign.numeric.spectrum import default_resolutions
 
     largest = default_resolutions(nm, "galerkin")[1]
-    found = plant_resolution_gap(plant, observer, initial, v.t, largest)
+    return plant_resolution_gap(plant, observer, initial, t, largest)
+
+
+def with_plant_gap(
+    v: Verification, found: tuple[float, int, float] | None, plant_degree: int
+) -> Verification:
+    """Add the plant's own resolution gap ``found`` (:func:`plant_gap`) to the verification."""
+    from phdesign.numeric.plant_resolution import gap_warning
+
     if found is None:
         unchecked = (
-            f"the verification plant (degree {plant.resolution}) is at this model's largest "
+            f"the verification plant (degree {plant_degree}) is at this model's largest "
             "Galerkin resolution: whether it resolves its own outputs from the initial "
             "state is not checked"
         )
         return dataclasses.replace(v, warnings=(*v.warnings, unchecked))
-    degrees = (plant.resolution, found[1])
-    warning = gap_warning(found[0], degrees, v.continuous_floor, v.peak, v.x0)
+    gap, finer, _ = found
+    warning = gap_warning(gap, (plant_degree, finer), v.continuous_floor, v.peak, v.x0)
     extra = () if warning is None else (warning,)
-    return dataclasses.replace(v, plant_gap=found[0], warnings=v.warnings + extra)
+    return dataclasses.replace(v, plant_gap=gap, warnings=v.warnings + extra)
 
 
 def with_target_check(
-    nm: NumericModel,
-    plant: Any,
-    observer: ContinuousObserver,
-    initial: Any,
     selection: OrderSelection,
-    t_end: float,
+    found: tuple[float, int, float] | None,
+    plant_degree: int,
     x0_text: str,
 ) -> OrderSelection:
     """Add the warning of :func:`~phdesign.numeric.plant_resolution.target_warning`."""
-    from phdesign.numeric.plant_resolution import plant_resolution_gap, target_warning
-    from phdesign.numeric.spectrum import default_resolutions
+    from phdesign.numeric.plant_resolution import target_warning
 
-    t = np.linspace(0.0, float(t_end), 501)
-    found = plant_resolution_gap(
-        plant, observer, initial, t, default_resolutions(nm, "galerkin")[1]
-    )
     if found is None:
         return selection
     gap, finer, peak = found
-    warning = target_warning(gap, peak, (plant.resolution, finer), selection.output_tol, x0_text)
+    warning = target_warning(gap, peak, (plant_degree, finer), selection.output_tol, x0_text)
     if warning is None:
         return selection
     return dataclasses.replace(selection, warnings=(*selection.warnings, warning))
