@@ -89,7 +89,9 @@ def test_the_loop_spectrum_is_refined_by_the_spectrum_rules_and_stays_honest():
     controlled plant's (k = K: limit -0.44602) and the error system's (k = L), whose
     limit -0.6179 lies further left, so the loop's abscissa is the plant's limit.  The old
     loop refinement reported the largest attained mode, 3.6e-5 right of the limit, with 6.7
-    digits claimed; the spectrum's rules recognise the limit and claim only what holds.
+    digits claimed; then an extrapolation, not converged; now the chains' limits of both
+    blocks are derived from the principal part (numeric/branches.py) and the loop's is the
+    plant's, to round-off.
     """
 
     def limit(k: float) -> float:
@@ -105,10 +107,11 @@ def test_the_loop_spectrum_is_refined_by_the_spectrum_rules_and_stays_honest():
     assert abs(report.spectral_abscissa - exact) <= claim, report.spectral_abscissa - exact
     assert report.uncertainty is not None
     assert abs(report.spectral_abscissa - exact) <= report.uncertainty
-    assert not report.converged  # a limit is never called converged
-    rising = [w for w in report.warnings if w.startswith("loop: the real parts")]
-    assert rising
-    assert "keep rising with frequency" in rising[0]
+    assert report.converged  # a derived limit, no longer an extrapolation
+    assert abs(report.spectral_abscissa - exact) < 1e-12
+    chains = [w for w in report.warnings if w.startswith("loop: the abscissa is the limit")]
+    assert chains
+    assert "controlled plant" in chains[0]
     assert not any("separation structure is not reproduced" in w for w in report.warnings)
 
 
@@ -122,6 +125,7 @@ class _SpoiledAtHighDegree:
 
     rate = 1.0
     dissipative = True
+    branches = None  # no principal part to derive: the band alone decides
 
     def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
         m = np.arange(p // 2 - 3)

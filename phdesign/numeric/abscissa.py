@@ -47,16 +47,29 @@ each resolved or clustered eigenvalue :math:`\lambda_i` has a real part known to
    the string with the matched damper.  A conservative system (lossless: every discrete
    eigenvalue on the imaginary axis) never shows it; there nothing is "not resolved at
    these resolutions".
+6. the spectrum above the band (:mod:`phdesign.numeric.branches`): the principal part's
+   root chains have real parts tending to limits that no finite band sees, and below
+   the onset Ω of the principal part the families are coupled into branches that start
+   anywhere up to Ω (the Timoshenko beam's thickness-shear cut-off).  So
+   (:func:`with_branches`) the abscissa is the larger of the attained value and every
+   chain's limit (kind ``"limit"``, the family named, when a limit is larger); it is
+   exact when the chains' limits are derived (N = 1) and supersedes an extrapolation of
+   rule 4 that agrees with it.  When the eigenvalues are not all resolved up to
+   :data:`~phdesign.numeric.branches.ONSET_MARGIN` Ω (:attr:`PairSpectrum.complete_band
+   <phdesign.numeric.drift.PairSpectrum.complete_band>`), the value is only a lower
+   bound (kind ``"lower bound"``): a branch may start above the band.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from phdesign.numeric.branches import Branches, BranchLimit
 from phdesign.numeric.drift import PairSpectrum
 
 __all__ = [
@@ -66,6 +79,7 @@ __all__ = [
     "estimate_abscissa",
     "high_frequency_limit",
     "looks_empty",
+    "with_branches",
 ]
 
 #: A converged report needs this many resolved modes (upper half plane) at higher
@@ -116,9 +130,10 @@ class Abscissa:
         The abscissa (None when no eigenvalue is resolved).
     uncertainty : float or None
         Accuracy of ``value`` (absolute).
-    kind : {"attained", "limit", "extinct", "none"}
-        Attained by an eigenvalue, a limit approached at high frequency, nothing resolved
-        with the evidence of an empty spectrum (rule 5), or nothing resolved.
+    kind : {"attained", "limit", "lower bound", "extinct", "none"}
+        Attained by an eigenvalue, a limit approached at high frequency (rules 4 and 6),
+        a lower bound (rule 6: the band does not reach the onset), nothing resolved with
+        the evidence of an empty spectrum (rule 5), or nothing resolved.
     index : int or None
         Index (into the pair's eigenvalues) of the counted eigenvalue with the largest real
         part.
@@ -137,11 +152,17 @@ class Abscissa:
         gives the abscissa.
     limit : HighFrequencyLimit or None
         The rising trend, when there is one (whatever its limit).
+    branches : Branches or None
+        The structure above the band (rule 6), when it was applied.
+    pair_dissipative : bool
+        The pencil is dissipative (no eigenvalue right of 0: rule 3), so is the abscissa.
+    branch : BranchLimit or None
+        The chains' limit that gives the abscissa (rule 6), when one does.
     """
 
     value: float | None
     uncertainty: float | None
-    kind: Literal["attained", "limit", "extinct", "none"]
+    kind: Literal["attained", "limit", "lower bound", "extinct", "none"]
     index: int | None
     attained: float | None
     attained_uncertainty: float | None
@@ -150,6 +171,13 @@ class Abscissa:
     loose_right: np.ndarray
     modes_above: int
     limit: HighFrequencyLimit | None
+    branches: Branches | None = None
+    branch: BranchLimit | None = None
+    pair_dissipative: bool = False
+
+    def band_short(self, pair: PairSpectrum) -> bool:
+        """Tell whether some eigenvalue below the required band is unresolved (rule 6)."""
+        return self.branches is not None and pair.complete_band < self.branches.required_band
 
 
 def _fit(w: np.ndarray, r: np.ndarray, q: float) -> tuple[float, float]:
@@ -274,4 +302,58 @@ def estimate_abscissa(pair: PairSpectrum, tol: float) -> Abscissa:
         loose_right=loose_right,
         modes_above=_modes_above(pair, reference),
         limit=limit,
+        pair_dissipative=pair.dissipative,
+    )
+
+
+def with_branches(a: Abscissa, pair: PairSpectrum, branches: Branches | None) -> Abscissa:
+    """Rule 6: combine the pair's abscissa with the chains' limits above the band.
+
+    Returns ``a`` with ``branches`` set.  The abscissa lies in
+    ``[max(lo_a, lo_c), max(hi_a, hi_c)]`` (the pair's interval and the largest chain
+    limit's), capped at 0 for a dissipative pencil; its value is the chains' limit when
+    that lies clearly right of the pair's value (kind ``"limit"``), else the pair's.
+    While the band does not reach the onset the kind is ``"lower bound"``.
+    """
+    if branches is None:
+        return a
+    out = replace(a, branches=branches)
+    if a.value is None or a.uncertainty is None or a.attained is None:
+        return out
+    kind = a.kind
+    top = branches.limit
+    if top is not None:
+        out = _combine(out, top)
+    if pair.complete_band < branches.required_band:
+        kind = "lower bound"
+    elif out.kind == "limit":
+        kind = "limit"
+    return replace(out, kind=kind)
+
+
+def _combine(a: Abscissa, top: BranchLimit) -> Abscissa:
+    """Return the abscissa of ``a`` (which has a value) together with the chains' limit ``top``."""
+    assert a.value is not None
+    assert a.uncertainty is not None
+    limit = a.limit
+    trend_agrees = limit is None or limit.value - limit.uncertainty <= top.limit + top.uncertainty
+    lo = max(a.value - a.uncertainty, top.limit - top.uncertainty)
+    hi = max(a.value + a.uncertainty, top.limit + top.uncertainty)
+    if a.kind == "limit" and trend_agrees:  # rule 4 extrapolated what rule 6 derives
+        lo, hi = top.limit - top.uncertainty, top.limit + top.uncertainty
+    cap = 0.0 if a.pair_dissipative else math.inf
+    hi = max(min(hi, cap), lo)
+    # the limit gives the value when it lies certainly right of the pair's value (its
+    # interval may still overlap the pair's, e.g. a lossless family above damped modes)
+    wins = top.limit - top.uncertainty > a.value or (a.kind == "limit" and trend_agrees)
+    value = top.limit if wins else a.value
+    value = min(max(value, lo), hi)
+    return replace(
+        a,
+        value=value,
+        uncertainty=max(value - lo, hi - value),
+        kind="limit" if wins else a.kind,
+        index=None if wins else a.index,
+        limit=limit if not trend_agrees else None,
+        branch=top if wins else None,
     )

@@ -6,13 +6,13 @@ table per discretization method, with one row per model order N (the last row se
 every higher order):
 
 ``GALERKIN``
-    ============  =======  ==========  ===========  ======  ========  ==============
-    order          degree  first pair  largest      tune    basis     cap (Legendre)
-    ============  =======  ==========  ===========  ======  ========  ==============
-    N = 1              40          20          100      30  legendre  --
-    N = 2              40          20          110      30  legendre  --
-    N >= 3             16           8          110      30  scaled    48
-    ============  =======  ==========  ===========  ======  ========  ==============
+    ============  =======  ==========  ===========  ======  ========  ==============  =====
+    order          degree  first pair  largest      tune    basis     cap (Legendre)  band
+    ============  =======  ==========  ===========  ======  ========  ==============  =====
+    N = 1              40          20          100      30  legendre  --                330
+    N = 2              40          20          110      30  legendre  --                240
+    N >= 3             16           8          110      30  scaled    48                110
+    ============  =======  ==========  ===========  ======  ========  ==============  =====
 
 ``FD`` (staggered finite differences, N = 1 and 2)
     70 nodes per state group (the paper's 140 states for the beam), refinement from 70
@@ -29,6 +29,10 @@ Why these numbers:
   resolution up to the largest; N >= 3 starts low because its rightmost modes are
   resolved early.  With the plain Legendre basis (``basis="legendre"``) round-off
   grows with the degree for N >= 3, which is why that basis is capped at 48.
+* ``band``: the largest resolution the refinement reaches while its band does not reach
+  the onset of the principal part (:mod:`phdesign.numeric.branches`): a steel
+  Timoshenko beam's thickness-shear branch starts at 2.03e5 rad/s, 78 times its rate,
+  and needs the pair (153, 230); a resolution of 330 costs about 5 s for n = 4.
 * ``tune``: the coarse degree of tuning's resolution pair when the spectrum at L = I
   did not converge (an unconverged start says nothing about a good pair).
 * ``basis``: the trace-scaled basis for N >= 3 turns 9 digits into 15 on the airy error
@@ -57,6 +61,7 @@ __all__ = [
     "GALERKIN",
     "METHODS",
     "MethodDefaults",
+    "band_resolution",
     "defaults_for",
     "spectrum_resolutions",
 ]
@@ -82,6 +87,9 @@ class MethodDefaults:
     legendre_max : int or None
         Largest refinement resolution when the plain Legendre basis is forced on this
         order (round-off grows with the degree); None when no cap applies.
+    band_max : int
+        Largest refinement resolution while the band does not reach the onset of the
+        principal part (:mod:`phdesign.numeric.branches`); at least ``spectrum_max``.
     resolved_rtol : float
         Relative drift under which an eigenvalue counts as resolved between two
         resolutions (spectral Galerkin 1e-6; second-order finite differences 1e-2).
@@ -96,21 +104,26 @@ class MethodDefaults:
     tune_fallback: int
     basis: str | None = None
     legendre_max: int | None = None
+    band_max: int = 0
     resolved_rtol: float = 1e-6
     abscissa_tol: float = 1e-10
 
 
 GALERKIN: Mapping[int, MethodDefaults] = MappingProxyType(
     {
-        1: MethodDefaults("galerkin", 40, 20, 100, 30, "legendre"),
-        2: MethodDefaults("galerkin", 40, 20, 110, 30, "legendre"),
-        3: MethodDefaults("galerkin", 16, 8, 110, 30, "scaled", legendre_max=48),
+        1: MethodDefaults("galerkin", 40, 20, 100, 30, "legendre", band_max=330),
+        2: MethodDefaults("galerkin", 40, 20, 110, 30, "legendre", band_max=240),
+        3: MethodDefaults("galerkin", 16, 8, 110, 30, "scaled", legendre_max=48, band_max=110),
     }
 )
 FD: Mapping[int, MethodDefaults] = MappingProxyType(
     {
-        1: MethodDefaults("fd", 70, 70, 240, 70, resolved_rtol=1e-2, abscissa_tol=1e-3),
-        2: MethodDefaults("fd", 70, 70, 240, 70, resolved_rtol=1e-2, abscissa_tol=1e-3),
+        1: MethodDefaults(
+            "fd", 70, 70, 240, 70, band_max=240, resolved_rtol=1e-2, abscissa_tol=1e-3
+        ),
+        2: MethodDefaults(
+            "fd", 70, 70, 240, 70, band_max=240, resolved_rtol=1e-2, abscissa_tol=1e-3
+        ),
     }
 )
 METHODS: Mapping[str, Mapping[int, MethodDefaults]] = MappingProxyType(
@@ -132,6 +145,18 @@ def defaults_for(method: str, order: int) -> MethodDefaults:
             f"unknown discretization method {method!r}; expected one of {tuple(METHODS)}"
         ) from None
     return table[min(max(int(order), 1), max(table))]
+
+
+def band_resolution(order: int, method: str, basis: str | None = None) -> int:
+    """Return the largest resolution the refinement reaches for a band short of the onset.
+
+    Forcing the plain Legendre basis on N >= 3 caps it as it caps the spectrum.
+    """
+    row = defaults_for(method, order)
+    top = spectrum_resolutions(order, method, basis)[1]
+    if basis == "legendre" and row.legendre_max is not None:
+        return top
+    return max(row.band_max, top)
 
 
 def spectrum_resolutions(order: int, method: str, basis: str | None = None) -> tuple[int, int]:

@@ -41,6 +41,7 @@ what it is.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -113,10 +114,12 @@ def in_band_unresolved(
     cluster: float = CLUSTER,
     kappa_min: float = KAPPA_MIN,
     scale: float = 1.0,
+    band_limit: float = math.inf,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Split the unresolved ``fine`` eigenvalues inside the resolved band.
 
-    The band is |λ| ≤ max |λ| over the resolved ones (indices ``tight``); unresolved
+    The band is |λ| ≤ max |λ| over the resolved ones (indices ``tight``), at most
+    ``band_limit``; unresolved
     eigenvalues above it are the high-frequency artefacts of the semi-discretization.
     Inside it, an eigenvalue within ``cluster * max(scale, |λ|)`` of another one, or with
     ``kappa > kappa_min``, is kept (module docstring); without ``kappa`` only clustering
@@ -131,7 +134,7 @@ def in_band_unresolved(
     empty = np.array([], dtype=int)
     if tight.size == 0:
         return empty, empty
-    band = np.max(np.abs(fine[tight]))
+    band = min(float(np.max(np.abs(fine[tight]))), band_limit)
     outside = ~np.isfinite(fine)
     outside[tight] = True
     rest = np.flatnonzero(~outside & (np.abs(np.where(outside, 0, fine)) <= band))
@@ -208,6 +211,19 @@ class PairSpectrum:
         lam = self.eigenvalues[self.resolved]
         return float(np.max(np.abs(lam))) if lam.size else 0.0
 
+    @property
+    def complete_band(self) -> float:
+        """Smallest modulus of an eigenvalue neither resolved nor kept (inf when none).
+
+        Every eigenvalue below it is accounted for.  The band above can be far larger: a
+        fast family resolved to high frequency beside a slow one that is not (the
+        Timoshenko beam's thickness-shear branch), so this, not :attr:`band`, says how
+        far the spectrum is known (:mod:`phdesign.numeric.branches`).
+        """
+        lam = self.eigenvalues
+        gaps = np.isfinite(lam) & ~(self.resolved | self.clustered)
+        return float(np.min(np.abs(lam[gaps]))) if gaps.any() else math.inf
+
 
 def pair_spectrum(
     fine: np.ndarray,
@@ -218,8 +234,14 @@ def pair_spectrum(
     scale: float,
     kappa: np.ndarray | None = None,
     dissipative: bool = False,
+    band_limit: float = math.inf,
 ) -> PairSpectrum:
     """Run the drift test between two resolutions (module docstring).
+
+    ``band_limit`` caps the resolved band inside which unresolved eigenvalues may be kept:
+    where a fast family is resolved far above the frequency a slow one can be at this
+    resolution (:meth:`phdesign.numeric.branches.Branches.resolvable_band`), the slow
+    family's unresolved modes in between are high frequencies, not a coalescence.
 
     ``dissipative=True`` states that every exact eigenvalue has Re λ <= 0, so that a
     positive computed real part counts as round-off (module docstring).
@@ -239,7 +261,9 @@ def pair_spectrum(
     # without condition numbers every in-band eigenvalue is kept: an upper bound that an
     # optimizer cannot exploit by driving eigenvalues into a cluster
     conservative = np.full(fine.shape, np.inf) if kappa is None else kappa
-    kept, artefacts = in_band_unresolved(fine, np.flatnonzero(resolved), conservative, scale=scale)
+    kept, artefacts = in_band_unresolved(
+        fine, np.flatnonzero(resolved), conservative, scale=scale, band_limit=band_limit
+    )
     clustered = np.zeros(fine.shape, dtype=bool)
     clustered[kept] = True
     discarded = np.zeros(fine.shape, dtype=bool)

@@ -42,20 +42,20 @@ from collections.abc import Iterable
 import numpy as np
 
 from phdesign.errors import NumericError
-from phdesign.numeric.abscissa import Abscissa, estimate_abscissa
+from phdesign.numeric.abscissa import Abscissa, estimate_abscissa, with_branches
+from phdesign.numeric.branches import Branches
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.discretize import discretize, feedback_matrix
+from phdesign.numeric.discretize import feedback_matrix
 from phdesign.numeric.drift import CLUSTER, PairSpectrum, pair_spectrum
-from phdesign.numeric.eigen import SHIFT, PreparedSystem, prepare, rescaled
-from phdesign.numeric.scales import dimensionless_model
+from phdesign.numeric.eigen import PreparedSystem, rescaled
+from phdesign.numeric.spectrum_refinement import (
+    Discretizations,
+    fine_resolution,
+    resolvable_band,
+)
 from phdesign.numeric.threads import small_dense_threads
 
 __all__ = ["AbscissaEvaluator", "default_tolerances", "fine_resolution"]
-
-
-def fine_resolution(p: int) -> int:
-    """Return the finer member ⌈1.5 p⌉ of the resolution pair started at ``p``."""
-    return math.ceil(1.5 * int(p))
 
 
 def default_tolerances(method: str) -> tuple[float, float]:
@@ -111,11 +111,11 @@ class AbscissaEvaluator:
         self.tol = default_tol if tol is None else float(tol)
         self.rtol_resolved = default_rtol if rtol_resolved is None else float(rtol_resolved)
         self.C_m = None if C_m is None else np.atleast_2d(np.asarray(C_m, dtype=float))
-        dimensionless, scales = dimensionless_model(nm)
-        self.scales = scales
+        self.discretizations = Discretizations(nm, method)
+        self.scales = self.discretizations.scales
         self.systems: tuple[PreparedSystem, PreparedSystem] = (
-            prepare(discretize(dimensionless, method, p), shift=SHIFT),
-            prepare(discretize(dimensionless, method, p_fine), shift=SHIFT),
+            self.discretizations(p),
+            self.discretizations(p_fine),
         )
         self.evaluations = 0
 
@@ -144,29 +144,42 @@ class AbscissaEvaluator:
         coarse = rescaled(self.systems[0].eigvals(K), rate)
         if condition:
             fine, kappa = self.systems[1].eigen_condition(K)
-            return self._pair(coarse, rescaled(fine, rate), kappa)
-        pair = self._pair(coarse, rescaled(self.systems[1].eigvals(K), rate), None)
+            return self._pair(coarse, rescaled(fine, rate), kappa, K)
+        pair = self._pair(coarse, rescaled(self.systems[1].eigvals(K), rate), None, K)
         if condition is None and _needs_condition(pair):
             fine, kappa = self.systems[1].eigen_condition(K)
-            pair = self._pair(coarse, rescaled(fine, rate), kappa)
+            pair = self._pair(coarse, rescaled(fine, rate), kappa, K)
         return pair
 
     def _pair(
-        self, coarse: np.ndarray, fine: np.ndarray, kappa: np.ndarray | None
+        self, coarse: np.ndarray, fine: np.ndarray, kappa: np.ndarray | None, K: np.ndarray | None
     ) -> PairSpectrum:
+        rate = self.scales.rate
         return pair_spectrum(
             fine,
             coarse,
             resolutions=self.resolutions,
             rtol=self.rtol_resolved,
-            scale=self.scales.rate,
+            scale=rate,
             kappa=kappa,
             dissipative=True,
+            band_limit=resolvable_band(
+                self.discretizations.branches(K), self.resolutions[1], rate
+            ),
         )
 
+    def branches(self, L: np.ndarray | None = None) -> Branches:
+        """Return the structure above the band at gain L (:mod:`phdesign.numeric.branches`)."""
+        return self.discretizations.branches(self.feedback(L))
+
     def abscissa(self, L: np.ndarray | None = None) -> Abscissa:
-        """Return the abscissa at gain L (:func:`phdesign.numeric.abscissa.estimate_abscissa`)."""
-        return estimate_abscissa(self.pair(L), self.tol)
+        """Return the abscissa at gain L (:mod:`phdesign.numeric.abscissa`, rules 1-6).
+
+        The chains' limits above the band count (rule 6): on a steel Timoshenko beam the
+        abscissa may lie on the thickness-shear branch, not among the bending modes.
+        """
+        pair = self.pair(L)
+        return with_branches(estimate_abscissa(pair, self.tol), pair, self.branches(L))
 
     def abscissas(self, gains: Iterable[np.ndarray]) -> np.ndarray:
         """Return the abscissas at many gains, on one BLAS thread (a gain map).

@@ -40,9 +40,10 @@ from dataclasses import replace
 import numpy as np
 
 from phdesign.errors import NumericError, check_shape
+from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.phs import DiscretePHS
 
-__all__ = ["close_plant_feedback", "close_ports"]
+__all__ = ["close_plant_feedback", "close_ports", "open_port_gain"]
 
 
 def close_ports(d: DiscretePHS, closed: Sequence[int], K: np.ndarray) -> DiscretePHS:
@@ -95,3 +96,28 @@ def close_plant_feedback(d: DiscretePHS) -> DiscretePHS:
     if feedback is None or d.n_ports == d.model.n_ports:
         return d
     return close_ports(d, feedback.closed, feedback.gain)
+
+
+def open_port_gain(nm: NumericModel, K: np.ndarray | None) -> np.ndarray:
+    """Gain on all N n open ports: the plant's own feedback and ``K`` on the external ones.
+
+    The loop is u = -K_full y on the open ports, so its boundary condition is
+    (U + K_full Y) v = 0.
+
+    Examples
+    --------
+    >>> from phdesign.models import load_builtin
+    >>> from phdesign.numeric.bridge import to_numeric
+    >>> open_port_gain(to_numeric(load_builtin("wave-damper")), np.array([[2.0]])).tolist()
+    [[2.0, 0.0], [0.0, 0.5]]
+    """
+    ports = nm.order * nm.size
+    full = np.zeros((ports, ports))
+    closed: list[int] = []
+    if nm.feedback is not None:
+        closed = [int(c) for c in nm.feedback.closed]
+        full[np.ix_(closed, closed)] = np.asarray(nm.feedback.gain, dtype=float)
+    if K is not None:
+        external = [j for j in range(ports) if j not in closed]
+        full[np.ix_(external, external)] = np.asarray(K, dtype=float)
+    return full

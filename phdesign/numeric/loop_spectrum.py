@@ -29,8 +29,10 @@ from typing import Any
 
 import numpy as np
 
+from phdesign.numeric.branches import Branches, merged_branches
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.discretize import discretize
+from phdesign.numeric.defaults import band_resolution
+from phdesign.numeric.discretize import discretize, feedback_matrix
 from phdesign.numeric.eigen import SHIFT, rescaled, shift_invert
 from phdesign.numeric.evaluator import default_tolerances
 from phdesign.numeric.loop import LoopSystem, NumericLoop, assemble
@@ -39,16 +41,17 @@ from phdesign.numeric.spectrum import (
     SpectrumReport,
     abscissa_digits,
     default_resolutions,
-    report_warnings,
     rightmost_indices,
     spectrum,
 )
 from phdesign.numeric.spectrum_refinement import (
+    Discretizations,
     PairResult,
     choose_pair,
     extinct_twice,
     refine,
 )
+from phdesign.numeric.spectrum_warnings import report_warnings, reported_value
 from phdesign.numeric.threads import small_dense_threads
 
 __all__ = ["AssembledLoopSolver", "LoopSpectrum", "loop_spectrum"]
@@ -68,6 +71,15 @@ class AssembledLoopSolver:
     def __init__(self, nm: NumericModel, loop: NumericLoop, *, method: str) -> None:
         self.dimensionless, self.scales = dimensionless_model(nm)
         self.rate = self.scales.rate
+        structure = Discretizations(nm, method)
+        m = nm.n_ports
+        S_a = loop.selection(m)
+        self.branches: Branches | None = merged_branches(
+            {
+                "controlled plant": structure.branches(S_a.T @ np.asarray(loop.K, float) @ S_a),
+                "error system": structure.branches(feedback_matrix(loop.C_m, loop.L, m)),
+            }
+        )
         self.loop, self.method = loop, method
         self.systems: dict[int, LoopSystem] = {}
         self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
@@ -348,7 +360,15 @@ def loop_spectrum(
     pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
     solver = AssembledLoopSolver(nm, loop, method=method)
     with small_dense_threads():
-        trail = refine(solver, start=p, stop=pmax, tol=tol, rtol_resolved=rtol_resolved)
+        band_stop = pmax if max_resolution is not None else band_resolution(nm.order, method)
+        trail = refine(
+            solver,
+            start=p,
+            stop=pmax,
+            tol=tol,
+            rtol_resolved=rtol_resolved,
+            band_stop=band_stop,
+        )
         chosen, notes = choose_pair(trail)
         blocks = solver.blocks(chosen.pair.resolutions[1])
     triangular = max(solver.systems[r].triangular_residual for r in chosen.pair.resolutions)
@@ -409,7 +429,8 @@ def _report(
             unbounded_below=extinct,
             warnings=warnings,
         )
-    own, ill, _ = report_warnings(chosen, a.value, a.uncertainty, a.attained, tol)
+    own, ill, no_decay = report_warnings(chosen, a.value, a.uncertainty, a.attained, tol)
+    value, uncertainty = reported_value(a.value, a.uncertainty, no_decay)
     warnings += [f"loop: {w}" for w in notes + own]
     lam = pair.eigenvalues
     top = rightmost_indices(chosen, count)
@@ -422,16 +443,16 @@ def _report(
     )
     gap = None
     if slower is not None and slower.spectral_abscissa is not None:
-        gap = a.value - slower.spectral_abscissa
-        scale = max(pair.scale, abs(a.value))
-        allowed = max(10.0 * (a.uncertainty + (slower.uncertainty or 0.0)), 1e-8 * scale)
+        gap = value - slower.spectral_abscissa
+        scale = max(pair.scale, abs(value))
+        allowed = max(10.0 * (uncertainty + (slower.uncertainty or 0.0)), 1e-8 * scale)
         if abs(gap) > allowed:
             warnings.append(
                 f"the loop's abscissa differs from max(plant, error) by {gap:.2g}, beyond its "
                 "resolved digits: the separation structure is not reproduced (report this)"
             )
     return report(
-        spectral_abscissa=float(a.value),
+        spectral_abscissa=value,
         converged=chosen.converged,
         digits=abscissa_digits(chosen),
         rightmost=rightmost,
@@ -441,5 +462,5 @@ def _report(
         separation_gap=gap,
         ill_conditioned=ill,
         warnings=warnings,
-        uncertainty=float(a.uncertainty),
+        uncertainty=uncertainty,
     )

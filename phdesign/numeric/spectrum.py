@@ -63,7 +63,7 @@ from phdesign.errors import NumericError
 from phdesign.numeric.abscissa import estimate_abscissa
 from phdesign.numeric.arguments import check_spectrum_arguments
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.defaults import spectrum_resolutions
+from phdesign.numeric.defaults import band_resolution, spectrum_resolutions
 from phdesign.numeric.discretize import feedback_matrix
 from phdesign.numeric.drift import in_band_unresolved, match_resolved, pair_spectrum
 from phdesign.numeric.eigen import prepare
@@ -71,7 +71,6 @@ from phdesign.numeric.evaluator import default_tolerances
 from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.scales import ProblemScales
 from phdesign.numeric.spectrum_refinement import (
-    ILL_CONDITION,
     ClosedLoopSolver,
     Discretizations,
     PairResult,
@@ -80,6 +79,7 @@ from phdesign.numeric.spectrum_refinement import (
     refine,
 )
 from phdesign.numeric.spectrum_report import SpectrumReport
+from phdesign.numeric.spectrum_warnings import report_warnings, reported_value, rightmost_order
 from phdesign.numeric.threads import small_dense_threads
 
 __all__ = [
@@ -97,8 +97,6 @@ __all__ = [
     "rightmost_indices",
     "spectrum",
 ]
-
-ILL_GAP = 1e-3  # relative gap to the nearest other eigenvalue below which it is ill-posed
 
 
 def eigen(
@@ -162,15 +160,11 @@ def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
     return spectrum_resolutions(nm.order, method)
 
 
-def _rightmost_order(lam: np.ndarray) -> np.ndarray:
-    return np.lexsort((np.abs(lam.imag), -np.round(lam.real, 12)))
-
-
 def rightmost_indices(chosen: PairResult, count: int) -> np.ndarray:
     """Return the indices (into the pair's eigenvalues) of the ``count`` rightmost counted."""
     lam = chosen.pair.eigenvalues
     counted = np.flatnonzero(chosen.abscissa.counted)
-    return counted[_rightmost_order(lam[counted])[:count]]
+    return counted[rightmost_order(lam[counted])[:count]]
 
 
 def abscissa_digits(chosen: PairResult) -> float:
@@ -180,89 +174,6 @@ def abscissa_digits(chosen: PairResult) -> float:
         raise NumericError("the pair has no abscissa: no digits")
     scale = max(chosen.pair.scale, abs(a.value))
     return -math.log10(max(a.uncertainty, np.finfo(float).eps * scale) / scale)
-
-
-def report_warnings(
-    chosen: PairResult, value: float, uncertainty: float, attained: float, tol: float
-) -> tuple[list[str], bool, bool]:
-    """Stage 3: warnings for the chosen pair; also (ill_conditioned, no_decay).
-
-    ``value``, ``uncertainty`` and ``attained`` are the chosen pair's abscissa.
-    """
-    pair, a = chosen.pair, chosen.abscissa
-    lam, s = pair.eigenvalues, pair.scale
-    warnings: list[str] = []
-    limit = a.limit
-    if limit is not None and a.kind == "limit":
-        warnings.append(
-            f"the real parts of the resolved eigenvalues keep rising with frequency (to "
-            f"{limit.top_real:.6g} at |λ| = {limit.top_frequency:.3g}): the abscissa is their "
-            f"limit, extrapolated from {limit.modes} modes as α∞ − c|λ|^-{limit.exponent:.2g}; "
-            "no mode attains it"
-        )
-    elif limit is not None and limit.value + limit.uncertainty > attained:
-        warnings.append(
-            f"the real parts rise with frequency toward {limit.value:.6g} ± "
-            f"{limit.uncertainty:.2g} at the top of the resolved band: the abscissa may be a "
-            "limit that no mode attains"
-        )
-    no_decay = value + uncertainty >= 0.0
-    if no_decay:
-        warnings.append(
-            "no exponential decay found: the abscissa is 0 within its accuracy"
-            + (
-                " (the real parts approach 0 at high frequency: no uniform decay)"
-                if limit is not None and a.kind == "limit"
-                else ""
-            )
-        )
-    counted = np.flatnonzero(a.counted)
-    lead_index = counted[_rightmost_order(lam[counted])[0]]
-    lead = lam[lead_index]
-    kappa = pair.condition
-    cond = float(kappa[lead_index]) if kappa is not None else 1.0
-    others = lam[np.isfinite(lam) & (np.arange(lam.size) != lead_index)]
-    gap = float(np.min(np.abs(others - lead))) / max(s, abs(lead)) if others.size else np.inf
-    # at the top of a band of rising real parts the "rightmost" mode is just the last one
-    ill = a.kind != "limit" and bool(
-        cond > ILL_CONDITION or gap < ILL_GAP or pair.clustered[lead_index]
-    )
-    if ill:
-        warnings.append(
-            f"the rightmost eigenvalue {lead:.6g} is ill-conditioned (condition number "
-            f"{cond:.3g}, relative gap to its nearest neighbour {gap:.2g}): near a "
-            "coalescence of eigenvalues (e.g. a critically damped gain); few digits are reliable"
-        )
-    if a.loose_right.any():
-        loose = np.flatnonzero(a.loose_right)
-        worst = loose[np.argmax(lam.real[loose])]
-        warnings.append(
-            f"{loose.size} resolved eigenvalues lie right of the abscissa by no more than their "
-            f"own accuracy (max Re {lam.real[worst]:.3g} ± {pair.uncertainty[worst]:.2g} at "
-            f"|λ| = {abs(lam[worst]):.3g}): their real parts are not resolved to {tol:g}, "
-            "so they do not count"
-        )
-    artefacts = np.flatnonzero(pair.artefacts & (lam.real > attained))
-    if artefacts.size:
-        warnings.append(
-            f"{artefacts.size} isolated, well-conditioned eigenvalues in the resolved band do "
-            f"not reproduce under refinement (max Re {float(np.max(lam.real[artefacts])):.3g}); "
-            "discarded as round-off artefacts"
-        )
-    rest = ~(pair.resolved | pair.clustered | pair.artefacts) & np.isfinite(lam)
-    right = np.flatnonzero(rest & (lam.real > attained + 1e-9 * max(s, abs(attained))))
-    if right.size:
-        warnings.append(
-            f"{right.size} unresolved eigenvalues lie to the right of the abscissa (max Re "
-            f"{float(np.max(lam.real[right])):.3g}), all above the resolved frequency band "
-            f"(|λ| > {pair.band:.3g}): unresolved high frequencies, discarded"
-        )
-    if not chosen.converged:
-        warnings.append(
-            f"the spectral abscissa did not converge to {tol:g} (relative to the rate "
-            f"{s:.3g}): {chosen.reason}"
-        )
-    return warnings, ill, no_decay
 
 
 def _unresolved_report(
@@ -383,12 +294,21 @@ def spectrum(
     p0, pmax = spectrum_resolutions(nm.order, method, basis)
     p = int(resolution) if resolution is not None else p0
     pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
+    # a band short of the onset of the principal part refines further, within the user's cap
+    band_stop = pmax if max_resolution is not None else band_resolution(nm.order, method, basis)
     system = "plant (u = 0)" if K is None else "observer error system"
     with small_dense_threads():
         solver = ClosedLoopSolver(
             nm, K, method=method, basis=basis, discretizations=discretizations
         )
-        trail = refine(solver, start=p, stop=pmax, tol=tol, rtol_resolved=rtol_resolved)
+        trail = refine(
+            solver,
+            start=p,
+            stop=pmax,
+            tol=tol,
+            rtol_resolved=rtol_resolved,
+            band_stop=band_stop,
+        )
     scales = solver.scales
     sensors = None if C_m is None else np.atleast_2d(np.asarray(C_m, float)).tolist()
     gain = None if L is None else np.atleast_2d(np.asarray(L, float)).tolist()
@@ -397,15 +317,18 @@ def spectrum(
     if a.value is None or a.uncertainty is None or a.attained is None:
         return _unresolved_report(trail, method, system, nm.name, scales, sensors, gain)
     warnings, ill, no_decay = report_warnings(chosen, a.value, a.uncertainty, a.attained, tol)
+    value, uncertainty = reported_value(a.value, a.uncertainty, no_decay)
+    lower_bound = a.kind == "lower bound"
     lam = pair.eigenvalues
     top = rightmost_indices(chosen, count)
     kappa = pair.condition if pair.condition is not None else np.ones(lam.shape)
-    digits = abscissa_digits(chosen)
+    scale = max(pair.scale, abs(value))
+    digits = -math.log10(max(uncertainty, np.finfo(float).eps * scale) / scale)
     return SpectrumReport(
-        spectral_abscissa=float(a.value),
+        spectral_abscissa=value,
         rightmost=[complex(z) for z in lam[top]],
         converged=chosen.converged,
-        digits=float(digits),
+        digits=None if lower_bound else float(digits),
         n_resolved=pair.n_resolved,
         n_total=int(lam.size),
         resolutions=pair.resolutions,
@@ -418,7 +341,7 @@ def spectrum(
         history=tuple(r.step() for r in trail),
         warnings=notes + warnings,
         model=nm.name,
-        uncertainty=float(a.uncertainty),
+        uncertainty=None if lower_bound else uncertainty,
         kind=a.kind,
         no_decay=no_decay,
         rate_scale=scales.rate,
@@ -426,4 +349,6 @@ def spectrum(
         resolved=pair.resolved,
         sensors=sensors,
         gain=gain,
+        branches=a.branches,
+        complete_band=pair.complete_band,
     )

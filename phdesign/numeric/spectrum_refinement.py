@@ -21,18 +21,27 @@ pair contradicts, unless an earlier pair's resolved abscissa lies clearly to the
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
 from phdesign.errors import NumericError
-from phdesign.numeric.abscissa import MIN_MODES_ABOVE, Abscissa, estimate_abscissa
+from phdesign.numeric.abscissa import (
+    MIN_MODES_ABOVE,
+    Abscissa,
+    estimate_abscissa,
+    with_branches,
+)
+from phdesign.numeric.branches import ONSET_MARGIN, Branches
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.characteristics import CharacteristicForm, characteristic_form
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.drift import PairSpectrum, pair_spectrum
 from phdesign.numeric.eigen import SHIFT, PreparedSystem, prepare, rescaled
-from phdesign.numeric.evaluator import fine_resolution
+from phdesign.numeric.feedback import open_port_gain
+from phdesign.numeric.principal_symbol import PrincipalForm, principal_form
 from phdesign.numeric.scales import dimensionless_model
 from phdesign.numeric.spectrum_report import RefinementStep
 
@@ -45,10 +54,24 @@ __all__ = [
     "choose_pair",
     "convergence_rule",
     "extinct_twice",
+    "fine_resolution",
     "refine",
+    "resolvable_band",
 ]
 
 ILL_CONDITION = 1e4  # energy-norm condition number of an ill-conditioned rightmost eigenvalue
+
+_GAINS_KEPT = 64  # structures above the band kept per model (one per gain)
+#: The structure above the band of each live model: (model, its form, structure by gain).
+_STRUCTURES: dict[
+    int,
+    tuple[weakref.ref[NumericModel], CharacteristicForm | PrincipalForm, dict[bytes, Branches]],
+] = {}
+
+
+def fine_resolution(p: int) -> int:
+    """Return the finer member ⌈1.5 p⌉ of the resolution pair started at ``p``."""
+    return math.ceil(1.5 * int(p))
 
 
 @dataclass(frozen=True)
@@ -94,6 +117,20 @@ class PairResult:
 
 def convergence_rule(pair: PairSpectrum, a: Abscissa, tol: float) -> str:
     """Return why the pair is not converged, or "" when it is (module docstring)."""
+    if a.band_short(pair):
+        assert a.branches is not None  # band_short says so
+        return (
+            f"not every eigenvalue up to |λ| = {a.branches.required_band:.3g} "
+            f"({ONSET_MARGIN:g} × the onset {a.branches.onset:.3g} of the principal part) is "
+            f"resolved: the first unresolved one lies at |λ| = {pair.complete_band:.3g}, and "
+            "a branch of the spectrum may start above it"
+        )
+    if a.kind == "limit" and a.branch is not None:
+        return (
+            ""
+            if a.uncertainty is not None and a.uncertainty <= _accuracy(pair, a, tol)
+            else (f"the chains' limit is known to {a.uncertainty:.2g} only")
+        )
     if a.kind == "limit":
         return "the real parts keep rising with frequency (the abscissa is a limit)"
     if a.value is None or a.index is None or a.uncertainty is None:
@@ -122,6 +159,11 @@ def convergence_rule(pair: PairSpectrum, a: Abscissa, tol: float) -> str:
     return ""
 
 
+def _accuracy(pair: PairSpectrum, a: Abscissa, tol: float) -> float:
+    """Return the accuracy a converged abscissa needs: tol max(rate, |α|)."""
+    return tol * max(pair.scale, abs(a.value or 0.0))
+
+
 class ResolutionSolver(Protocol):
     """What :func:`refine` needs: the eigenvalues of the problem at a resolution.
 
@@ -131,10 +173,13 @@ class ResolutionSolver(Protocol):
         The problem's rate s (:mod:`phdesign.numeric.scales`): the drift test's scale.
     dissipative : bool
         Every exact eigenvalue has Re λ <= 0 (:mod:`phdesign.numeric.drift`).
+    branches : Branches or None
+        The structure above the band (:mod:`phdesign.numeric.branches`).
     """
 
     rate: float
     dissipative: bool
+    branches: Branches | None
 
     def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
         """Eigenvalues (in the model's units) and energy-norm condition numbers at p."""
@@ -160,6 +205,30 @@ class Discretizations:
         self.model, self.method, self.basis = nm, method, basis
         self.dimensionless, self.scales = dimensionless_model(nm)
         self._cache: dict[int, PreparedSystem] = {}
+
+    def branches(self, K: np.ndarray | None) -> Branches:
+        """Return the structure above the band of the loop ũ = −Kỹ (K on the external ports).
+
+        It depends on the model and the gain only: it is kept for the model's lifetime
+        (:data:`_STRUCTURES`), the gain-independent characteristic form once, the last
+        :data:`_GAINS_KEPT` gains' structures beside it.
+        """
+        entry = _STRUCTURES.get(id(self.model))
+        if entry is None or entry[0]() is not self.model:
+            nd = self.dimensionless
+            form = characteristic_form(nd) if nd.order == 1 else principal_form(nd)
+            entry = (weakref.ref(self.model), form, {})
+            _STRUCTURES[id(self.model)] = entry
+            weakref.finalize(self.model, _STRUCTURES.pop, id(self.model), None)
+        _, form, by_gain = entry
+        key = b"" if K is None else np.ascontiguousarray(K, dtype=float).tobytes()
+        if key not in by_gain:
+            nd, sc = self.dimensionless, self.scales
+            W = nd.U + open_port_gain(nd, K) @ nd.Y
+            if len(by_gain) >= _GAINS_KEPT:
+                by_gain.pop(next(iter(by_gain)))
+            by_gain[key] = form.at(W, sc.rate, sc.length)
+        return by_gain[key]
 
     def serves(self, nm: NumericModel, method: str, basis: str | None) -> bool:
         """Tell whether these discretizations are those of ``nm`` by ``method`` and ``basis``."""
@@ -213,6 +282,7 @@ class ClosedLoopSolver:
             )
         self.discretizations, self.scales, self.K = discretizations, discretizations.scales, K
         self.rate = self.scales.rate
+        self.branches: Branches | None = discretizations.branches(K)
         self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
@@ -224,14 +294,24 @@ class ClosedLoopSolver:
 
 
 def refine(
-    solver: ResolutionSolver, *, start: int, stop: int, tol: float, rtol_resolved: float
+    solver: ResolutionSolver,
+    *,
+    start: int,
+    stop: int,
+    tol: float,
+    rtol_resolved: float,
+    band_stop: int | None = None,
 ) -> list[PairResult]:
     """Stage 1: pairs (p, ⌈1.5 p⌉) from ``start`` until one converges or p_fine >= ``stop``.
 
-    ``solver(p)`` gives the eigenvalues and condition numbers at resolution p.
+    ``solver(p)`` gives the eigenvalues and condition numbers at resolution p.  While the
+    band does not reach the onset of the principal part (:mod:`phdesign.numeric.branches`),
+    the refinement goes on up to ``band_stop`` (default ``stop``), jumping to the
+    resolution the slowest family needs.
     """
     trail: list[PairResult] = []
     p = int(start)
+    band_stop = stop if band_stop is None else max(int(band_stop), stop)
     while True:
         p_fine = fine_resolution(p)
         coarse, _ = solver(p)
@@ -244,14 +324,38 @@ def refine(
             scale=solver.rate,
             kappa=kappa,
             dissipative=solver.dissipative,
+            band_limit=resolvable_band(solver.branches, p_fine, solver.rate),
         )
-        a = estimate_abscissa(pair, tol)
+        a = with_branches(estimate_abscissa(pair, tol), pair, solver.branches)
         reason = convergence_rule(pair, a, tol)
         trail.append(PairResult(pair, a, not reason, reason))
-        settled = _degrading(trail) or _limit_settled(trail) or extinct_twice(trail)
-        if not reason or p_fine >= stop or settled:
+        short = a.band_short(pair)
+        settled = not short and (_degrading(trail) or _limit_settled(trail))
+        if (
+            not reason
+            or p_fine >= (band_stop if short else stop)
+            or settled
+            or extinct_twice(trail)
+        ):
             return trail
-        p = p_fine
+        p = _next_resolution(p_fine, a, solver.rate, band_stop) if short else p_fine
+
+
+def resolvable_band(branches: Branches | None, resolution: int, rate: float) -> float:
+    """Return the band the slowest family can reach at ``resolution`` (inf: no structure)."""
+    return math.inf if branches is None else branches.resolvable_band(resolution, rate)
+
+
+def _next_resolution(p_fine: int, a: Abscissa, rate: float, band_stop: int) -> int:
+    """Return the next coarse resolution: the finer one, or one whose band reaches the onset.
+
+    The finer member of the next pair should resolve the required band
+    (:meth:`~phdesign.numeric.branches.Branches.resolution_for`), within ``band_stop``.
+    """
+    assert a.branches is not None  # called for a short band only
+    needed = a.branches.resolution_for(a.branches.required_band, rate)
+    jump = math.ceil(min(needed, band_stop) / 1.5)
+    return max(p_fine, jump)
 
 
 def extinct_twice(trail: list[PairResult]) -> bool:

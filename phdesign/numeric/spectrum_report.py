@@ -20,6 +20,8 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
+    from phdesign.numeric.branches import Branches
+
 __all__ = ["RefinementStep", "SpectrumReport", "finite_or_none", "html_rows"]
 
 
@@ -144,6 +146,11 @@ class SpectrumReport:
         Mask of the resolved ones.
     sensors, gain : list of list of float or None
         C_m and L of the error system (None for the plant).
+    branches : Branches or None
+        The structure above the band (:mod:`phdesign.numeric.branches`): the families of
+        the principal part, its onset and the chains' limits.
+    complete_band : float or None
+        Every eigenvalue up to this modulus is resolved (``inf``: all of them).
     """
 
     spectral_abscissa: float | None
@@ -170,6 +177,8 @@ class SpectrumReport:
     resolved: np.ndarray = field(default_factory=lambda: np.zeros(0, bool), repr=False)
     sensors: list[list[float]] | None = None
     gain: list[list[float]] | None = None
+    branches: Branches | None = None
+    complete_band: float | None = None
 
     # -- text -------------------------------------------------------------------------
 
@@ -181,6 +190,8 @@ class SpectrumReport:
             top = self.resolutions[1]
             return f"not resolved at these resolutions (up to {top})"
         text = f"{self.spectral_abscissa:.12g}"
+        if self.kind == "lower bound":
+            return f">= {text} (a lower bound: the band does not reach the onset)"
         if self.uncertainty is not None:
             text += f" ± {self.uncertainty:.2g}"
         if self.kind == "limit":
@@ -194,7 +205,8 @@ class SpectrumReport:
             lines.append(f"sensors C_m = {self.sensors}   gain L = {self.gain}")
         line = f"spectral abscissa: {self.abscissa_text()}"
         if self.spectral_abscissa is not None:
-            line += f"   converged: {self.converged}   digits: {self.digits:.1f}"
+            digits = "—" if self.digits is None else f"{self.digits:.1f}"
+            line += f"   converged: {self.converged}   digits: {digits}"
         line += (
             f"   resolved: {self.n_resolved}/{self.n_total} "
             f"at resolutions {self.resolutions[0]}, {self.resolutions[1]}"
@@ -256,6 +268,8 @@ class SpectrumReport:
             "resolved": [bool(r) for r in self.resolved],
             "sensors": self.sensors,
             "gain": self.gain,
+            "complete_band": finite_or_none(self.complete_band),
+            "branches": None if self.branches is None else self.branches.to_dict(),
         }
 
     def plot(

@@ -174,14 +174,22 @@ def _bounded(v: float, penalty: float) -> float:
 def _search_pair(
     nm: NumericModel, C: np.ndarray, L0: np.ndarray, verify: int, method: str
 ) -> tuple[AbscissaEvaluator, AbscissaEvaluator]:
-    """Return the cheapest search evaluator that agrees with the verification one, and it."""
+    """Return the cheapest search evaluator that agrees with the verification one, and it.
+
+    A pair whose band stops below the onset of the principal part while the verification
+    pair's does not (:mod:`phdesign.numeric.branches`) is not a search pair, whatever it
+    gives at the starting gain: a branch may start above its band.
+    """
     ev_verify = AbscissaEvaluator(nm, C, verify, method=method)
     target = ev_verify(L0)
+    seen = ev_verify.abscissa(L0).kind != "lower bound"
     for fraction in (0.5, 0.6, 0.75):
         p = max(nm.order + 2, math.ceil(fraction * verify))
         if p >= verify:
             break
         ev = AbscissaEvaluator(nm, C, p, method=method)
+        if seen and ev.abscissa(L0).kind == "lower bound":
+            continue  # its band stops below a branch the verification pair sees
         v = ev(L0)
         same = (math.isnan(v) and math.isnan(target)) or v == target
         scale = max(ev.scales.rate, abs(target)) if math.isfinite(target) else 1.0
