@@ -82,6 +82,7 @@ NOISE = "noise euler-bernoulli --sensors 3,4 --gain 0.1,1"
 TRADE = "tradeoff euler-bernoulli --sensors 3,4"
 TUNE_BEAM = "tune euler-bernoulli --sensors 3,4"
 EXPORT = "export euler-bernoulli --sensors 3,4 --gain 0.1,1 --format json"
+EXPORT_C = "export wave --sensors 2 --gain 1 --dt 1e-3 --format c"
 SWEEP = "sweep wave --sensors 2 --scheduler synchronous -o {tmp}/m.zarr"
 MAP = "sweep wave --sensors 2 --grid l1=0.1:1:3 --scheduler synchronous"
 COMMAND_ROWS = [
@@ -376,15 +377,40 @@ COMMAND_ROWS = [
     ),
     row(
         "export wave --sensors 2 --gain 1 --dt 1e-3 --format c -o {tmp}",
-        "output folder .* exists; pass --force to replace it",
+        "output folder .* exists and is not an export of phdesign: it holds no marker "
+        r"\.phdesign-export",
         OutputFileError,
     ),
     row(
         "export wave --sensors 2 --gain 1 --dt 1e-3 --format c -o {tmp}/obs",
-        "is a file; --format c writes a folder",
+        "is a file; format 'c' writes a folder",
         OutputFileError,
         obs="a file",
     ),
+    # ---- issue 30: --force replaces only an export phdesign wrote (a user's folder survives)
+    row(
+        f"{EXPORT_C} -o {{tmp}} --force",
+        "is not an export of phdesign: it holds no marker .*--force replaces only a folder "
+        "phdesign wrote",
+        OutputFileError,
+        **{"precious.txt": "mine"},
+    ),
+    row(f"{EXPORT_C} -o . --force", "output path '.' names no folder", OutputFileError),
+    row(f"{EXPORT_C} -o {{tmp}}/.. --force", "names no folder", OutputFileError),
+    row(
+        f"{EXPORT_C} -o {{tmp}}/link --force",
+        "is a symbolic link; format 'c' writes a folder, and replaces only a folder it "
+        "wrote, even with --force",
+        OutputFileError,
+        link="symlink:.",
+    ),
+    row(
+        f"{EXPORT_C} -o {{tmp}}/fifo --force",
+        "is a FIFO; format 'c'",
+        OutputFileError,
+        fifo="fifo:",
+    ),
+    row(f"{EXPORT_C} -o /dev/null --force", "is a device; format 'c'", OutputFileError),
     row(f"{EXPORT} --dt 1e-3 -o {{tmp}}/none/o.json", "none' does not exist", OutputFileError),
     row(
         f"{EXPORT} --dt 1e-3 -o /proc/phdesign-export.json",

@@ -79,7 +79,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     ex.add_argument(
         "--output", "-o", required=True, metavar="PATH", help="file (a folder for --format c)"
     )
-    ex.add_argument("--force", action="store_true", help="replace an existing output")
+    ex.add_argument(
+        "--force",
+        action="store_true",
+        help="replace an existing output that phdesign wrote (a C folder only while it holds "
+        "exactly the files of its marker .phdesign-export)",
+    )
     ex.add_argument(
         "--verify",
         action="store_true",

@@ -7,7 +7,8 @@ significant digits, which reproduces every double exactly.
 
 Every export is all or nothing: a single file goes through
 :func:`phdesign.io.atomic_write`; the C folder is written into a temporary folder next to
-the target and renamed into place (:func:`write_directory`).
+the target and renamed into place (:func:`write_directory`), and ``force`` replaces only a
+folder that phdesign wrote (:mod:`phdesign.codegen.folder`).
 """
 
 from __future__ import annotations
@@ -15,14 +16,13 @@ from __future__ import annotations
 import io
 import json
 import os
-import shutil
 import tempfile
-from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from phdesign.codegen.folder import MARKER, check_export_folder, write_directory
 from phdesign.errors import NumericError, OutputFileError
 
 if TYPE_CHECKING:
@@ -30,6 +30,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FORMATS",
+    "MARKER",
     "check_export_path",
     "render_c",
     "render_statespace",
@@ -52,71 +53,24 @@ def check_export_path(path: str | os.PathLike[str], format: str, force: bool = F
     ------
     OutputFileError
         If the path exists and ``force`` is false, has the wrong kind (a file where the C
-        folder goes, a folder where a file goes), or its folder is missing or not writable.
+        folder goes, a folder where a file goes, a symbolic link, a FIFO, a device), is a
+        folder phdesign did not write (:func:`~phdesign.codegen.folder.check_export_folder`),
+        or its folder is missing or not writable.
     """
     if format not in FORMATS:
         raise NumericError(f"unknown export format {format!r}; expected one of {FORMATS}")
-    target = Path(path)
-    if format != "c":
+    if format == "c":
+        target, _ = check_export_folder(path, force)
+    else:
         from phdesign.io import check_output_path
 
-        check_output_path(target, force)
-    elif target.exists() and not target.is_dir():
-        raise OutputFileError(f"output path {str(target)!r} is a file; --format c writes a folder")
-    elif target.exists() and not force:
-        raise OutputFileError(f"output folder {str(target)!r} exists; pass --force to replace it")
-    elif not target.parent.is_dir():
-        raise OutputFileError(
-            f"cannot write {str(target)!r}: folder {str(target.parent)!r} does not exist"
-        )
+        target = check_output_path(path, force)
     try:
         with tempfile.TemporaryFile(dir=target.parent):
             pass
     except OSError as error:
         raise OutputFileError(f"cannot write {str(target)!r}: {error.strerror}") from None
     return target
-
-
-def write_directory(
-    path: str | os.PathLike[str], files: Mapping[str, str | bytes], force: bool = False
-) -> None:
-    """Write ``files`` (name → content) as the folder ``path``: all of them or none.
-
-    They are written into a temporary folder next to ``path``, which is then renamed to
-    ``path``; an existing folder (``force``) is first renamed aside and removed last, and
-    put back if the final rename fails.
-    """
-    target = check_export_path(path, "c", force)
-    try:
-        staging = Path(
-            tempfile.mkdtemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-        )
-    except OSError as error:
-        raise OutputFileError(f"cannot write {str(target)!r}: {error.strerror}") from None
-    aside: Path | None = None
-    try:
-        for name, content in files.items():
-            data = content.encode("utf-8") if isinstance(content, str) else content
-            (staging / name).write_bytes(data)
-        umask = os.umask(0)
-        os.umask(umask)
-        staging.chmod(0o777 & ~umask)  # mkdtemp creates 0700
-        if target.exists():
-            aside = Path(tempfile.mkdtemp(dir=target.parent, prefix=f".{target.name}.old."))
-            aside.rmdir()
-            target.rename(aside)
-        try:
-            staging.rename(target)
-        except OSError:
-            if aside is not None:
-                aside.rename(target)
-                aside = None
-            raise
-    except OSError as error:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise OutputFileError(f"cannot write {str(target)!r}: {error.strerror}") from None
-    if aside is not None:
-        shutil.rmtree(aside, ignore_errors=True)
 
 
 def _double(value: float) -> str:
@@ -250,9 +204,7 @@ def write_observer(
     if not all(np.all(np.isfinite(m)) for m in matrices):
         raise NumericError("the observer's matrices are not finite: nothing was written")
     if format == "c":
-        files = render_c(observer)
-        write_directory(target, files, force=force)
-        return [str(target / name) for name in files]
+        return write_directory(target, render_c(observer), force=force)
     if format == "json":
         data: str | bytes = json.dumps(observer.to_dict(), allow_nan=False) + "\n"
     elif format == "npz":

@@ -188,7 +188,9 @@ class SampledObserver:
 
         ``json``, ``npz`` and ``statespace`` (a Python module that rebuilds the
         ``control.StateSpace``) write one file; ``c`` writes a folder holding
-        ``observer.h`` and ``observer.c``, all files or none.
+        ``observer.h``, ``observer.c`` and the marker ``.phdesign-export``, all files or
+        none. ``force`` replaces a file, or a folder phdesign wrote and nothing else
+        (:mod:`phdesign.codegen.folder`).
         """
         from phdesign.codegen import write_observer
 
