@@ -429,7 +429,18 @@ COMMAND_ROWS = [
     ),
     row(
         f"{EXPORT} --dt 1e-3 --at 2 -o {{tmp}}/o.json",
-        r"--at: expected numbers in \[0, 1\]; found '2'",
+        r"--at: expected numbers in \[0, 1\]; found 2$",
+        NumericError,
+    ),
+    # ---- issue 30: two points, one output name
+    row(
+        f"{EXPORT} --dt 1e-3 --at 1,1 -o {{tmp}}/o.json",
+        r"--at: 1.0 and 1.0 both give the output w\(1\); expected distinct points",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --at 0.5,1,0.5000001 -o {{tmp}}/o.json",
+        r"--at: 0.5 and 0.5000001 both give the output w\(0.5\)",
         NumericError,
     ),
     row(

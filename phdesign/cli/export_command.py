@@ -125,24 +125,21 @@ def _finite_positive(name: str, value: float) -> float:
 
 
 def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
-    """Parse ``--at``: numbers in the interval, for a model with a displacement."""
+    """Parse ``--at`` (numbers; their checks are the library's)."""
     if text is None:
         return None
-    if nm.displacement is None:
-        raise NumericError(f"--at: model {nm.name!r} has no displacement")
+    from phdesign.numeric.sampled import displacement_points
+
     a, b = nm.interval
     points = []
     for item in text.split(","):
         try:
-            z = float(item)
+            points.append(float(item))
         except ValueError:
             raise NumericError(
                 f"--at: expected numbers in [{a:g}, {b:g}]; found {item!r}"
             ) from None
-        if not (math.isfinite(z) and a <= z <= b):
-            raise NumericError(f"--at: expected numbers in [{a:g}, {b:g}]; found {item!r}")
-        points.append(z)
-    return tuple(points)
+    return displacement_points(nm, points, "--at")
 
 
 def _export(args: argparse.Namespace) -> int:

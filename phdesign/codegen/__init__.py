@@ -32,6 +32,7 @@ __all__ = [
     "FORMATS",
     "MARKER",
     "check_export_path",
+    "escaped",
     "render_c",
     "render_statespace",
     "write_directory",
@@ -79,14 +80,36 @@ def _double(value: float) -> str:
     return text if any(c in text for c in ".en") else text + ".0"
 
 
-def _safe(text: str) -> str:
-    """Text that cannot close a C comment or a Python docstring."""
-    return (
-        "".join(c if c.isprintable() else " " for c in text)
-        .replace("*/", "* /")
-        .replace('"""', "'''")
-        .replace("\\", "/")
-    )
+def escaped(text: str) -> str:
+    r"""Return ``text`` as it may stand in a C comment and in a Python docstring or comment.
+
+    Text from a model (its name) or from a caller (a file name, a signal label) reaches the
+    generated sources only through here. The result is one line of printable ASCII in
+    which no C comment opens or closes (``/*``, ``*/``), no trigraph forms (``??/`` is a
+    backslash in C99) and no quote can end a docstring; every character that would is
+    written as a Python escape sequence, so that the docstring reads back the text exactly.
+
+    Examples
+    --------
+    >>> print(escaped('beam */ #include "x" ??/ é\n'))
+    beam *\x2f #include \"x\" ?\x3f/ \xe9\n
+    """
+    out = []
+    for i, char in enumerate(text):
+        # at either end the template's next character is unknown: count it as a '*'
+        before = text[i - 1] if i else "*"
+        after = text[i + 1] if i + 1 < len(text) else "*"
+        if char in '\\"':
+            out.append("\\" + char)
+        elif char == "/" and "*" in (before, after):
+            out.append("\\x2f")
+        elif char == "?" and before == "?":
+            out.append("\\x3f")
+        elif char.isascii() and char.isprintable():
+            out.append(char)
+        else:
+            out.append(ascii(char)[1:-1])  # \n, \x00, \xe9, \u2028, \U0001f600
+    return "".join(out)
 
 
 def _environment() -> Any:
@@ -111,7 +134,9 @@ def _context(observer: SampledObserver, filename: str = "observer.py") -> dict[s
     from phdesign import __version__
 
     states = [f"xhat{i + 1}" for i in range(observer.order)]
-    inputs, outputs = list(observer.inputs), list(observer.outputs)
+    inputs = [escaped(name) for name in observer.inputs]  # as comments show them
+    outputs = [escaped(name) for name in observer.outputs]
+    signals = observer.signal_names()
     meaning = {
         "A": "state update, x[k+1] = A x[k] + B v[k]",
         "B": "input map of the state update",
@@ -143,18 +168,22 @@ def _context(observer: SampledObserver, filename: str = "observer.py") -> dict[s
     )
     return {
         "banner": BANNER.format(version=__version__),
-        "model": _safe(observer.model),
+        "model": escaped(observer.model),
         "order": observer.order,
         "dt": _double(observer.dt),
         "dt_text": f"{observer.dt:g}",
-        "sampler": observer.sampler,
+        "sampler": escaped(observer.sampler),
         "sampler_text": sampler_text,
         "timing": timing,
         "inputs": inputs,
         "outputs": outputs,
         "states": states,
+        # Python literals (repr writes any text as a valid one) of the python-control names
+        "input_list": repr(list(signals[0])),
+        "output_list": repr(list(signals[1])),
+        "state_list": repr(states),
         "matrices": matrices,
-        "filename": _safe(filename),
+        "filename": escaped(filename),
     }
 
 
