@@ -342,6 +342,26 @@ COMMAND_ROWS = [
     row(f"{EXPORT} --dt nan -o {{tmp}}/o.json", "seconds; found nan", NumericError),
     row(f"{EXPORT} --dt inf -o {{tmp}}/o.json", "seconds; found inf", NumericError),
     row(f"{EXPORT} --dt 1ms -o {{tmp}}/o.json", "argument --dt: invalid float value: '1ms'", None),
+    # ---- issue 30: a period longer than the run, more periods than a run may step
+    row(
+        f"{EXPORT} --dt 1e300 -o {{tmp}}/o.json",
+        r"--dt = 1e\+300 s is longer than --t-end = 5 s; expected a sampling period at most",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-300 --verify -o {{tmp}}/o.json",
+        r"--t-end / --dt = 5e\+300 sampling periods; expected at most 1e\+09 \(the budget "
+        r"phdesign.limits.MAX_PERIODS\)",
+        NumericError,
+    ),
+    row(f"{SIM} --dt 1e300", r"--dt = 1e\+300 s is longer than --t-end = 5 s", NumericError),
+    row(f"{SIM} --dt 1e-300", r"--t-end / --dt = 5e\+300 sampling periods", NumericError),
+    row(
+        f"{SIM} --dt 1e-6 --u u1:sin(t) --resolution 6",
+        r"t_end / dt = 5e\+06 periods, each stepped with an input, times 28 states is "
+        r"1.4e\+08 values; expected at most 20,000,000",
+        NumericError,
+    ),
     row(
         f"{EXPORT} --dt 1e-3 --sampler spline -o {{tmp}}/o.json",
         "argument --sampler: invalid choice: 'spline' (choose from 'average', 'point')",

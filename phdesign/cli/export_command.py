@@ -144,12 +144,14 @@ def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
 
 def _export(args: argparse.Namespace) -> int:
     from phdesign.codegen import check_export_path
+    from phdesign.limits import check_periods
     from phdesign.numeric.inputs import initial_state_function
     from phdesign.numeric.sampled import export_observer, verification_plant_degree
     from phdesign.numeric.sampling import check_sampling
 
     dt = check_sampling(args.dt, args.sampler, dt_name="--dt")
     _finite_positive("--t-end", args.t_end)
+    check_periods(dt, args.t_end, stepped=args.verify, names=("--dt", "--t-end"))
     _finite_positive("--tol", args.tol)
     _finite_positive("--output-tol", args.output_tol)
     check_export_path(args.output, args.format, args.force)
@@ -214,7 +216,7 @@ def add_sampling_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def sampled_simulation(
-    args: argparse.Namespace, nm: Any, C_m: Any, L: Any, x0: Any, xhat0: Any
+    args: argparse.Namespace, nm: Any, C_m: Any, L: Any, x0: Any, xhat0: Any, u: Any = None
 ) -> Any:
     """Run ``simulate`` through :func:`simulate_sampled` when a sampling flag is given.
 
@@ -223,6 +225,7 @@ def sampled_simulation(
     """
     if args.dt is None and args.sampler is None and args.observer_resolution is None:
         return None
+    from phdesign.limits import check_periods
     from phdesign.numeric.sampled_simulation import simulate_sampled
     from phdesign.numeric.sampling import check_sampling
 
@@ -233,7 +236,8 @@ def sampled_simulation(
     if args.sampler is not None and args.dt is None:
         raise NumericError("--sampler needs --dt, the sampling period")
     if args.dt is not None:
-        check_sampling(args.dt, args.sampler or "average", dt_name="--dt")
+        dt = check_sampling(args.dt, args.sampler or "average", dt_name="--dt")
+        check_periods(dt, _finite_positive("--t-end", args.t_end), names=("--dt", "--t-end"))
     if args.scheme != "expm":
         raise NumericError("a sampled or lower-order observer is stepped exactly: drop --scheme")
     check_positive("--observer-resolution", args.observer_resolution)
@@ -250,4 +254,5 @@ def sampled_simulation(
         method=args.method,
         resolution=args.resolution,
         observer_resolution=args.observer_resolution,
+        u=u,
     )

@@ -227,7 +227,7 @@ def _simulate(args: argparse.Namespace) -> int:
     noisy = stochastic_simulation(args)
     with run_outputs(args) as commit:
         with np.errstate(all="ignore"):  # an overflow is refused below, with one line
-            res = sampled_simulation(args, plant.numeric, C_m, L, x0, xhat0)
+            res = sampled_simulation(args, plant.numeric, C_m, L, x0, xhat0, u)
             if res is None and noisy is not None:
                 res = noisy(
                     plant.numeric,

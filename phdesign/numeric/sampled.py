@@ -41,6 +41,7 @@ import numpy as np
 from phdesign.arguments import positive_number
 from phdesign.errors import ArgumentError, NumericError
 from phdesign.export_defaults import EXPORT
+from phdesign.limits import check_periods
 from phdesign.numeric.arguments import check_initial_state
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.order import REDUCTIONS, OrderSelection, check_order, select_order
@@ -410,6 +411,7 @@ def export_observer(
         raise NumericError(f"t_end must be a finite positive number; found {t_end!r}")
     if not isinstance(verify, bool):
         raise ArgumentError(f"verify must be True or False; found {verify!r}")
+    check_periods(dt, float(t_end), stepped=verify)
     positive_number(tol, "tol")
     positive_number(output_tol, "output_tol")
     check_initial_state(x0, nm, "x0")
