@@ -64,6 +64,11 @@ Searches and numerics (checked at the entry of each library function)
                                              length t_end); a run with an input signal
                                              steps every period, so periods times states
                                              count against ``MAX_SIMULATION_VALUES``
+    ``MAX_NOISE_INTENSITY``     1e100        a noise intensity (variance per unit time):
+                                             the noise figures and paths scale with it
+                                             in double precision; at 1e300 the
+                                             covariances of a fine discretization leave
+                                             the range of doubles
     ``MAX_STARTS``              100          starts of the gain tuning
     ``MAX_TUNE_ITERATIONS``     10 000       optimizer iterations per start
     =========================  ===========  ===============================================
@@ -98,6 +103,7 @@ __all__ = [
     "MAX_EXPRESSION_LENGTH",
     "MAX_MAGNITUDE",
     "MAX_MODEL_FILE_BYTES",
+    "MAX_NOISE_INTENSITY",
     "MAX_NUMBER_BITS",
     "MAX_NUMBER_DIGITS",
     "MAX_NUMBER_OPERATIONS",
@@ -114,6 +120,7 @@ __all__ = [
     "MIN_TIME_STEP",
     "check_discretization",
     "check_model_dimensions",
+    "check_noise_intensity",
     "check_parameter_count",
     "check_periods",
     "check_sensor_outputs",
@@ -148,6 +155,7 @@ MAX_SIMULATION_VALUES = 20_000_000
 MAX_T_END = 1e12
 MIN_TIME_STEP = 1e-300
 MAX_PERIODS = 1e9
+MAX_NOISE_INTENSITY = 1e100
 MAX_STARTS = 100
 MAX_TUNE_ITERATIONS = 10_000
 
@@ -304,6 +312,15 @@ def check_simulation(
             f"samples = {count} times {states:,} states is {total:,} values; expected at "
             f"most {MAX_SIMULATION_VALUES:,} ({_budget('MAX_SIMULATION_VALUES')}): ask for "
             "fewer samples"
+        )
+
+
+def check_noise_intensity(largest: float, name: str = "intensity") -> None:
+    """Refuse a noise intensity above :data:`MAX_NOISE_INTENSITY` (``largest`` of them)."""
+    if largest > MAX_NOISE_INTENSITY:
+        raise NumericError(
+            f"{name}: intensities must be at most {MAX_NOISE_INTENSITY:g} (variances per "
+            f"unit time); found {largest:g} ({_budget('MAX_NOISE_INTENSITY')})"
         )
 
 

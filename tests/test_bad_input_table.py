@@ -325,6 +325,24 @@ COMMAND_ROWS = [
     ),
     row(f"{SIM} --noise-intensity 1,1", "intensity: expected 1 values", NumericError),
     row(f"{SIM} --seed 3", "--seed needs --noise-intensity or --input-noise", NumericError),
+    # ---- issue 30: a negative seed and intensities beyond the range of the computation
+    row(
+        f"{SIM} --noise-intensity 1 --seed -1",
+        "seed must be an integer >= 0; found -1",
+        NumericError,
+    ),
+    row(
+        f"{SIM} --noise-intensity 1e101",
+        r"--noise-intensity: intensities must be at most 1e\+100 \(variances per unit time\); "
+        r"found 1e\+101 \(the budget phdesign.limits.MAX_NOISE_INTENSITY\)",
+        NumericError,
+    ),
+    row(
+        f"{NOISE} --intensity 1e308",
+        r"--intensity: intensities must be at most 1e\+100 .*found 1e\+308",
+        NumericError,
+    ),
+    row(f"{TRADE} --intensity 1,1e200", r"at most 1e\+100 .*found 1e\+200", NumericError),
     row(f"{SIM} --noise-intensity 1 --scheme midpoint", "scheme does not apply", NumericError),
     row(f"{SIM} --noise-intensity 1 --dt 0.01", "--dt asks for a sampled one", NumericError),
     row("tune wave --sensors 2 --max-rms -1", "--max-rms must be a positive number", NumericError),
