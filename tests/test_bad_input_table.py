@@ -350,6 +350,19 @@ COMMAND_ROWS = [
         "tune wave --sensors 2 --objective rms", "--objective rms needs --min-decay", NumericError
     ),
     row("tune wave --sensors 2 --intensity 2", "--intensity needs --max-rms", NumericError),
+    row(
+        "tune euler-bernoulli --sensors 4 --max-rms 0.3 --starts 3",
+        "--starts belongs to the abscissa search; the noise-aware tuning .* drop --starts",
+        NumericError,
+    ),
+    row(
+        "tune euler-bernoulli --sensors 4 --objective rms --min-decay 1 --seed 2",
+        "drop --seed",
+        NumericError,
+    ),
+    row(
+        "tune euler-bernoulli --sensors 4 --max-rms 0.3 --robust 5%", "drop --robust", NumericError
+    ),
     row("tune wave --sensors 2 --max-rms 0.5", "needs a performance output", NumericError),
     row(f"{TUNE_BEAM} --max-rms 0.1 --full", "drop --full", NumericError),
     # export and the sampled simulation (issue 15): checked before any work, nothing written
@@ -764,6 +777,17 @@ COMMAND_ROWS = [
         "loop tune wave --actuate 2 --sensors 2 --tune everything",
         "argument --tune: invalid choice: 'everything'",
         None,
+    ),
+    # ---- issue 30: options that would do nothing are refused
+    row(
+        "loop tune wave --actuate 2 --sensors 2 --gain 0.5",
+        "--gain is what --tune both tunes .*: drop --gain, or keep it with --tune feedback",
+        LoopError,
+    ),
+    row(
+        "loop tune wave --actuate 2 --sensors 2 --tune feedback --feedback 2",
+        "--feedback is what --tune feedback tunes",
+        LoopError,
     ),
     # sweep (issue 17): grids, axes, jobs, outputs and stores, schedulers; then plot
     row(f"{SWEEP} --grid l1=", "grid l1: empty; expected start:stop:count", SweepError),

@@ -399,6 +399,16 @@ def noise_tuning(args: argparse.Namespace) -> int | None:
         raise NumericError("--max-rms goes with the abscissa objective")
     if args.full:
         raise NumericError("noise-aware tuning searches positive diagonal gains; drop --full")
+    for flag, value in (
+        ("--starts", args.starts),
+        ("--seed", args.seed),
+        ("--robust", args.robust),
+    ):
+        if value is not None:  # they steer the abscissa search only
+            raise NumericError(
+                f"{flag} belongs to the abscissa search; the noise-aware tuning (--max-rms, "
+                f"--objective rms) does not take it: drop {flag}"
+            )
     for flag, value in (("--max-rms", args.max_rms), ("--min-decay", args.min_decay)):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise NumericError(f"{flag} must be a positive number; found {value}")
