@@ -59,6 +59,16 @@ Searches and numerics (checked at the entry of each library function)
     ``MAX_T_END``               1e12         final time of a simulation
     ``MIN_TIME_STEP``           1e-300       t_end / (samples - 1): time stamps stay
                                              distinct normal floats
+    ``MAX_PERIODS``             1e9          sampling periods t_end / dt of one sampled
+                                             run (the period of a run is also at most its
+                                             length t_end); a run with an input signal
+                                             steps every period, so periods times states
+                                             count against ``MAX_SIMULATION_VALUES``
+    ``MAX_NOISE_INTENSITY``     1e100        a noise intensity (variance per unit time):
+                                             the noise figures and paths scale with it
+                                             in double precision; at 1e300 the
+                                             covariances of a fine discretization leave
+                                             the range of doubles
     ``MAX_STARTS``              100          starts of the gain tuning
     ``MAX_TUNE_ITERATIONS``     10 000       optimizer iterations per start
     =========================  ===========  ===============================================
@@ -93,11 +103,13 @@ __all__ = [
     "MAX_EXPRESSION_LENGTH",
     "MAX_MAGNITUDE",
     "MAX_MODEL_FILE_BYTES",
+    "MAX_NOISE_INTENSITY",
     "MAX_NUMBER_BITS",
     "MAX_NUMBER_DIGITS",
     "MAX_NUMBER_OPERATIONS",
     "MAX_ORDER",
     "MAX_PARAMETERS",
+    "MAX_PERIODS",
     "MAX_PORTS",
     "MAX_SENSOR_OUTPUTS",
     "MAX_SIMULATION_VALUES",
@@ -108,7 +120,9 @@ __all__ = [
     "MIN_TIME_STEP",
     "check_discretization",
     "check_model_dimensions",
+    "check_noise_intensity",
     "check_parameter_count",
+    "check_periods",
     "check_sensor_outputs",
     "check_simulation",
     "check_tuning",
@@ -140,6 +154,8 @@ MAX_DISCRETE_STATES = 2000
 MAX_SIMULATION_VALUES = 20_000_000
 MAX_T_END = 1e12
 MIN_TIME_STEP = 1e-300
+MAX_PERIODS = 1e9
+MAX_NOISE_INTENSITY = 1e100
 MAX_STARTS = 100
 MAX_TUNE_ITERATIONS = 10_000
 
@@ -296,6 +312,61 @@ def check_simulation(
             f"samples = {count} times {states:,} states is {total:,} values; expected at "
             f"most {MAX_SIMULATION_VALUES:,} ({_budget('MAX_SIMULATION_VALUES')}): ask for "
             "fewer samples"
+        )
+
+
+def check_noise_intensity(largest: float, name: str = "intensity") -> None:
+    """Refuse a noise intensity above :data:`MAX_NOISE_INTENSITY` (``largest`` of them)."""
+    if largest > MAX_NOISE_INTENSITY:
+        raise NumericError(
+            f"{name}: intensities must be at most {MAX_NOISE_INTENSITY:g} (variances per "
+            f"unit time); found {largest:g} ({_budget('MAX_NOISE_INTENSITY')})"
+        )
+
+
+def check_periods(
+    dt: float,
+    t_end: float,
+    *,
+    stepped: bool = True,
+    states: int = 0,
+    names: tuple[str, str] = ("dt", "t_end"),
+) -> None:
+    """Refuse a sampling period longer than the run, or more periods than a run may step.
+
+    Parameters
+    ----------
+    dt, t_end : float
+        The period and the run's length (both checked finite and positive before).
+    stepped : bool
+        The run steps the periods (a simulation, a verification); an export without
+        verification only needs ``dt <= t_end``.
+    states : int
+        States stepped one period at a time (a run with an input signal), whose
+        periods times states count against :data:`MAX_SIMULATION_VALUES`; 0 when the
+        periods are jumped over by powers of the one-period map.
+    names : (str, str)
+        How ``dt`` and ``t_end`` are called in the message (``("--dt", "--t-end")``).
+    """
+    dt_name, t_name = names
+    if dt > t_end:
+        raise NumericError(
+            f"{dt_name} = {dt:g} s is longer than {t_name} = {t_end:g} s; expected a sampling "
+            f"period at most the run's length (a longer {t_name}, or a shorter {dt_name})"
+        )
+    periods = t_end / dt
+    if stepped and periods > MAX_PERIODS:
+        raise NumericError(
+            f"{t_name} / {dt_name} = {periods:.3g} sampling periods; expected at most "
+            f"{MAX_PERIODS:.0e} ({_budget('MAX_PERIODS')}): a longer {dt_name} or a shorter "
+            f"{t_name}"
+        )
+    if stepped and states and periods * states > MAX_SIMULATION_VALUES:
+        raise NumericError(
+            f"{t_name} / {dt_name} = {periods:.3g} periods, each stepped with an input, times "
+            f"{states:,} states is {periods * states:.3g} values; expected at most "
+            f"{MAX_SIMULATION_VALUES:,} ({_budget('MAX_SIMULATION_VALUES')}): a longer "
+            f"{dt_name} or a shorter {t_name}"
         )
 
 

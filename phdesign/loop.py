@@ -101,7 +101,8 @@ class Loop:
         Parameter overrides (applied to the model).
     method : {"galerkin", "fd"}
     resolution : int, optional
-        Discretization used by :meth:`simulate`, :meth:`statespace`, :meth:`assemble`.
+        Discretization used by :meth:`simulate`, :meth:`statespace`, :meth:`assemble`, and
+        the first resolution of :meth:`spectrum`'s refinement (unless it is given one).
     """
 
     model: BCPHS
@@ -261,14 +262,17 @@ class Loop:
         resolution: int | None = None,
         max_resolution: int | None = None,
     ) -> LoopSpectrum:
-        """Return the loop's converged spectrum (:func:`.numeric.loop_spectrum.loop_spectrum`)."""
+        """Return the loop's converged spectrum (:func:`.numeric.loop_spectrum.loop_spectrum`).
+
+        ``resolution`` defaults to the loop's own (its refinement's first resolution).
+        """
         from phdesign.numeric.loop_spectrum import loop_spectrum
 
         return loop_spectrum(
             self.numeric_model,
             self.numeric,
             method=self.method,
-            resolution=resolution,
+            resolution=self.resolution if resolution is None else resolution,
             max_resolution=max_resolution,
             tol=tol,
             count=count,

@@ -52,7 +52,7 @@ def plot_tradeoff(
     annotate : {"pareto", "all", "none"}
         Which points carry their gain as a label.
     """
-    from phdesign.plots import check_plot_path, new_figure
+    from phdesign.plots import check_plot_path, literal, new_figure
 
     if path is not None:
         check_plot_path(path, force=force)
@@ -101,7 +101,7 @@ def plot_tradeoff(
     ax.set(
         xlabel=f"RMS of the estimation error of {result.performance}",
         ylabel="decay rate −α [1/s]",
-        title=(
+        title=literal(
             f"{result.model}, sensors {describe_sensors(result.sensors, result.output_labels)}: "
             "speed against noise"
         ),
@@ -139,7 +139,7 @@ def plot_noise_report(
     its finest value against the resolution (flat when it converges, rising when it
     diverges).
     """
-    from phdesign.plots import check_plot_path, new_figure
+    from phdesign.plots import check_plot_path, literal, new_figure
 
     if path is not None:
         check_plot_path(path, force=force)
@@ -178,7 +178,7 @@ def plot_noise_report(
             right.plot(est.resolutions, values / values[-1], "-o", label=label)
     right.set(xlabel="resolution", ylabel="value / finest value", title="figures under refinement")
     right.legend(loc="best", fontsize=8)
-    fig.suptitle(report.header(), fontsize=9)
+    fig.suptitle(literal(report.header()), fontsize=9)
     if path is not None:
         save_figure(fig, path, force=force)
     return fig

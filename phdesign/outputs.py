@@ -41,6 +41,7 @@ import secrets
 import signal
 import stat
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 from types import FrameType, TracebackType
 from typing import Any
@@ -53,6 +54,7 @@ __all__ = [
     "atomic_write",
     "check_output_path",
     "remove_stale_temporaries",
+    "terminate_as_interrupt",
 ]
 
 
@@ -153,12 +155,11 @@ class OutputFiles:
         self.force = force
         self._targets: dict[Path, str] = {}
         self._staged: dict[Path, Path | bytes] = {}
-        self._previous: Any = None
+        self._signals = contextlib.ExitStack()
 
     # ------------------------------------------------------------------ context
     def __enter__(self) -> OutputFiles:
-        if threading.current_thread() is threading.main_thread():
-            self._previous = signal.signal(signal.SIGTERM, _raise_terminated)
+        self._signals.enter_context(terminate_as_interrupt())
         return self
 
     def __exit__(
@@ -170,9 +171,7 @@ class OutputFiles:
         try:
             self.discard()
         finally:
-            if self._previous is not None:
-                signal.signal(signal.SIGTERM, self._previous)
-                self._previous = None
+            self._signals.close()
 
     # ------------------------------------------------------------------ steps
     def add(self, path: str | os.PathLike[str]) -> Path:
@@ -266,6 +265,24 @@ class OutputFiles:
 
 def _raise_terminated(signum: int, frame: FrameType | None) -> None:
     raise Terminated
+
+
+@contextlib.contextmanager
+def terminate_as_interrupt() -> Iterator[None]:
+    """Raise :class:`Terminated` on SIGTERM inside the block, so that cleanups run.
+
+    Python's default for SIGTERM is to die at once, leaving temporary files behind; only
+    the main thread can install a handler, so elsewhere the block runs unchanged.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        if previous is not None:  # None: a handler installed outside Python
+            signal.signal(signal.SIGTERM, previous)
 
 
 def _identity(path: Path) -> tuple[Any, ...]:

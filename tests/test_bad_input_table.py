@@ -82,6 +82,7 @@ NOISE = "noise euler-bernoulli --sensors 3,4 --gain 0.1,1"
 TRADE = "tradeoff euler-bernoulli --sensors 3,4"
 TUNE_BEAM = "tune euler-bernoulli --sensors 3,4"
 EXPORT = "export euler-bernoulli --sensors 3,4 --gain 0.1,1 --format json"
+EXPORT_C = "export wave --sensors 2 --gain 1 --dt 1e-3 --format c"
 SWEEP = "sweep wave --sensors 2 --scheduler synchronous -o {tmp}/m.zarr"
 MAP = "sweep wave --sensors 2 --grid l1=0.1:1:3 --scheduler synchronous"
 COMMAND_ROWS = [
@@ -324,6 +325,24 @@ COMMAND_ROWS = [
     ),
     row(f"{SIM} --noise-intensity 1,1", "intensity: expected 1 values", NumericError),
     row(f"{SIM} --seed 3", "--seed needs --noise-intensity or --input-noise", NumericError),
+    # ---- issue 30: a negative seed and intensities beyond the range of the computation
+    row(
+        f"{SIM} --noise-intensity 1 --seed -1",
+        "seed must be an integer >= 0; found -1",
+        NumericError,
+    ),
+    row(
+        f"{SIM} --noise-intensity 1e101",
+        r"--noise-intensity: intensities must be at most 1e\+100 \(variances per unit time\); "
+        r"found 1e\+101 \(the budget phdesign.limits.MAX_NOISE_INTENSITY\)",
+        NumericError,
+    ),
+    row(
+        f"{NOISE} --intensity 1e308",
+        r"--intensity: intensities must be at most 1e\+100 .*found 1e\+308",
+        NumericError,
+    ),
+    row(f"{TRADE} --intensity 1,1e200", r"at most 1e\+100 .*found 1e\+200", NumericError),
     row(f"{SIM} --noise-intensity 1 --scheme midpoint", "scheme does not apply", NumericError),
     row(f"{SIM} --noise-intensity 1 --dt 0.01", "--dt asks for a sampled one", NumericError),
     row("tune wave --sensors 2 --max-rms -1", "--max-rms must be a positive number", NumericError),
@@ -331,6 +350,19 @@ COMMAND_ROWS = [
         "tune wave --sensors 2 --objective rms", "--objective rms needs --min-decay", NumericError
     ),
     row("tune wave --sensors 2 --intensity 2", "--intensity needs --max-rms", NumericError),
+    row(
+        "tune euler-bernoulli --sensors 4 --max-rms 0.3 --starts 3",
+        "--starts belongs to the abscissa search; the noise-aware tuning .* drop --starts",
+        NumericError,
+    ),
+    row(
+        "tune euler-bernoulli --sensors 4 --objective rms --min-decay 1 --seed 2",
+        "drop --seed",
+        NumericError,
+    ),
+    row(
+        "tune euler-bernoulli --sensors 4 --max-rms 0.3 --robust 5%", "drop --robust", NumericError
+    ),
     row("tune wave --sensors 2 --max-rms 0.5", "needs a performance output", NumericError),
     row(f"{TUNE_BEAM} --max-rms 0.1 --full", "drop --full", NumericError),
     # export and the sampled simulation (issue 15): checked before any work, nothing written
@@ -341,6 +373,26 @@ COMMAND_ROWS = [
     row(f"{EXPORT} --dt nan -o {{tmp}}/o.json", "seconds; found nan", NumericError),
     row(f"{EXPORT} --dt inf -o {{tmp}}/o.json", "seconds; found inf", NumericError),
     row(f"{EXPORT} --dt 1ms -o {{tmp}}/o.json", "argument --dt: invalid float value: '1ms'", None),
+    # ---- issue 30: a period longer than the run, more periods than a run may step
+    row(
+        f"{EXPORT} --dt 1e300 -o {{tmp}}/o.json",
+        r"--dt = 1e\+300 s is longer than --t-end = 5 s; expected a sampling period at most",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-300 --verify -o {{tmp}}/o.json",
+        r"--t-end / --dt = 5e\+300 sampling periods; expected at most 1e\+09 \(the budget "
+        r"phdesign.limits.MAX_PERIODS\)",
+        NumericError,
+    ),
+    row(f"{SIM} --dt 1e300", r"--dt = 1e\+300 s is longer than --t-end = 5 s", NumericError),
+    row(f"{SIM} --dt 1e-300", r"--t-end / --dt = 5e\+300 sampling periods", NumericError),
+    row(
+        f"{SIM} --dt 1e-6 --u u1:sin(t) --resolution 6",
+        r"t_end / dt = 5e\+06 periods, each stepped with an input, times 28 states is "
+        r"1.4e\+08 values; expected at most 20,000,000",
+        NumericError,
+    ),
     row(
         f"{EXPORT} --dt 1e-3 --sampler spline -o {{tmp}}/o.json",
         "argument --sampler: invalid choice: 'spline' (choose from 'average', 'point')",
@@ -376,15 +428,40 @@ COMMAND_ROWS = [
     ),
     row(
         "export wave --sensors 2 --gain 1 --dt 1e-3 --format c -o {tmp}",
-        "output folder .* exists; pass --force to replace it",
+        "output folder .* exists and is not an export of phdesign: it holds no marker "
+        r"\.phdesign-export",
         OutputFileError,
     ),
     row(
         "export wave --sensors 2 --gain 1 --dt 1e-3 --format c -o {tmp}/obs",
-        "is a file; --format c writes a folder",
+        "is a file; format 'c' writes a folder",
         OutputFileError,
         obs="a file",
     ),
+    # ---- issue 30: --force replaces only an export phdesign wrote (a user's folder survives)
+    row(
+        f"{EXPORT_C} -o {{tmp}} --force",
+        "is not an export of phdesign: it holds no marker .*--force replaces only a folder "
+        "phdesign wrote",
+        OutputFileError,
+        **{"precious.txt": "mine"},
+    ),
+    row(f"{EXPORT_C} -o . --force", "output path '.' names no folder", OutputFileError),
+    row(f"{EXPORT_C} -o {{tmp}}/.. --force", "names no folder", OutputFileError),
+    row(
+        f"{EXPORT_C} -o {{tmp}}/link --force",
+        "is a symbolic link; format 'c' writes a folder, and replaces only a folder it "
+        "wrote, even with --force",
+        OutputFileError,
+        link="symlink:.",
+    ),
+    row(
+        f"{EXPORT_C} -o {{tmp}}/fifo --force",
+        "is a FIFO; format 'c'",
+        OutputFileError,
+        fifo="fifo:",
+    ),
+    row(f"{EXPORT_C} -o /dev/null --force", "is a device; format 'c'", OutputFileError),
     row(f"{EXPORT} --dt 1e-3 -o {{tmp}}/none/o.json", "none' does not exist", OutputFileError),
     row(
         f"{EXPORT} --dt 1e-3 -o /proc/phdesign-export.json",
@@ -403,7 +480,18 @@ COMMAND_ROWS = [
     ),
     row(
         f"{EXPORT} --dt 1e-3 --at 2 -o {{tmp}}/o.json",
-        r"--at: expected numbers in \[0, 1\]; found '2'",
+        r"--at: expected numbers in \[0, 1\]; found 2$",
+        NumericError,
+    ),
+    # ---- issue 30: two points, one output name
+    row(
+        f"{EXPORT} --dt 1e-3 --at 1,1 -o {{tmp}}/o.json",
+        r"--at: 1.0 and 1.0 both give the output w\(1\); expected distinct points",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --at 0.5,1,0.5000001 -o {{tmp}}/o.json",
+        r"--at: 0.5 and 0.5000001 both give the output w\(0.5\)",
         NumericError,
     ),
     row(
@@ -689,6 +777,17 @@ COMMAND_ROWS = [
         "loop tune wave --actuate 2 --sensors 2 --tune everything",
         "argument --tune: invalid choice: 'everything'",
         None,
+    ),
+    # ---- issue 30: options that would do nothing are refused
+    row(
+        "loop tune wave --actuate 2 --sensors 2 --gain 0.5",
+        "--gain is what --tune both tunes .*: drop --gain, or keep it with --tune feedback",
+        LoopError,
+    ),
+    row(
+        "loop tune wave --actuate 2 --sensors 2 --tune feedback --feedback 2",
+        "--feedback is what --tune feedback tunes",
+        LoopError,
     ),
     # sweep (issue 17): grids, axes, jobs, outputs and stores, schedulers; then plot
     row(f"{SWEEP} --grid l1=", "grid l1: empty; expected start:stop:count", SweepError),

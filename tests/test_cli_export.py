@@ -59,7 +59,11 @@ def test_export_c_folder_and_force(capsys, tmp_path):
     folder = tmp_path / "controller"
     argv = ["export", *BEAM, "--dt", "1e-3", "--order", "16", "--format", "c", "-o", str(folder)]
     assert run(capsys, *argv)[0] == 0
-    assert sorted(p.name for p in folder.iterdir()) == ["observer.c", "observer.h"]
+    assert sorted(p.name for p in folder.iterdir()) == [
+        ".phdesign-export",
+        "observer.c",
+        "observer.h",
+    ]
     status, _, err = run(capsys, *argv)
     assert status == 2
     assert "exists; pass --force" in err

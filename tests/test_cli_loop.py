@@ -91,8 +91,9 @@ def test_loop_simulate_writes_csv_and_a_figure_and_refuses_to_overwrite(tmp_path
 
 
 def test_loop_tune_prints_both_gains(capsys):
+    untuned = ["euler-bernoulli", "--actuate", "3", "--sensors", "4"]  # K is what is tuned
     out, _ = run(
-        ["loop", "tune", *BEAM_LOOP, "--tune", "feedback", "--starts", "1", "--json"], capsys
+        ["loop", "tune", *untuned, "--tune", "feedback", "--starts", "1", "--json"], capsys
     )
     payload = json.loads(out)
     assert payload["tuned"] == "feedback"

@@ -252,6 +252,9 @@ def _forked_run(argv: list[str], kill: str, signum: int) -> int:
         _, status = os.waitpid(pid, 0)
         return os.waitstatus_to_exitcode(status)
     try:  # the child: never returns into pytest
+        # a runner that ignores SIGINT (nohup, a background job) passes that on to the
+        # child: restore Python's own handler, which the command line relies on
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, 1)
         os.dup2(devnull, 2)

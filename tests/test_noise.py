@@ -360,3 +360,24 @@ def test_the_l2_gain_of_a_wave_with_dampers_at_both_ends_is_its_closed_form():
     figure = report.to_dict()["l2_gain"]
     assert figure["converged"]
     assert abs(figure["value"] - sup) < 1e-10 * sup
+
+
+@pytest.mark.parametrize("scale", [1e20, 1e100])
+def test_the_sampled_noise_covariance_is_linear_in_a_huge_intensity(scale):
+    """Issue 30: at 1e20 the block exponential overflowed to NaN, every eigenvalue of the
+    covariance failed the rank test, and the run was exactly the noise-free one."""
+    from phdesign.numeric.stochastic import simulate_noisy
+
+    d = discretize(numeric("wave"), "galerkin", 6)
+    L = np.array([[1.0]])
+    covariances = []
+    for sigma2 in (1.0, scale):
+        E2, A2, _, N2 = noisy_coupled_system(d, SENSOR_2, L, np.array([sigma2]), None)
+        s = sampled_noise(E2, A2, N2, 0.25)
+        covariances.append(s.factor @ s.factor.T / sigma2)
+    unit = covariances[0]
+    assert np.max(np.abs(covariances[1] - unit)) <= 1e-12 * np.max(np.abs(unit))
+    run = simulate_noisy(
+        numeric("wave"), SENSOR_2, L, noise_intensity=scale, seed=1, resolution=6, samples=5
+    )
+    assert np.all(run.H_err[1:] > 1e-3 * scale)  # the noise is there, at its own scale

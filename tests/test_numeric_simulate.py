@@ -188,3 +188,32 @@ def test_bad_simulation_requests():
         simulate(nm, samples=1)
     with pytest.raises(NumericError, match="scheme"):
         simulate(nm, scheme="rk4", resolution=8)
+
+
+def _nan_after(t0: float):
+    return lambda t: np.array([np.nan if t >= t0 else 0.0, 0.0])
+
+
+@pytest.mark.parametrize("front", ["simulate", "noisy", "sampled", "loop"])
+def test_a_nan_input_signal_is_refused_naming_the_input_and_time(front):
+    """Issue 30: a NaN input signal returned NaN series without an error."""
+    import phdesign as phd
+    from phdesign.numeric.sampled_simulation import simulate_sampled
+    from phdesign.numeric.stochastic import simulate_noisy
+
+    nm = numeric("wave")
+    design = (np.array([[0.0, 1.0]]), np.array([[1.0]]))
+    runs = {
+        "simulate": lambda u: simulate(nm, *design, u=u, resolution=6, samples=5),
+        "noisy": lambda u: simulate_noisy(
+            nm, *design, noise_intensity=1.0, seed=1, u=u, resolution=6, samples=5
+        ),
+        "sampled": lambda u: simulate_sampled(nm, *design, u=u, dt=1.25, resolution=6),
+        "loop": lambda u: phd.Loop(
+            phd.Observer(phd.load("wave"), sensors=[2], gain=1, resolution=6), actuate=2
+        ).simulate(u=lambda t: np.array([u(t)[0], 0.0]), samples=5),
+    }
+    with pytest.raises(
+        NumericError, match=r"^u\(t\) must be finite; found nan in input u1 at t = 2\.5$"
+    ):
+        runs[front](_nan_after(2.5))

@@ -328,3 +328,19 @@ def test_c_export_folder_is_all_or_nothing(tmp_path, monkeypatch):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["obs"]
     assert (target / "a.h").read_text() == "new"
     assert (target / "a.c").exists()
+
+
+def test_a_sampling_period_is_at_most_the_run_and_the_periods_are_bounded():
+    """Issue 30: ``dt = 1e300`` ended in numpy's LinAlgError, ``1e-300`` in an OverflowError."""
+    from phdesign.numeric.sampled_simulation import simulate_sampled
+
+    nm = to_numeric(load_builtin("wave"))
+    design = (np.array([[0.0, 1.0]]), np.array([[0.5]]))
+    with pytest.raises(NumericError, match=r"^dt = 1e\+300 s is longer than t_end = 5 s"):
+        export_observer(nm, *design, dt=1e300, order=6)
+    with pytest.raises(NumericError, match=r"^t_end / dt = 5e\+300 sampling periods"):
+        export_observer(nm, *design, dt=1e-300, order=6, verify=True)
+    with pytest.raises(NumericError, match=r"^dt = 10 s is longer than t_end = 5 s"):
+        simulate_sampled(nm, *design, dt=10.0, resolution=6)
+    with pytest.raises(NumericError, match=r"^t_end / dt = 5e\+300 sampling periods"):
+        simulate_sampled(nm, *design, dt=1e-300, resolution=6)

@@ -170,8 +170,9 @@ def run_outputs(args: argparse.Namespace) -> Iterator[Callable[[str, Any], None]
     with OutputFiles(args.force) as out, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         fmt = None
-        if args.output:
-            out.add(args.output)
+        output = getattr(args, "output", None)  # noise has a --plot only
+        if output:
+            out.add(output)
         if args.plot:
             from phdesign.plots import check_plot_path
 
@@ -186,10 +187,10 @@ def run_outputs(args: argparse.Namespace) -> Iterator[Callable[[str, Any], None]
                 picture = io.BytesIO()
                 result.plot().savefig(picture, format=fmt, dpi=110)
                 out.stage(args.plot, picture.getvalue())
-            if args.output:
-                out.stage(args.output, text)
+            if output:
+                out.stage(output, text)
             out.commit()
-            if not args.output:
+            if not output:
                 printed.append(text)
 
         yield commit

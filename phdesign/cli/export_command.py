@@ -79,7 +79,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     ex.add_argument(
         "--output", "-o", required=True, metavar="PATH", help="file (a folder for --format c)"
     )
-    ex.add_argument("--force", action="store_true", help="replace an existing output")
+    ex.add_argument(
+        "--force",
+        action="store_true",
+        help="replace an existing output that phdesign wrote (a C folder only while it holds "
+        "exactly the files of its marker .phdesign-export)",
+    )
     ex.add_argument(
         "--verify",
         action="store_true",
@@ -120,34 +125,33 @@ def _finite_positive(name: str, value: float) -> float:
 
 
 def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
-    """Parse ``--at``: numbers in the interval, for a model with a displacement."""
+    """Parse ``--at`` (numbers; their checks are the library's)."""
     if text is None:
         return None
-    if nm.displacement is None:
-        raise NumericError(f"--at: model {nm.name!r} has no displacement")
+    from phdesign.numeric.sampled import displacement_points
+
     a, b = nm.interval
     points = []
     for item in text.split(","):
         try:
-            z = float(item)
+            points.append(float(item))
         except ValueError:
             raise NumericError(
                 f"--at: expected numbers in [{a:g}, {b:g}]; found {item!r}"
             ) from None
-        if not (math.isfinite(z) and a <= z <= b):
-            raise NumericError(f"--at: expected numbers in [{a:g}, {b:g}]; found {item!r}")
-        points.append(z)
-    return tuple(points)
+    return displacement_points(nm, points, "--at")
 
 
 def _export(args: argparse.Namespace) -> int:
     from phdesign.codegen import check_export_path
+    from phdesign.limits import check_periods
     from phdesign.numeric.inputs import initial_state_function
     from phdesign.numeric.sampled import export_observer, verification_plant_degree
     from phdesign.numeric.sampling import check_sampling
 
     dt = check_sampling(args.dt, args.sampler, dt_name="--dt")
     _finite_positive("--t-end", args.t_end)
+    check_periods(dt, args.t_end, stepped=args.verify, names=("--dt", "--t-end"))
     _finite_positive("--tol", args.tol)
     _finite_positive("--output-tol", args.output_tol)
     check_export_path(args.output, args.format, args.force)
@@ -212,7 +216,7 @@ def add_sampling_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def sampled_simulation(
-    args: argparse.Namespace, nm: Any, C_m: Any, L: Any, x0: Any, xhat0: Any
+    args: argparse.Namespace, nm: Any, C_m: Any, L: Any, x0: Any, xhat0: Any, u: Any = None
 ) -> Any:
     """Run ``simulate`` through :func:`simulate_sampled` when a sampling flag is given.
 
@@ -221,6 +225,7 @@ def sampled_simulation(
     """
     if args.dt is None and args.sampler is None and args.observer_resolution is None:
         return None
+    from phdesign.limits import check_periods
     from phdesign.numeric.sampled_simulation import simulate_sampled
     from phdesign.numeric.sampling import check_sampling
 
@@ -231,7 +236,8 @@ def sampled_simulation(
     if args.sampler is not None and args.dt is None:
         raise NumericError("--sampler needs --dt, the sampling period")
     if args.dt is not None:
-        check_sampling(args.dt, args.sampler or "average", dt_name="--dt")
+        dt = check_sampling(args.dt, args.sampler or "average", dt_name="--dt")
+        check_periods(dt, _finite_positive("--t-end", args.t_end), names=("--dt", "--t-end"))
     if args.scheme != "expm":
         raise NumericError("a sampled or lower-order observer is stepped exactly: drop --scheme")
     check_positive("--observer-resolution", args.observer_resolution)
@@ -248,4 +254,5 @@ def sampled_simulation(
         method=args.method,
         resolution=args.resolution,
         observer_resolution=args.observer_resolution,
+        u=u,
     )

@@ -38,7 +38,6 @@ def _loop_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--feedback",
-        default="1",
         metavar="K",
         help="feedback gain K > 0 on the collocated estimates: '1' or '1,2' (diagonal) or "
         "'[[..]]' (full); default 1",
@@ -143,7 +142,7 @@ def _loop(args: argparse.Namespace, numeric: bool = True) -> Any:
         observer.C_m,
         observer.L,
         actuate=parse_indices(args.actuate, "--actuate"),
-        feedback=parse_gain_text(args.feedback, "--feedback"),
+        feedback=parse_gain_text(args.feedback or "1", "--feedback"),
         feedback_source=args.feedback_source,
         feedback_outputs=None if outputs is None else parse_indices(outputs, "--feedback-outputs"),
         method=args.method if numeric else "galerkin",
@@ -195,6 +194,14 @@ def _simulate(args: argparse.Namespace) -> int:
 
 def _tune(args: argparse.Namespace) -> int:
     check_positive("--starts", args.starts)
+    tuned = {"feedback": ("--feedback",), "gain": ("--gain",), "both": ("--feedback", "--gain")}
+    for flag in tuned[args.tune]:  # a tuned gain starts from the grid, not from a given value
+        if getattr(args, flag[2:]) is not None:
+            raise LoopError(
+                f"{flag} is what --tune {args.tune} tunes (its search starts from a grid, not "
+                f"from a given value): drop {flag}, or keep it with --tune "
+                f"{'gain' if flag == '--feedback' else 'feedback'}"
+            )
     loop = _loop(args, numeric=False)
     result = loop.tune(args.tune, full=args.full, starts=args.starts, seed=args.seed)
     return _print(args, result, loop.model.name)

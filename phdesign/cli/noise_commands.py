@@ -29,9 +29,8 @@ from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
     check_positive,
-    emit,
     emit_result,
-    write_output,
+    run_outputs,
 )
 from phdesign.cli.design_arguments import add_observer_arguments
 from phdesign.errors import NumericError, ObserverError
@@ -211,23 +210,27 @@ def _noise(args: argparse.Namespace) -> int:
     check_positive("--resolution", args.resolution)
     check_positive("--tol", args.tol)
     model, nm, C_m, L = _observer(args, "noise")
-    if args.plot:
-        from phdesign.plots import check_plot_path
-
-        check_plot_path(args.plot, args.force)
-    report = noise(
-        nm,
-        C_m,
-        L,
-        **_noise_inputs(args, nm, model, C_m.shape[0]),
-        method=args.method,
-        resolution=args.resolution,
-        tol=args.tol,
-    )
-    emit_result(args, report)
-    if args.plot:
-        report.plot(args.plot, force=args.force)
+    with run_outputs(args) as commit:  # the plot is checked now, the text printed after it
+        report = noise(
+            nm,
+            C_m,
+            L,
+            **_noise_inputs(args, nm, model, C_m.shape[0]),
+            method=args.method,
+            resolution=args.resolution,
+            tol=args.tol,
+        )
+        commit(_text(args, report), report)
     return 0
+
+
+def _text(args: argparse.Namespace, result: Any) -> str:
+    """Return the result as ``--json``, ``--csv`` (where a command has it) or text."""
+    from phdesign.io import dumps_json
+
+    if args.json:
+        return dumps_json(result.to_dict())
+    return result.to_csv() if getattr(args, "csv", False) else str(result)
 
 
 def _range(text: str, flag: str) -> Any:
@@ -271,35 +274,18 @@ def _tradeoff(args: argparse.Namespace) -> int:
     if args.grid is not None:
         grid = [_range(axis, "--grid") for axis in str(args.grid).split(",")]
     scales = None if args.scales is None else _range(args.scales, "--scales")
-    if args.output:
-        from phdesign.io import check_output_path
-
-        check_output_path(args.output, args.force)
-    if args.plot:
-        from phdesign.plots import check_plot_path
-
-        check_plot_path(args.plot, args.force)
-    result = tradeoff(
-        nm,
-        C_m,
-        direction=direction,
-        scales=scales,
-        grid=grid,
-        **_noise_inputs(args, nm, model, q),
-        method=args.method,
-    )
-    if args.json:
-        from phdesign.io import dumps_json
-
-        text = dumps_json(result.to_dict())
-    else:
-        text = result.to_csv() if args.csv else str(result)
-    if args.output:
-        write_output(args.output, text, args.force)
-    else:
-        emit(text)
-    if args.plot:
-        result.plot(args.plot, force=args.force)
+    # the table and the picture are checked now and written together: both or neither
+    with run_outputs(args) as commit:
+        result = tradeoff(
+            nm,
+            C_m,
+            direction=direction,
+            scales=scales,
+            grid=grid,
+            **_noise_inputs(args, nm, model, q),
+            method=args.method,
+        )
+        commit(_text(args, result), result)
     return 0
 
 
@@ -413,6 +399,16 @@ def noise_tuning(args: argparse.Namespace) -> int | None:
         raise NumericError("--max-rms goes with the abscissa objective")
     if args.full:
         raise NumericError("noise-aware tuning searches positive diagonal gains; drop --full")
+    for flag, value in (
+        ("--starts", args.starts),
+        ("--seed", args.seed),
+        ("--robust", args.robust),
+    ):
+        if value is not None:  # they steer the abscissa search only
+            raise NumericError(
+                f"{flag} belongs to the abscissa search; the noise-aware tuning (--max-rms, "
+                f"--objective rms) does not take it: drop {flag}"
+            )
     for flag, value in (("--max-rms", args.max_rms), ("--min-decay", args.min_decay)):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise NumericError(f"{flag} must be a positive number; found {value}")

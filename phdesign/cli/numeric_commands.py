@@ -41,6 +41,9 @@ from phdesign.errors import NumericError
 
 __all__ = ["register"]
 
+#: Local searches of ``tune`` (the library's default is 3; two suffice from the grid).
+TUNE_STARTS = 2
+
 
 def _add_discretization(parser: argparse.ArgumentParser, default_hint: str) -> None:
     parser.add_argument(
@@ -136,17 +139,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     add_model_argument(tn)
     add_observer_arguments(tn, gain=False)
     tn.add_argument("--full", action="store_true", help="full L instead of positive diagonal")
+    # None: not given (the noise-aware tuning refuses them), then the defaults below
     tn.add_argument(
         "--starts",
         type=int,
-        default=2,
-        help="local searches, from the best points of the grid; default: %(default)s",
+        help=f"local searches, from the best points of the grid; default: {TUNE_STARTS}",
     )
     tn.add_argument(
         "--seed",
         type=non_negative_int,
-        default=0,
-        help="seed of the random grid (more than 625 points); default: %(default)s",
+        help="seed of the random grid (more than 625 points: five or more sensors); default: 0",
     )
     tn.add_argument(
         "--robust",
@@ -227,7 +229,7 @@ def _simulate(args: argparse.Namespace) -> int:
     noisy = stochastic_simulation(args)
     with run_outputs(args) as commit:
         with np.errstate(all="ignore"):  # an overflow is refused below, with one line
-            res = sampled_simulation(args, plant.numeric, C_m, L, x0, xhat0)
+            res = sampled_simulation(args, plant.numeric, C_m, L, x0, xhat0, u)
             if res is None and noisy is not None:
                 res = noisy(
                     plant.numeric,
@@ -322,7 +324,8 @@ def _tune(args: argparse.Namespace) -> int:
 
     if (noisy := noise_tuning(args)) is not None:  # --max-rms / --objective rms
         return noisy
-    check_positive("--starts", args.starts)
+    starts = TUNE_STARTS if args.starts is None else args.starts
+    check_positive("--starts", starts)
     robust = _robust_fraction(args.robust)
     model = load_model(args)
     observer = observer_from_args(args, model)  # argparse requires --sensors or --cm here
@@ -333,8 +336,8 @@ def _tune(args: argparse.Namespace) -> int:
             observer.plant.numeric,
             C_m,
             full=args.full,
-            starts=args.starts,
-            seed=args.seed,
+            starts=starts,
+            seed=0 if args.seed is None else args.seed,
             robust=robust,
             progress=progress,
         )

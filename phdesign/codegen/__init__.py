@@ -7,7 +7,8 @@ significant digits, which reproduces every double exactly.
 
 Every export is all or nothing: a single file goes through
 :func:`phdesign.io.atomic_write`; the C folder is written into a temporary folder next to
-the target and renamed into place (:func:`write_directory`).
+the target and renamed into place (:func:`write_directory`), and ``force`` replaces only a
+folder that phdesign wrote (:mod:`phdesign.codegen.folder`).
 """
 
 from __future__ import annotations
@@ -15,14 +16,13 @@ from __future__ import annotations
 import io
 import json
 import os
-import shutil
 import tempfile
-from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from phdesign.codegen.folder import MARKER, check_export_folder, write_directory
 from phdesign.errors import NumericError, OutputFileError
 
 if TYPE_CHECKING:
@@ -30,7 +30,9 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FORMATS",
+    "MARKER",
     "check_export_path",
+    "escaped",
     "render_c",
     "render_statespace",
     "write_directory",
@@ -52,23 +54,18 @@ def check_export_path(path: str | os.PathLike[str], format: str, force: bool = F
     ------
     OutputFileError
         If the path exists and ``force`` is false, has the wrong kind (a file where the C
-        folder goes, a folder where a file goes), or its folder is missing or not writable.
+        folder goes, a folder where a file goes, a symbolic link, a FIFO, a device), is a
+        folder phdesign did not write (:func:`~phdesign.codegen.folder.check_export_folder`),
+        or its folder is missing or not writable.
     """
     if format not in FORMATS:
         raise NumericError(f"unknown export format {format!r}; expected one of {FORMATS}")
-    target = Path(path)
-    if format != "c":
+    if format == "c":
+        target, _ = check_export_folder(path, force)
+    else:
         from phdesign.io import check_output_path
 
-        check_output_path(target, force)
-    elif target.exists() and not target.is_dir():
-        raise OutputFileError(f"output path {str(target)!r} is a file; --format c writes a folder")
-    elif target.exists() and not force:
-        raise OutputFileError(f"output folder {str(target)!r} exists; pass --force to replace it")
-    elif not target.parent.is_dir():
-        raise OutputFileError(
-            f"cannot write {str(target)!r}: folder {str(target.parent)!r} does not exist"
-        )
+        target = check_output_path(path, force)
     try:
         with tempfile.TemporaryFile(dir=target.parent):
             pass
@@ -77,62 +74,42 @@ def check_export_path(path: str | os.PathLike[str], format: str, force: bool = F
     return target
 
 
-def write_directory(
-    path: str | os.PathLike[str], files: Mapping[str, str | bytes], force: bool = False
-) -> None:
-    """Write ``files`` (name → content) as the folder ``path``: all of them or none.
-
-    They are written into a temporary folder next to ``path``, which is then renamed to
-    ``path``; an existing folder (``force``) is first renamed aside and removed last, and
-    put back if the final rename fails.
-    """
-    target = check_export_path(path, "c", force)
-    try:
-        staging = Path(
-            tempfile.mkdtemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-        )
-    except OSError as error:
-        raise OutputFileError(f"cannot write {str(target)!r}: {error.strerror}") from None
-    aside: Path | None = None
-    try:
-        for name, content in files.items():
-            data = content.encode("utf-8") if isinstance(content, str) else content
-            (staging / name).write_bytes(data)
-        umask = os.umask(0)
-        os.umask(umask)
-        staging.chmod(0o777 & ~umask)  # mkdtemp creates 0700
-        if target.exists():
-            aside = Path(tempfile.mkdtemp(dir=target.parent, prefix=f".{target.name}.old."))
-            aside.rmdir()
-            target.rename(aside)
-        try:
-            staging.rename(target)
-        except OSError:
-            if aside is not None:
-                aside.rename(target)
-                aside = None
-            raise
-    except OSError as error:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise OutputFileError(f"cannot write {str(target)!r}: {error.strerror}") from None
-    if aside is not None:
-        shutil.rmtree(aside, ignore_errors=True)
-
-
 def _double(value: float) -> str:
     """Format as a C and Python literal with 17 significant digits (exact for doubles)."""
     text = format(float(value), ".17g")
     return text if any(c in text for c in ".en") else text + ".0"
 
 
-def _safe(text: str) -> str:
-    """Text that cannot close a C comment or a Python docstring."""
-    return (
-        "".join(c if c.isprintable() else " " for c in text)
-        .replace("*/", "* /")
-        .replace('"""', "'''")
-        .replace("\\", "/")
-    )
+def escaped(text: str) -> str:
+    r"""Return ``text`` as it may stand in a C comment and in a Python docstring or comment.
+
+    Text from a model (its name) or from a caller (a file name, a signal label) reaches the
+    generated sources only through here. The result is one line of printable ASCII in
+    which no C comment opens or closes (``/*``, ``*/``), no trigraph forms (``??/`` is a
+    backslash in C99) and no quote can end a docstring; every character that would is
+    written as a Python escape sequence, so that the docstring reads back the text exactly.
+
+    Examples
+    --------
+    >>> print(escaped('beam */ #include "x" ??/ é\n'))
+    beam *\x2f #include \"x\" ?\x3f/ \xe9\n
+    """
+    out = []
+    for i, char in enumerate(text):
+        # at either end the template's next character is unknown: count it as a '*'
+        before = text[i - 1] if i else "*"
+        after = text[i + 1] if i + 1 < len(text) else "*"
+        if char in '\\"':
+            out.append("\\" + char)
+        elif char == "/" and "*" in (before, after):
+            out.append("\\x2f")
+        elif char == "?" and before == "?":
+            out.append("\\x3f")
+        elif char.isascii() and char.isprintable():
+            out.append(char)
+        else:
+            out.append(ascii(char)[1:-1])  # \n, \x00, \xe9, \u2028, \U0001f600
+    return "".join(out)
 
 
 def _environment() -> Any:
@@ -157,7 +134,9 @@ def _context(observer: SampledObserver, filename: str = "observer.py") -> dict[s
     from phdesign import __version__
 
     states = [f"xhat{i + 1}" for i in range(observer.order)]
-    inputs, outputs = list(observer.inputs), list(observer.outputs)
+    inputs = [escaped(name) for name in observer.inputs]  # as comments show them
+    outputs = [escaped(name) for name in observer.outputs]
+    signals = observer.signal_names()
     meaning = {
         "A": "state update, x[k+1] = A x[k] + B v[k]",
         "B": "input map of the state update",
@@ -189,18 +168,22 @@ def _context(observer: SampledObserver, filename: str = "observer.py") -> dict[s
     )
     return {
         "banner": BANNER.format(version=__version__),
-        "model": _safe(observer.model),
+        "model": escaped(observer.model),
         "order": observer.order,
         "dt": _double(observer.dt),
         "dt_text": f"{observer.dt:g}",
-        "sampler": observer.sampler,
+        "sampler": escaped(observer.sampler),
         "sampler_text": sampler_text,
         "timing": timing,
         "inputs": inputs,
         "outputs": outputs,
         "states": states,
+        # Python literals (repr writes any text as a valid one) of the python-control names
+        "input_list": repr(list(signals[0])),
+        "output_list": repr(list(signals[1])),
+        "state_list": repr(states),
         "matrices": matrices,
-        "filename": _safe(filename),
+        "filename": escaped(filename),
     }
 
 
@@ -250,9 +233,7 @@ def write_observer(
     if not all(np.all(np.isfinite(m)) for m in matrices):
         raise NumericError("the observer's matrices are not finite: nothing was written")
     if format == "c":
-        files = render_c(observer)
-        write_directory(target, files, force=force)
-        return [str(target / name) for name in files]
+        return write_directory(target, render_c(observer), force=force)
     if format == "json":
         data: str | bytes = json.dumps(observer.to_dict(), allow_nan=False) + "\n"
     elif format == "npz":

@@ -48,6 +48,7 @@ from phdesign.numeric.phs import DiscretePHS, feedback_matrix
 
 __all__ = [
     "QUANTITIES",
+    "control_signal_name",
     "error_statespace",
     "observer_statespace",
     "plant_statespace",
@@ -76,8 +77,17 @@ def state_labels(d: DiscretePHS, prefix: str = "") -> list[str]:
     return labels
 
 
+def control_signal_name(label: str) -> str:
+    """Return ``label`` as python-control accepts a signal name: '.' is written 'p'.
+
+    >>> control_signal_name("w(0.5)")
+    'w(0p5)'
+    """
+    return label.replace(".", "p")
+
+
 def _point_name(z: float) -> str:
-    return f"{z:g}".replace(".", "p")
+    return control_signal_name(f"{z:g}")
 
 
 def point_outputs(

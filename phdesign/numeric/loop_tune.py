@@ -91,6 +91,8 @@ class LoopTuneResult:
         """JSON-ready."""
         return {
             "tuned": self.tuned,
+            # the spectrum is the same either way (separation); the loop it describes is not
+            "feedback_source": self.loop.source,
             "feedback": np.asarray(self.loop.K).tolist(),
             "gain": np.asarray(self.loop.L).tolist(),
             "spectral_abscissa": self.report.to_dict()["spectral_abscissa"],

@@ -68,6 +68,7 @@ from scipy.optimize import minimize_scalar
 
 from phdesign.arguments import positive_int, positive_number
 from phdesign.errors import NumericError, ObserverError
+from phdesign.limits import check_noise_intensity
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.functionals import Functional, parse_functionals
@@ -126,6 +127,7 @@ def check_intensity(values: Any, count: int, name: str) -> np.ndarray:
             f"{name}: intensities must be finite and non-negative (variances per unit "
             f"time); found {bad[0]}"
         )
+    check_noise_intensity(float(np.max(arr)) if arr.size else 0.0, name)
     return arr
 
 
@@ -574,10 +576,8 @@ def _figure_warnings(label: str, est: Estimate, tol: float, smooth_hint: bool) -
             "steady-state error energy; only smooth functionals of the error have a "
             "finite variance"
         )
-        return [
-            f"{label} diverges under refinement ({values} at resolutions {at}; grows like "
-            f"p^{est.growth:.2f}): {why}"
-        ]
+        grows = "" if est.growth is None else f"; grows like p^{est.growth:.2f}"
+        return [f"{label} diverges under refinement ({values} at resolutions {at}{grows}): {why}"]
     if not est.converged and len(est.values) >= 2 and all(map(math.isfinite, est.values)):
         return [f"{label} did not converge to {tol:g} ({values} at resolutions {at})"]
     return []

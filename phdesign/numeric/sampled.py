@@ -41,6 +41,7 @@ import numpy as np
 from phdesign.arguments import positive_number
 from phdesign.errors import ArgumentError, NumericError
 from phdesign.export_defaults import EXPORT
+from phdesign.limits import check_periods
 from phdesign.numeric.arguments import check_initial_state
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.order import REDUCTIONS, OrderSelection, check_order, select_order
@@ -48,6 +49,7 @@ from phdesign.numeric.sampling import (
     ContinuousObserver,
     check_sampling,
     default_initial_state,
+    displacement_label,
 )
 from phdesign.numeric.verification import (
     Verification,
@@ -61,6 +63,7 @@ __all__ = [
     "FORMATS",
     "SampledObserver",
     "Verification",
+    "displacement_points",
     "export_observer",
     "verification_plant_degree",
     "verify_observer",
@@ -144,18 +147,32 @@ class SampledObserver:
             x, out[k] = self.step(x, v)
         return out
 
+    def signal_names(self) -> tuple[tuple[str, ...], tuple[str, ...]]:
+        """Return the inputs' and outputs' names as python-control takes them.
+
+        python-control refuses '.' in a signal name: ``w(0.5)`` is ``w(0p5)`` there
+        (:func:`~phdesign.numeric.export.control_signal_name`).
+        """
+        from phdesign.numeric.export import control_signal_name
+
+        return (
+            tuple(control_signal_name(name) for name in self.inputs),
+            tuple(control_signal_name(name) for name in self.outputs),
+        )
+
     def statespace(self) -> Any:
-        """``control.StateSpace(A, B, C, D, dt)`` with the signal names."""
+        """``control.StateSpace(A, B, C, D, dt)`` with the signal names (:meth:`signal_names`)."""
         import control
 
+        inputs, outputs = self.signal_names()
         return control.ss(
             self.A,
             self.B,
             self.C,
             self.D,
             self.dt,
-            inputs=list(self.inputs),
-            outputs=list(self.outputs),
+            inputs=list(inputs),
+            outputs=list(outputs),
             states=[f"xhat{i + 1}" for i in range(self.order)],
             name="observer",
         )
@@ -188,7 +205,9 @@ class SampledObserver:
 
         ``json``, ``npz`` and ``statespace`` (a Python module that rebuilds the
         ``control.StateSpace``) write one file; ``c`` writes a folder holding
-        ``observer.h`` and ``observer.c``, all files or none.
+        ``observer.h``, ``observer.c`` and the marker ``.phdesign-export``, all files or
+        none. ``force`` replaces a file, or a folder phdesign wrote and nothing else
+        (:mod:`phdesign.codegen.folder`).
         """
         from phdesign.codegen import write_observer
 
@@ -283,24 +302,37 @@ def _plant_degree(nm: NumericModel, order: int | None, plant_resolution: int | N
     return max(PLANT_DEGREE, needed)
 
 
-def _displacement_points(nm: NumericModel, points: Any) -> tuple[float, ...]:
-    """Return the points of the outputs ``w(z)``: numbers of [a, b] (default: b, if any)."""
+def displacement_points(nm: NumericModel, points: Any, name: str = "points") -> tuple[float, ...]:
+    """Return the points of the outputs ``w(z)``: numbers of [a, b] (default: b, if any).
+
+    Two points may not give one output name (:func:`displacement_label`, 6 significant
+    digits): ``1, 1`` would be two outputs ``w(1)``. ``name`` is how the points are called
+    in the messages (``"--at"`` on the command line).
+    """
     if points is None:
         return (nm.interval[1],) if nm.displacement is not None else ()
     a, b = nm.interval
     if nm.displacement is None and np.size(points):
         raise NumericError(
-            f"points: model {nm.name!r} has no displacement: drop the displacement points"
+            f"{name}: model {nm.name!r} has no displacement: drop the displacement points"
         )
     try:
         values = tuple(float(z) for z in np.asarray(points, dtype=float).ravel())
     except (TypeError, ValueError):
         raise NumericError(
-            f"points: expected numbers in [{a:g}, {b:g}]; found {points!r}"
+            f"{name}: expected numbers in [{a:g}, {b:g}]; found {points!r}"
         ) from None
     outside = [z for z in values if not (math.isfinite(z) and a <= z <= b)]
     if outside:
-        raise NumericError(f"points: expected numbers in [{a:g}, {b:g}]; found {outside[0]:g}")
+        raise NumericError(f"{name}: expected numbers in [{a:g}, {b:g}]; found {outside[0]:g}")
+    labels = [displacement_label(z) for z in values]
+    for i, label in enumerate(labels):
+        if label in labels[:i]:
+            first = values[labels.index(label)]
+            raise NumericError(
+                f"{name}: {first!r} and {values[i]!r} both give the output {label}; expected "
+                "distinct points (6 significant digits)"
+            )
     return values
 
 
@@ -379,11 +411,12 @@ def export_observer(
         raise NumericError(f"t_end must be a finite positive number; found {t_end!r}")
     if not isinstance(verify, bool):
         raise ArgumentError(f"verify must be True or False; found {verify!r}")
+    check_periods(dt, float(t_end), stepped=verify)
     positive_number(tol, "tol")
     positive_number(output_tol, "output_tol")
     check_initial_state(x0, nm, "x0")
     plant_degree = verification_plant_degree(nm, order, plant_resolution, reduction)
-    points = _displacement_points(nm, points)
+    points = displacement_points(nm, points)
     plant = discretize(nm, "galerkin", plant_degree)
     initial = default_initial_state(nm.size, nm.interval) if x0 is None else x0
     text = x0_text or ("x_i = (z - a)/(b - a) - 0.9 for every component" if x0 is None else "x0")

@@ -22,6 +22,8 @@ from collections.abc import Callable
 import numpy as np
 
 from phdesign.errors import NumericError
+from phdesign.limits import check_periods
+from phdesign.numeric.arguments import input_samples
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
 from phdesign.numeric.phs import DiscretePHS
@@ -113,9 +115,13 @@ def simulate_sampled(
         raise NumericError(f"t_end must be a positive number; found {t_end}")
     if int(samples) < 2:
         raise NumericError(f"samples must be at least 2; found {samples}")
+    if dt is not None:
+        check_periods(check_sampling(dt, sampler), t_end)
     plant = discretize(nm, method, resolution)
     same = observer_resolution is None or int(observer_resolution) == plant.resolution
     d_obs = plant if same else discretize(nm, method, observer_resolution)
+    if dt is not None and u is not None:  # every period is stepped, with its input
+        check_periods(float(dt), t_end, states=plant.dim + d_obs.dim)
     P = embedding(d_obs, plant)
     points: tuple[float, ...] = ()
     if plant.displacement_basis is not None:
@@ -132,9 +138,7 @@ def simulate_sampled(
     zero = lambda z: np.zeros((np.atleast_1d(z).size, nm.size))  # noqa: E731
     U = None
     if u is not None:
-        U = np.array(
-            [np.asarray(u(k * step), dtype=float).reshape(nm.n_ports) for k in range(n_steps + 1)]
-        )
+        U = input_samples(u, step * np.arange(n_steps + 1), nm.n_ports)
     e0 = plant.project(x0 or zero)
     xh0 = d_obs.project(xhat0 or zero)
     kind = None if dt is None else sampler

@@ -112,6 +112,15 @@ def check_sampling(dt: object, sampler: object, *, dt_name: str = "dt") -> float
     return value
 
 
+def displacement_label(z: float) -> str:
+    """Return the name of the output ``w(z)``: the point with 6 significant digits.
+
+    >>> displacement_label(0.5), displacement_label(1.0)
+    ('w(0.5)', 'w(1)')
+    """
+    return f"w({z:g})"
+
+
 def sensor_names(C_m: np.ndarray) -> tuple[str, ...]:
     """``y<i>`` for a row of C_m that picks output i, ``y_m<j>`` for a combination.
 
@@ -214,7 +223,7 @@ class ContinuousObserver:
                 )
             rows.append(d.displacement_basis(pts))
             feed.append(np.zeros((pts.size, closed.B.shape[1])))
-            outputs += [f"w({z:g})" for z in pts]
+            outputs += [displacement_label(float(z)) for z in pts]
         performance = tuple(range(m, m + pts.size)) if pts.size else tuple(range(m))
         return cls(
             A=closed.A,

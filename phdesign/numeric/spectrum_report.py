@@ -286,7 +286,7 @@ class SpectrumReport:
         The default window frames the resolved eigenvalues (the unresolved ones run far
         off); see :func:`phdesign.plots.plot_spectrum` for the arguments.
         """
-        from phdesign.plots import plot_spectrum
+        from phdesign.plots import literal, plot_spectrum
 
         lam = self.eigenvalues
         if xlim is None and ylim is None and self.resolved.any():
@@ -304,7 +304,7 @@ class SpectrumReport:
             ax=ax,
             abscissa=self.spectral_abscissa,
             exact=exact,
-            title=title if title is not None else f"{self.model}: {self.system}",
+            title=title if title is not None else literal(f"{self.model}: {self.system}"),
             xlim=xlim,
             ylim=ylim,
         )

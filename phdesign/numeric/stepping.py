@@ -271,7 +271,16 @@ def dissipation_integral(F: np.ndarray, P: np.ndarray, dt: float) -> np.ndarray:
     Van Loan's block holds exp(-Fᵀ δ), which overflows for the stiff, strongly damped
     modes of a fine discretization; so it is applied on a step δ = dt/2^m with
     ‖F‖δ ≤ 1 and doubled back up: G(2δ) = G(δ) + exp(Fδ)ᵀ G(δ) exp(Fδ).
+
+    G is linear in P, so it is computed for P / max|P| and scaled back: a large P (the
+    covariance of a noise of intensity 1e20) would otherwise set the block exponential's
+    scaling, whose squarings then overflow to NaN (and the noise was lost).
     """
+    size = float(np.max(np.abs(P))) if P.size else 0.0
+    if size == 0.0 or not np.isfinite(size):
+        return np.zeros_like(P) if size == 0.0 else np.full_like(P, np.nan)
+    if size != 1.0:
+        return size * dissipation_integral(F, P / size, dt)
     n = F.shape[0]
     norm = float(np.linalg.norm(F, 1)) * dt
     doublings = max(0, int(np.ceil(np.log2(norm)))) if norm > 1 else 0

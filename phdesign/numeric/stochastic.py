@@ -46,7 +46,9 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sl
 
+from phdesign.arguments import positive_int
 from phdesign.errors import NumericError, ObserverError
+from phdesign.numeric.arguments import input_samples
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.noise import noise_intensities
@@ -171,9 +173,11 @@ def simulate_noisy(
         )
     if noise_intensity is not None and C_m is None:
         raise ObserverError("sensor noise needs an observer: give the sensors C_m and gain L")
-    d = discrete if discrete is not None else discretize(nm, method, resolution)
+    if seed is not None:
+        positive_int(seed, "seed", minimum=0)  # numpy's own message is a traceback
     q = 0 if C_m is None else np.atleast_2d(C_m).shape[0]
     sigma, w_in = noise_intensities(nm, q, noise_intensity, input_intensity, default=0.0)
+    d = discrete if discrete is not None else discretize(nm, method, resolution)
     base = simulate(
         nm, C_m, L, x0=x0, xhat0=xhat0, t_end=t_end, samples=samples, u=u, z_w=z_w, discrete=d
     )
@@ -186,7 +190,7 @@ def simulate_noisy(
     else:
         extra = np.zeros((t.size, E2.shape[0]))
     eh = np.asarray(base.states) + extra[:, :n]
-    U = None if u is None else np.array([np.asarray(u(float(tk)), float) for tk in t])
+    U = None if u is None else input_samples(u, t, d.n_ports)
     changes: dict[str, Any] = {"states": eh, "H": d.hamiltonian(eh), "y": d.output(eh, U)}
     if C_m is not None and L is not None:
         eo = np.asarray(base.states_hat) + extra[:, n:]

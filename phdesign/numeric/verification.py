@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from phdesign.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.order import OrderSelection, check_order
 from phdesign.numeric.sampling import ContinuousObserver, check_sampling, run_against_continuous
@@ -158,6 +159,7 @@ def verify_observer(
     on the same instants (every ``stride`` periods, about ``samples`` records).
     """
     dt = check_sampling(dt, sampler)
+    check_periods(dt, t_end)
     check_order(observer.order, plant.dim, plant.resolution)
     n_steps = max(1, round(t_end / dt))
     stride = max(1, round(t_end / ((max(samples, 2) - 1) * dt)))

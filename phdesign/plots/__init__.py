@@ -40,7 +40,7 @@ Examples
 
 from __future__ import annotations
 
-from phdesign.plots._figures import new_figure
+from phdesign.plots._figures import literal, new_figure
 from phdesign.plots.deflection import (
     plot_deflection,
     plot_deflection_panels,
@@ -54,6 +54,7 @@ from phdesign.plots.spectra import plot_abscissa_sweep, plot_gain_map, plot_spec
 
 __all__ = [
     "check_plot_path",
+    "literal",
     "new_figure",
     "plot_abscissa_sweep",
     "plot_deflection",

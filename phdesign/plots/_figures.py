@@ -38,6 +38,21 @@ DESIGN_COLORS = ("goldenrod", "tab:orange", "tab:purple", "tab:green", "tab:brow
 SI_UNITS = {"t": "s", "z": "m", "energy": "J", "displacement": "m"}
 
 
+def literal(text: str) -> str:
+    r"""Return ``text`` as a figure shows it literally: never as matplotlib mathtext.
+
+    Text from a model (its name, in every title that names the model) may hold ``$``:
+    an even number of them makes matplotlib parse mathtext, and ``$\frac{1}{$`` then
+    fails when the figure is drawn. An escaped dollar is drawn as a dollar.
+
+    Examples
+    --------
+    >>> literal("$\\frac{1}{$ beam")
+    '\\$\\frac{1}{\\$ beam'
+    """
+    return text.replace("$", r"\$")
+
+
 def unit_label(result: Any, text: str, quantity: str) -> str:
     """``text [unit]`` with the unit of ``quantity`` that ``result``'s model states."""
     units = getattr(result, "units", None)

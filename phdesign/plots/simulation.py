@@ -14,6 +14,7 @@ from phdesign.errors import OutputFileError
 from phdesign.plots._figures import (
     DESIGN_COLORS,
     legend_in_view,
+    literal,
     new_figure,
     require,
     unit_label,
@@ -110,7 +111,7 @@ def plot_simulation(
     if title is None:
         title = getattr(result, "title", None)
     if title:  # a title, never mathtext: a model named "$\frac{1}{$" must not break it
-        fig.suptitle(title.replace("$", r"\$"))
+        fig.suptitle(literal(title))
     if path is not None:
         from phdesign.io import atomic_write
 
