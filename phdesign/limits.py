@@ -61,6 +61,23 @@ Searches and numerics (checked at the entry of each library function)
                                              distinct normal floats
     ``MAX_STARTS``              100          starts of the gain tuning
     ``MAX_TUNE_ITERATIONS``     10 000       optimizer iterations per start
+    ``MAX_TRADEOFF_GAINS``      1000         gains of a trade-off (scales of a ray, or the
+                                             product of a grid's counts); each costs a
+                                             spectrum and the noise figures (about 0.5 s on
+                                             the beam), checked before the gains are built
+    =========================  ===========  ===============================================
+
+Sweeps (:mod:`phdesign.sweep`, checked before any store is created or worker started)
+    =========================  ===========  ===============================================
+    ``MAX_SWEEP_POINTS``        1 000 000    points of a sweep (the product of its axes;
+                                             each axis, and the sensor sets ``all``, are
+                                             checked before their values are built): a
+                                             10⁶-point beam map is 3 h on one core
+                                             (``docs/scaling.md``)
+    ``MAX_WORKERS_PER_CORE``    1            workers of a local cluster per core this
+                                             process may use: each is a process of about
+                                             150 MB, and the jobs are CPU-bound (more
+                                             workers than cores cost memory, not time)
     =========================  ===========  ===============================================
 
 Examples
@@ -79,7 +96,7 @@ import numbers
 import operator
 from typing import Any
 
-from phdesign.errors import ModelError, ModelFileError, NumericError, ObserverError
+from phdesign.errors import ModelError, ModelFileError, NumericError, ObserverError, SweepError
 
 __all__ = [
     "EXACT_DEFINITENESS_BITS",
@@ -103,14 +120,20 @@ __all__ = [
     "MAX_SIMULATION_VALUES",
     "MAX_SIZE",
     "MAX_STARTS",
+    "MAX_SWEEP_POINTS",
+    "MAX_TRADEOFF_GAINS",
     "MAX_TUNE_ITERATIONS",
     "MAX_T_END",
+    "MAX_WORKERS_PER_CORE",
     "MIN_TIME_STEP",
     "check_discretization",
+    "check_local_workers",
     "check_model_dimensions",
     "check_parameter_count",
     "check_sensor_outputs",
     "check_simulation",
+    "check_sweep_points",
+    "check_tradeoff_gains",
     "check_tuning",
 ]
 
@@ -142,6 +165,10 @@ MAX_T_END = 1e12
 MIN_TIME_STEP = 1e-300
 MAX_STARTS = 100
 MAX_TUNE_ITERATIONS = 10_000
+MAX_TRADEOFF_GAINS = 1000
+# ---------------------------------------------------------------- sweeps
+MAX_SWEEP_POINTS = 1_000_000
+MAX_WORKERS_PER_CORE = 1
 
 #: The resolution a discretization uses when none is given is at most this (the finite
 #: differences' 70 nodes per group; Galerkin uses 40, or 16 for N >= 3): the estimate of
@@ -322,3 +349,36 @@ def check_tuning(
     if resolution is not None:
         fine = math.ceil(1.5 * _integer(resolution, "resolution", NumericError))
         check_discretization(nm, "galerkin", resolution, fine)
+
+
+def check_tradeoff_gains(count: int, what: str) -> None:
+    """Refuse a trade-off of more than :data:`MAX_TRADEOFF_GAINS` gains (before building them).
+
+    ``what`` names the argument for the message (``"scales"``, ``"grid"``).
+    """
+    if count > MAX_TRADEOFF_GAINS:
+        raise NumericError(
+            f"{what} gives {count:,} gains; a trade-off evaluates at most "
+            f"{MAX_TRADEOFF_GAINS:,} (a spectrum and the noise figures at each, about 0.5 s "
+            f"apiece on the beam; {_budget('MAX_TRADEOFF_GAINS')})"
+        )
+
+
+def check_sweep_points(count: int, what: str) -> None:
+    """Refuse a sweep, or one of its axes, of more than :data:`MAX_SWEEP_POINTS` points."""
+    if count > MAX_SWEEP_POINTS:
+        raise SweepError(
+            f"{what} has {count:,} points; a sweep has at most {MAX_SWEEP_POINTS:,} "
+            f"({_budget('MAX_SWEEP_POINTS')}): split the study into several sweeps"
+        )
+
+
+def check_local_workers(workers: int, cores: int) -> None:
+    """Refuse more local workers than :data:`MAX_WORKERS_PER_CORE` per usable core."""
+    cap = max(1, MAX_WORKERS_PER_CORE * cores)
+    if workers > cap:
+        raise SweepError(
+            f"workers: a local cluster has at most {cap} workers on this machine "
+            f"({MAX_WORKERS_PER_CORE} per core it may use, {_budget('MAX_WORKERS_PER_CORE')}: "
+            f"each worker is a process of about 150 MB); found {workers}"
+        )

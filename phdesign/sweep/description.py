@@ -35,11 +35,13 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from phdesign.errors import ParameterError, PhdesignError, SweepError
+from phdesign.limits import check_sweep_points
 from phdesign.sweep.grids import Axis, parse_axis, parse_sensor_sets, sensor_set_indices
 from phdesign.sweep.jobs import Job, get_job
 
@@ -273,6 +275,33 @@ def _fixed_gain(gain: str | Sequence[float] | float, count: int, per: str) -> tu
     return values
 
 
+#: A parameter axis of at most this many values is checked at every value before the sweep
+#: starts (5 to 10 ms each); a longer one at its ends, and a chunk that meets a refused
+#: value names its point (and a store the sweep created is removed again).
+_CHECKED_PARAMETER_VALUES = 256
+
+
+def _parameter_axis(name: str, text: Any, known: tuple[str, ...]) -> Axis:
+    if name not in known:
+        raise ParameterError(
+            f"unknown parameter {name!r}; the model's parameters are "
+            f"{', '.join(known) if known else 'none'}"
+        )
+    return parse_axis(name, text, "parameter")
+
+
+def _check_parameter_values(model: Any, axis: Axis) -> None:
+    """Refuse a value of a parameter axis the model refuses (the others at their values)."""
+    values = axis.values
+    if len(values) > _CHECKED_PARAMETER_VALUES:
+        values = (values[0], values[-1])
+    for value in values:
+        try:
+            model.with_parameters({axis.name: value})
+        except PhdesignError as error:
+            raise type(error)(f"parameter grid {axis.name} = {value!r}: {error}") from None
+
+
 def describe(
     model: Any,
     *,
@@ -376,23 +405,7 @@ def describe(
                 "(or l for every entry)"
             )
 
-    param_axes = []
-    for name, text in (param_grid or {}).items():
-        if name not in known:
-            raise ParameterError(
-                f"unknown parameter {name!r}; the model's parameters are "
-                f"{', '.join(known) if known else 'none'}"
-            )
-        axis = parse_axis(name, text, "parameter")
-        # the ends of the axis, the other parameters fixed: cheap, and it catches most bad
-        # ranges before any work; a chunk that meets a refused value names its point
-        for value in sorted({axis.values[0], axis.values[-1]}):
-            try:
-                model.with_parameters({name: value})
-            except PhdesignError as error:
-                raise type(error)(f"parameter grid {name} = {value!r}: {error}") from None
-        param_axes.append(axis)
-
+    param_axes = [_parameter_axis(name, text, known) for name, text in (param_grid or {}).items()]
     axes = tuple(([set_axis] if set_axis else []) + param_axes + gain_axes)
     if not axes:
         raise SweepError(
@@ -400,13 +413,18 @@ def describe(
         )
     if len({a.name for a in axes}) != len(axes):
         raise SweepError("an axis is given twice")
+    check_sweep_points(math.prod(a.size for a in axes), "the sweep")
+    for axis in param_axes:
+        _check_parameter_values(model, axis)
+    option_values = spec.option_values(options)
+    spec.check_options(model, option_values)
     return SweepDescription(
         model_toml=model_to_toml(model),
         model_name=str(model.name),
         n_outputs=n_outputs,
         parameter_names=known,
         job=job,
-        options=tuple(sorted(spec.option_values(options).items())),
+        options=tuple(sorted(option_values.items())),
         axes=axes,
         sensors=fixed_sensors,
         gain=fixed_gain,

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from phdesign.errors import SweepError
+from phdesign.limits import MAX_MAGNITUDE, check_sweep_points
 
 __all__ = [
     "AXIS_KINDS",
@@ -49,7 +50,6 @@ __all__ = [
 
 AXIS_KINDS = ("gain", "parameter", "sensors")
 _GAIN_NAME = re.compile(r"^l([1-9][0-9]*)?$")
-_MAX_POINTS = 10**9  # per axis: beyond this the count is a typo, not a study
 
 
 @dataclass(frozen=True)
@@ -97,6 +97,15 @@ class Axis:
         if self.kind == "gain" and values[0] <= 0:
             raise SweepError(
                 f"gain axis {self.name}: gains must be positive (L + Lᵀ ≻ 0); found {values[0]!r}"
+            )
+        if (
+            self.kind == "gain"
+            and not 1 / MAX_MAGNITUDE <= values[0] <= values[-1] <= MAX_MAGNITUDE
+        ):
+            bad = values[0] if values[0] < 1 / MAX_MAGNITUDE else values[-1]
+            raise SweepError(
+                f"gain axis {self.name}: gains must lie between {1 / MAX_MAGNITUDE:g} and "
+                f"{MAX_MAGNITUDE:g}, as every gain; found {bad!r}"
             )
         if self.scale == "log" and values[0] <= 0:
             raise SweepError(
@@ -164,8 +173,7 @@ def _range(name: str, spec: str) -> tuple[tuple[float, ...], str]:
     log = len(parts) == 4
     if count == 0:
         raise SweepError(f"grid {name}: count must be at least 1; found zero points in {spec!r}")
-    if count > _MAX_POINTS:
-        raise SweepError(f"grid {name}: count must be at most {_MAX_POINTS}; found {count}")
+    check_sweep_points(count, f"grid {name}")  # before the values are built
     if log and (start <= 0 or stop <= 0):
         raise SweepError(
             f"grid {name}: a log grid needs start > 0 and stop > 0; "
@@ -210,6 +218,8 @@ def parse_axis(name: str, spec: str | Sequence[float], kind: str) -> Axis:
             "(the same gain on every sensor)"
         )
     if not isinstance(spec, str):
+        if hasattr(spec, "__len__"):
+            check_sweep_points(len(spec), f"grid {name}")
         values = tuple(float(v) for v in spec)
         text = ",".join(repr(v) for v in values)
         if not values:
@@ -223,7 +233,9 @@ def parse_axis(name: str, spec: str | Sequence[float], kind: str) -> Axis:
     if ":" in text:
         values, scale = _range(name, text)
     else:
-        values = tuple(_number(p.strip(), f"grid {name} value") for p in text.split(","))
+        items = text.split(",")
+        check_sweep_points(len(items), f"grid {name}")
+        values = tuple(_number(p.strip(), f"grid {name} value") for p in items)
         scale = "linear"
     return Axis(name, kind, values, scale, text)
 
@@ -245,6 +257,7 @@ def parse_sensor_sets(spec: str | Sequence[Sequence[int]], n_outputs: int) -> Ax
     if isinstance(spec, str):
         text = spec.strip()
         if text == "all":
+            check_sweep_points(2**n_outputs - 1, f"sensor sets 'all' of {n_outputs} outputs")
             sets = [
                 combo
                 for size in range(1, n_outputs + 1)

@@ -32,8 +32,17 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from phdesign.errors import SweepError
+from phdesign.limits import check_local_workers
 
-__all__ = ["CONNECT_TIMEOUT", "WORKER_TIMEOUT", "Executor", "executor", "usable_cores"]
+__all__ = [
+    "CONNECT_TIMEOUT",
+    "WORKER_TIMEOUT",
+    "Executor",
+    "check_address",
+    "check_scheduler",
+    "executor",
+    "usable_cores",
+]
 
 CONNECT_TIMEOUT = 4.0  # seconds to reach a scheduler: an error within 10 s, imports included
 WORKER_TIMEOUT = 30.0  # seconds for a reachable cluster to offer a worker
@@ -157,7 +166,16 @@ def _connect(address: str) -> Any:
     return client
 
 
-def _validate(scheduler: Any, workers: int | None) -> None:
+def check_scheduler(scheduler: Any, workers: int | None) -> None:
+    """Refuse a malformed scheduler or worker count before anything starts or is written.
+
+    Raises
+    ------
+    SweepError
+        A worker count that is not a positive integer or exceeds the machine's cores
+        (:func:`phdesign.limits.check_local_workers`), workers with a scheduler of its own,
+        a name that is not a scheduler, or a malformed address (:func:`check_address`).
+    """
     if workers is not None and (
         isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
     ):
@@ -167,14 +185,58 @@ def _validate(scheduler: Any, workers: int | None) -> None:
             "workers sizes the local cluster a sweep starts; it does not apply to "
             f"scheduler {scheduler!r}"
         )
+    if workers is not None:
+        check_local_workers(workers, usable_cores())
     if scheduler is None or not isinstance(scheduler, str):
         return
-    if scheduler in ("synchronous", "local") or "://" in scheduler:
+    if scheduler in ("synchronous", "local"):
+        return
+    if "://" in scheduler:
+        check_address(scheduler)
         return
     raise SweepError(
         f"scheduler: expected 'synchronous', 'local' or an address such as "
         f"tcp://HOST:PORT; found {scheduler!r}"
     )
+
+
+#: The transports of Dask addresses; those with a host and a port are checked in full.
+_TRANSPORTS = ("tcp", "tls", "ws", "wss", "inproc", "ucx")
+_NETWORK = ("tcp", "tls", "ws", "wss")
+
+
+def check_address(address: str) -> None:
+    """Refuse a Dask address that no scheduler can have (before any connection).
+
+    Examples
+    --------
+    >>> check_address("tcp://127.0.0.1:8786")
+    >>> check_address("tcp://[::1]:8786")
+    >>> check_address("tcp://127.0.0.1:0")
+    Traceback (most recent call last):
+    ...
+    phdesign.errors.SweepError: scheduler address 'tcp://127.0.0.1:0': the port must be from 1 ...
+    """
+    shown = f"scheduler address {address!r}"
+    expected = "expected tcp://HOST:PORT with a port from 1 to 65535"
+    try:
+        parts = urlsplit(address)
+        port = parts.port
+    except ValueError as error:  # an unclosed IPv6 bracket, a port that is not a number
+        raise SweepError(f"{shown} is malformed ({error}); {expected}") from None
+    if parts.scheme not in _TRANSPORTS:
+        raise SweepError(
+            f"{shown}: unknown transport {parts.scheme!r}; expected one of "
+            f"{', '.join(_TRANSPORTS)}, as in tcp://HOST:PORT"
+        )
+    if parts.scheme not in _NETWORK:
+        return
+    if not parts.hostname or parts.path not in ("", "/") or parts.query or parts.fragment:
+        raise SweepError(f"{shown} is malformed; {expected}")
+    if parts.username is not None or parts.password is not None:
+        raise SweepError(f"{shown} holds a user name; {expected}")
+    if port is not None and not 1 <= port <= 65535:
+        raise SweepError(f"{shown}: the port must be from 1 to 65535; found {port}")
 
 
 _GUARD = (
@@ -225,7 +287,7 @@ def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Exec
     SweepError
         A malformed scheduler, an unreachable one, or a cluster without workers.
     """
-    _validate(scheduler, workers)
+    check_scheduler(scheduler, workers)
     if scheduler == "synchronous":
         yield Executor("synchronous", 1)
         return

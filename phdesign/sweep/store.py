@@ -16,12 +16,19 @@ for, so that a sweep killed at any instant resumes with exactly the chunks it ha
 finished (a chunk written without its marker is computed again and overwritten).  A
 store is resumed only by the sweep it describes: any difference in the description (the
 model, job, options, axes, sensors, gain or phdesign version) is refused.
+
+Only a Zarr store or a regular file at the path is replaced (``force``), and only while
+the store's lock is held (:mod:`phdesign.sweep.lock`, taken by
+:func:`~phdesign.sweep.execute.run`); symbolic links, FIFOs, sockets and devices are
+refused whatever the flags, and a folder that is not a Zarr store is never replaced.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -37,6 +44,25 @@ from phdesign.sweep.plan import ChunkPlan
 __all__ = ["ZarrStore"]
 
 _MARKERS = ".phdesign"
+
+
+def _kind(path: Path) -> str:
+    """Say what is at ``path``, not following a symbolic link (``"missing"``, ``"folder"``...)."""
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return "missing"
+    except (OSError, ValueError) as error:  # ValueError: an embedded NUL byte
+        raise OutputFileError(f"cannot write {str(path)!r}: {error}") from None
+    if stat.S_ISDIR(mode):
+        return "folder"
+    if stat.S_ISREG(mode):
+        return "file"
+    if stat.S_ISLNK(mode):
+        return "a symbolic link"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO"
+    return "a socket" if stat.S_ISSOCK(mode) else "a device"
 
 
 @dataclass(frozen=True)
@@ -106,14 +132,20 @@ class ZarrStore:
         where = str(self.path)
         if resume and force:
             raise SweepError("choose one of resume (continue the store) and force (replace it)")
-        if not self.path.exists():
+        kind = _kind(self.path)
+        if kind == "missing":
             if not self.path.parent.is_dir():
                 raise OutputFileError(
                     f"cannot write {where!r}: folder {str(self.path.parent)!r} does not exist"
                 )
             return "create"
+        if kind not in ("folder", "file"):
+            raise OutputFileError(
+                f"output {where!r} is {kind}; a sweep writes its store only where there is "
+                "nothing, a file or a Zarr store, even with --force (name the store itself)"
+            )
         if force:
-            if self.path.is_dir() and not self.is_zarr:
+            if kind == "folder" and not self.is_zarr:
                 raise OutputFileError(
                     f"output {where!r} is a folder that is not a Zarr store; "
                     "refusing to replace it"
@@ -152,18 +184,28 @@ class ZarrStore:
         return stored[1]
 
     def create(
-        self, template: Any, description: SweepDescription, plan: ChunkPlan, replace: bool
+        self, template: Any, description: SweepDescription, plan: ChunkPlan, action: str
     ) -> None:
-        """Write the metadata (no figures yet), replacing what is at the path if asked."""
-        if replace:
-            if self.path.is_dir():
-                shutil.rmtree(self.path)
-            else:
-                self.path.unlink()
+        """Write the metadata (no figures yet); ``action`` is :meth:`check`'s answer.
+
+        With ``"replace"`` the store or file at the path goes first; :meth:`check` has
+        refused anything else (a folder that is not a Zarr store, a link, a FIFO, a device),
+        and the caller holds the store's lock.
+        """
+        if action == "replace":
+            self.remove()
         template.to_zarr(self.path, mode="w-", compute=False, zarr_format=2, consolidated=True)
         (self._markers / "chunks").mkdir(parents=True)
         record = {"description": description.to_json(), "chunk_shape": list(plan.chunk_shape)}
         atomic_write(self._markers / "sweep.json", json.dumps(record, indent=1), force=True)
+
+    def remove(self) -> None:
+        """Delete the store (or the file) at the path: only one :meth:`check` accepted."""
+        kind = _kind(self.path)
+        if kind == "folder":
+            shutil.rmtree(self.path)
+        elif kind == "file":
+            self.path.unlink()
 
     def writer(self) -> Any:
         """Open the Zarr group once for the chunk writes."""
