@@ -74,6 +74,10 @@ Sweeps (:mod:`phdesign.sweep`, checked before any store is created or worker sta
                                              checked before their values are built): a
                                              10⁶-point beam map is 3 h on one core
                                              (``docs/scaling.md``)
+    ``MAX_STORE_METADATA_BYTES`` 64 MiB      a metadata file of a stored sweep (its
+                                             description holds every axis value: 10⁶
+                                             values take about 25 MB), read in one bounded
+                                             piece before it is parsed
     ``MAX_WORKERS_PER_CORE``    1            workers of a local cluster per core this
                                              process may use: each is a process of about
                                              150 MB, and the jobs are CPU-bound (more
@@ -120,6 +124,7 @@ __all__ = [
     "MAX_SIMULATION_VALUES",
     "MAX_SIZE",
     "MAX_STARTS",
+    "MAX_STORE_METADATA_BYTES",
     "MAX_SWEEP_POINTS",
     "MAX_TRADEOFF_GAINS",
     "MAX_TUNE_ITERATIONS",
@@ -168,6 +173,7 @@ MAX_TUNE_ITERATIONS = 10_000
 MAX_TRADEOFF_GAINS = 1000
 # ---------------------------------------------------------------- sweeps
 MAX_SWEEP_POINTS = 1_000_000
+MAX_STORE_METADATA_BYTES = 64 << 20
 MAX_WORKERS_PER_CORE = 1
 
 #: The resolution a discretization uses when none is given is at most this (the finite

@@ -10,7 +10,9 @@ the damper on sensor 2, whose points cost a few milliseconds.
 from __future__ import annotations
 
 import hashlib
+import json
 import os
+import re
 import stat
 from pathlib import Path
 
@@ -184,3 +186,214 @@ def test_a_resumed_store_is_kept_when_a_point_is_refused(tmp_path, monkeypatch):
     with pytest.raises(ModelError, match="refused here"):
         phdesign.sweep("wave", output=store, resume=True, **kwargs)
     assert digest(store) == kept
+
+
+# ------------------------------------------------------------------ crafted stores
+def _json(path: Path, change) -> None:
+    data = json.loads(path.read_text())
+    change(data)
+    path.write_text(json.dumps(data))
+
+
+def _metadata(change):
+    """A change of the consolidated metadata (and of the array's own file, kept equal)."""
+
+    def apply(store: Path) -> None:
+        _json(store / ".zmetadata", lambda d: change(d["metadata"]))
+        metadata = json.loads((store / ".zmetadata").read_text())["metadata"]
+        for key, value in metadata.items():
+            if key.endswith("/.zarray") and (store / key).parent.is_dir():
+                (store / key).write_text(json.dumps(value))
+
+    return apply
+
+
+def _description(change):
+    """A change of the stored description (in sweep.json and the group's attribute)."""
+
+    def apply(store: Path) -> None:
+        def edit(record):
+            description = json.loads(record["description"])
+            change(description)
+            record["description"] = json.dumps(description)
+
+        _json(store / ".phdesign" / "sweep.json", edit)
+
+    return apply
+
+
+def _pickled(metadata):
+    array = metadata["spectral_abscissa/.zarray"]
+    array.update(dtype="|O", filters=[{"id": "pickle", "protocol": 5}], fill_value=None)
+
+
+def _dev_zero(store: Path) -> None:
+    chunk = store / "digits" / "0"
+    chunk.unlink()
+    chunk.symlink_to("/dev/zero")
+
+
+def _blosc_bomb(store: Path) -> None:
+    import struct
+
+    chunk = store / "digits" / "0"
+    data = bytearray(chunk.read_bytes())
+    data[4:8] = struct.pack("<I", 2**31 - 1)  # "decompresses to 2 GiB"
+    chunk.write_bytes(bytes(data))
+
+
+CRAFTED = [
+    # (change, the message; each ended in a traceback or a large allocation before)
+    (lambda s: (s / ".zmetadata").write_text("{"), "is not JSON"),
+    (lambda s: (s / ".phdesign" / "sweep.json").write_text("[1"), "sweep.json is not JSON"),
+    (
+        lambda s: _json(s / ".phdesign" / "sweep.json", lambda d: d.update(chunk_shape="ab")),
+        "the chunk shape must be a list of integers",
+    ),
+    (_description(lambda d: d.pop("job")), "a stored description must have the fields"),
+    (_description(lambda d: d.update(n_outputs="2")), "n_outputs must be int; found str"),
+    (
+        _description(lambda d: d["axes"][0].update(values=["²", "x", "y"])),
+        "expected numbers as values",
+    ),
+    (_description(lambda d: d.update(job="nosuch")), "unknown sweep job 'nosuch'"),
+    (
+        _description(lambda d: d["axes"][0].update(values=list(range(2_000_000)))),
+        "stored axis 'l1' has 2,000,000 points; a sweep has at most 1,000,000",
+    ),
+    (_metadata(lambda m: m.pop("digits/.zarray")), "does not hold the arrays its description"),
+    (_metadata(lambda m: m.update({"extra/.zarray": {}})), "does not hold the arrays"),
+    (_metadata(_pickled), 'dtype must be "<f8"'),
+    (
+        _metadata(lambda m: m["digits/.zarray"].update(shape=[3_000_000_000])),
+        r"shape must be \[3\] \(the grid the store describes\); found \[3000000000\]",
+    ),
+    (
+        _metadata(lambda m: m["digits/.zarray"].update(compressor={"id": "pickle"})),
+        "the compressor must be none or Blosc",
+    ),
+    (
+        _metadata(lambda m: m["spectral_abscissa/.zattrs"].update(units="days since 1970-01-01")),
+        "attribute units must be '1/s'",
+    ),
+    (_metadata(lambda m: m[".zattrs"].update(phdesign_sweep="{}")), "its attributes are not"),
+    (_dev_zero, "chunk digits/0 is not a regular file"),
+    (_blosc_bomb, r"chunk digits/0 declares 2147483647 bytes .*; expected 24"),
+]
+
+
+@pytest.mark.parametrize(("change", "message"), CRAFTED, ids=[str(i) for i in range(len(CRAFTED))])
+def test_a_crafted_store_is_refused_by_plot_and_resume_in_one_line(
+    change, message, tmp_path, capsys
+):
+    """plot and --resume read crafted stores: KeyError, JSONDecodeError, int('²'),
+    TypeError, zarr's "No Zarr data type found", or 2 GiB for a 172 kB store."""
+    store = tmp_path / "m.zarr"
+    phdesign.sweep("wave", output=store, **WAVE)
+    change(store)
+    crafted = digest(store) if not (store / "digits" / "0").is_symlink() else None
+    status = main(["plot", str(store), "-o", str(tmp_path / "p.png")])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert err.count("\n") == 1, err
+    assert "Traceback" not in err
+    assert re.search(message, err), err
+    assert not (tmp_path / "p.png").exists()
+    (store / ".phdesign" / "complete.json").unlink(missing_ok=True)  # resume, not reopen
+    with pytest.raises(SweepError, match=message):
+        phdesign.sweep("wave", output=store, resume=True, **WAVE)
+    if crafted is not None:
+        crafted.pop("m.zarr/.phdesign/complete.json", None)
+        assert digest(store) == crafted  # refused before anything was written
+
+
+def test_a_marker_name_that_python_calls_a_digit_is_not_a_chunk(tmp_path, capsys):
+    """'0000000²'.isdigit() is true and int() of it raised: such a name is no marker."""
+    store = tmp_path / "m.zarr"
+    phdesign.sweep("wave", output=store, chunk_size=1, **WAVE)
+    (store / ".phdesign" / "complete.json").unlink()
+    (store / ".phdesign" / "chunks" / "00000001").unlink()
+    (store / ".phdesign" / "chunks" / "0000000²").write_text("")
+    (store / ".phdesign" / "chunks" / "99999999").write_text("")  # beyond the last chunk
+    assert main(["plot", str(store), "-o", str(tmp_path / "p.png")]) == 2
+    assert "is incomplete (2 of 3 chunks stored)" in capsys.readouterr().err
+    resumed = phdesign.sweep("wave", output=store, resume=True, chunk_size=1, **WAVE)
+    assert json.loads(resumed.attrs["phdesign_run"])["computed"] == 1
+
+
+def _netcdf(tmp_path: Path, change) -> Path:
+    path = tmp_path / "m.nc"
+    phdesign.sweep("wave", output=path, **WAVE)
+    import xarray as xr
+
+    with xr.open_dataset(path, engine="scipy") as ds:
+        crafted = change(ds.load())
+    path.unlink()
+    crafted.to_netcdf(path, engine="scipy")
+    return path
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda ds: ds.assign(extra=ds.digits * 2), "does not hold the variables"),
+        (
+            lambda ds: ds.isel(l1=[0, 1, 2, 0, 1]).assign_coords(l1=[1.0, 2, 3, 4, 5]),
+            r"variable .*expected dimensions \('l1',\) of shape \(3,\); found .* \(5,\)",
+        ),
+        (
+            lambda ds: ds.assign(digits=ds.digits.assign_attrs(units="days since 1970-01-01")),
+            "variable digits: expected float64; found datetime64",
+        ),
+    ],
+)
+def test_a_crafted_netcdf_file_is_refused_before_it_is_read(change, message, tmp_path):
+    path = _netcdf(tmp_path, change)
+    with pytest.raises(SweepError, match=message):
+        phdesign.sweep.open_sweep(path)
+
+
+def test_truncated_and_non_regular_netcdf_files_are_refused(tmp_path):
+    path = tmp_path / "m.nc"
+    phdesign.sweep("wave", output=path, **WAVE)
+    path.write_bytes(path.read_bytes()[:200])
+    with pytest.raises(SweepError, match=r"cannot read .* as NetCDF"):
+        phdesign.sweep.open_sweep(path)
+    path.unlink()
+    os.mkfifo(path)
+    with pytest.raises(SweepError, match="it is not a regular file"):
+        phdesign.sweep.open_sweep(path)
+
+
+def test_a_local_cluster_spawns_its_workers_with_sigint_ignored(monkeypatch):
+    """The workers inherit an ignored SIGINT (the cluster test sends a real Ctrl-C); this
+    process gets its own handler back as soon as the cluster is up."""
+    import signal
+
+    import dask.distributed
+
+    from phdesign.sweep import schedulers
+
+    seen = []
+
+    class Cluster:
+        def __init__(self, **kwargs):
+            seen.append(signal.getsignal(signal.SIGINT))
+
+    handler = signal.getsignal(signal.SIGINT)
+    monkeypatch.setattr(dask.distributed, "LocalCluster", Cluster)
+    schedulers._local_cluster(2)
+    assert seen == [signal.SIG_IGN]
+    assert signal.getsignal(signal.SIGINT) is handler
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "x"])
+def test_plot_select_refuses_a_value_with_no_nearest_point(value, tmp_path, capsys):
+    """`plot --select d=nan` was a KeyError traceback (NaN has no nearest value)."""
+    path = tmp_path / "m.nc"
+    phdesign.sweep("wave", output=path, param_grid={"rho": "1,2"}, **WAVE)
+    argv = ["plot", str(path), "-o", str(tmp_path / "p.png"), "--select", f"rho={value}"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == f"phdesign: error: select: rho expects a finite number; found {value!r}\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.nc"]

@@ -16,6 +16,7 @@ synchronous run, a local cluster and a remote one give identical arrays.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sys
 import time
@@ -219,8 +220,11 @@ def _compute(
     todo = [(plan.chunk_shape, i) for i in range(plan.n_chunks) if i not in done]
     record["reused"] = len(done)
     record["scheduler"] = ex.describe()
-    with _progress(plan.n_chunks, len(done), progress) as bar:
-        for result in ex.map_unordered(run_chunk, text, todo):
+    results = ex.map_unordered(run_chunk, text, todo)
+    # closed at once on an error or Ctrl-C (its finally cancels the futures and releases the
+    # scattered description), not when a traceback that holds it is collected
+    with contextlib.closing(results), _progress(plan.n_chunks, len(done), progress) as bar:
+        for result in results:
             write(result, plan.region(result["index"]))
             record["computed"] += 1
             record["compute_seconds"] += result["seconds"]
@@ -282,6 +286,6 @@ def _run_in_store(
 
 def _finished(store: Any, record: dict[str, Any]) -> Any:
     """Return the complete store's Dataset, read while its lock is held (a sweep may follow)."""
-    dataset = store.dataset().load()
+    dataset = store.dataset()
     dataset.attrs[RUN_ATTRIBUTE] = json.dumps(record)
     return dataset

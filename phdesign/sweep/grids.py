@@ -50,6 +50,7 @@ __all__ = [
 
 AXIS_KINDS = ("gain", "parameter", "sensors")
 _GAIN_NAME = re.compile(r"^l([1-9][0-9]*)?$")
+_SENSOR_SET = re.compile(r"[1-9][0-9]{0,2}(,[1-9][0-9]{0,2})*", re.ASCII)
 
 
 @dataclass(frozen=True)
@@ -129,15 +130,40 @@ class Axis:
         }
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Axis:
-        """Inverse of :meth:`to_dict`."""
-        return cls(
-            str(data["name"]),
-            str(data["kind"]),
-            tuple(data["values"]),
-            str(data["scale"]),
-            str(data["spec"]),
-        )
+    def from_dict(cls, data: Any) -> Axis:
+        """Inverse of :meth:`to_dict`, for data read from a file: every field is checked.
+
+        Raises
+        ------
+        SweepError
+            Not the five fields of an axis, of their kinds: a name, kind, scale and spec of
+            text, and at most :data:`~phdesign.limits.MAX_SWEEP_POINTS` values (numbers,
+            or sensor sets such as ``"3,4"``), valid as :class:`Axis` requires.
+        """
+        fields = ("name", "kind", "values", "scale", "spec")
+        if not isinstance(data, dict) or set(data) != set(fields):
+            found = sorted(map(str, data)) if isinstance(data, dict) else type(data).__name__
+            raise SweepError(
+                f"a stored axis must have the fields {', '.join(fields)}; found {found}"
+            )
+        name, kind, values, scale, spec = (data[f] for f in fields)
+        if not all(isinstance(x, str) and len(x) <= 1000 for x in (name, kind, scale, spec)):
+            raise SweepError("a stored axis must have a name, kind, scale and spec of short text")
+        if scale not in ("linear", "log", "sets") or not isinstance(values, list):
+            raise SweepError(
+                f"stored axis {name!r}: unknown scale {scale!r}, or no list of values"
+            )
+        check_sweep_points(len(values), f"stored axis {name!r}")
+        if kind == "gain" and not _GAIN_NAME.fullmatch(name):
+            raise SweepError(f"stored gain axis {name!r}: expected l1, l2, ... or l")
+        if kind == "sensors":
+            if not all(isinstance(v, str) and _SENSOR_SET.fullmatch(v) for v in values):
+                raise SweepError(
+                    f"stored axis {name!r}: sensor sets must be 1-based indices such as '3,4'"
+                )
+        elif not all(type(v) in (int, float) for v in values):
+            raise SweepError(f"stored axis {name!r}: expected numbers as values")
+        return cls(name, kind, tuple(values), scale, spec)
 
     def __repr__(self) -> str:
         first, last = self.values[0], self.values[-1]

@@ -24,7 +24,9 @@ floating-point operations the same wherever it runs.
 from __future__ import annotations
 
 import os
+import signal
 import socket
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -246,6 +248,28 @@ _GUARD = (
 )
 
 
+@contextmanager
+def _workers_ignore_sigint() -> Iterator[None]:
+    """Ignore SIGINT while a local cluster spawns its workers, so that they ignore it too.
+
+    Ctrl-C reaches every process of the terminal's process group: the workers died of it
+    with 34 to 68 lines of tracebacks, and the scheduler logged the data they lost.  An
+    ignored signal stays ignored across the spawn (a handler or a blocked mask does not),
+    and Python leaves a SIGINT it finds ignored alone, so the workers never see Ctrl-C;
+    this process alone handles it once its handler is back, and closes the cluster, whose
+    workers then shut down quietly.  A Ctrl-C while the workers start (a second or two)
+    is lost.  Only the main thread may change a handler: elsewhere nothing changes.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _local_cluster(n_workers: int) -> Any:
     """Start a LocalCluster of single-threaded worker processes (spawned, as Dask does)."""
     import logging
@@ -258,13 +282,14 @@ def _local_cluster(n_workers: int) -> Any:
     from dask.distributed import LocalCluster
 
     try:
-        return LocalCluster(
-            n_workers=n_workers,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",  # any free port: never a clash with another 8787
-            silence_logs=logging.ERROR,
-        )
+        with _workers_ignore_sigint():
+            return LocalCluster(
+                n_workers=n_workers,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # any free port: never a clash with another 8787
+                silence_logs=logging.ERROR,
+            )
     except RuntimeError as error:
         main = sys.modules.get("__main__")
         if getattr(main, "__file__", None) and getattr(main, "__spec__", None) is None:
@@ -314,13 +339,15 @@ def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Exec
         finally:
             client.close()
         return
-    cluster = _local_cluster(workers or usable_cores())
     from dask.distributed import Client
 
-    n_workers = len(cluster.workers)
-    client = Client(cluster)
-    try:
-        yield Executor("LocalCluster", n_workers, client)
+    cluster = client = None
+    try:  # one finally for both: a Ctrl-C between the two starts closes the cluster too
+        cluster = _local_cluster(workers or usable_cores())
+        client = Client(cluster)
+        yield Executor("LocalCluster", len(cluster.workers), client)
     finally:
-        client.close()
-        cluster.close()
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import stat
 from dataclasses import dataclass
@@ -35,15 +36,17 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import OutputFileError, SweepError
+from phdesign.errors import OutputFileError, PhdesignError, SweepError
 from phdesign.io import atomic_write
 from phdesign.outputs import remove_stale_temporaries
 from phdesign.sweep.description import SweepDescription
 from phdesign.sweep.plan import ChunkPlan
+from phdesign.sweep.schema import check_zarr, read_json
 
 __all__ = ["ZarrStore"]
 
 _MARKERS = ".phdesign"
+_MARKER_NAME = re.compile(r"[0-9]{8}", re.ASCII)  # '²' is a digit to str.isdigit, not here
 
 
 def _kind(path: Path) -> str:
@@ -81,31 +84,44 @@ class ZarrStore:
         return any((self.path / name).exists() for name in (".zgroup", "zarr.json"))
 
     def stored(self) -> tuple[SweepDescription, ChunkPlan] | None:
-        """Return the stored description and chunk layout (``None``: not a sweep)."""
-        try:
-            data = json.loads((self._markers / "sweep.json").read_text())
-            description = SweepDescription.from_json(data["description"])
-            plan = ChunkPlan(description.shape, tuple(data["chunk_shape"]))
-        except (OSError, ValueError, KeyError, TypeError):
+        """Return the stored description and chunk layout (``None``: no ``sweep.json``).
+
+        Raises
+        ------
+        SweepError
+            A ``sweep.json`` that is not a regular file, too large, not JSON, or not a
+            description and a chunk layout that fits it (the message says which).
+        """
+        where = f"{str(self.path)!r}'s {_MARKERS}/sweep.json"
+        if not os.path.lexists(self._markers / "sweep.json"):
             return None
-        return description, plan
+        data = read_json(self._markers / "sweep.json", where)
+        if not isinstance(data, dict) or set(data) != {"description", "chunk_shape"}:
+            raise SweepError(f"{where} must hold a description and a chunk shape")
+        description = SweepDescription.from_json(data["description"])
+        chunks = data["chunk_shape"]
+        if not isinstance(chunks, list) or not all(type(c) is int for c in chunks):
+            raise SweepError(f"{where}: the chunk shape must be a list of integers")
+        return description, ChunkPlan(description.shape, tuple(chunks))
 
     @property
     def complete(self) -> bool:
-        """The completion marker exists."""
-        return (self._markers / "complete.json").is_file()
+        """The completion marker exists (a regular file)."""
+        return _kind(self._markers / "complete.json") == "file"
 
     def done(self) -> set[int]:
-        """Return the indices of the chunks whose figures are stored."""
+        """Return the indices of the chunks whose figures are stored (their markers' names)."""
         folder = self._markers / "chunks"
-        if not folder.is_dir():
+        if _kind(folder) != "folder":
             return set()
-        return {int(p.name) for p in folder.iterdir() if p.name.isdigit()}
+        n_chunks = self.plan().n_chunks
+        names = (p.name for p in folder.iterdir())
+        return {int(n) for n in names if _MARKER_NAME.fullmatch(n) and int(n) < n_chunks}
 
     def remove_stale_markers(self) -> int:
         """Delete the half-written markers a killed sweep left (they vouch for nothing)."""
         folders = (self._markers, self._markers / "chunks")
-        return sum(remove_stale_temporaries(folder) for folder in folders)
+        return sum(remove_stale_temporaries(f) for f in folders if _kind(f) == "folder")
 
     def check(
         self,
@@ -156,7 +172,17 @@ class ZarrStore:
                 f"output {where!r} exists; resume the sweep it holds (--resume) "
                 "or replace it (--force)"
             )
-        stored = self.stored()
+        if kind != "folder":
+            raise SweepError(
+                f"cannot resume {where!r}: it is not a phdesign sweep store (it is a file); "
+                "replace it with --force"
+            )
+        try:
+            stored = self.stored()
+        except SweepError as error:
+            raise SweepError(
+                f"cannot resume {where!r}: {error}; replace it with --force"
+            ) from None
         if stored is None:
             raise SweepError(
                 f"cannot resume {where!r}: it is not a phdesign sweep store "
@@ -174,6 +200,10 @@ class ZarrStore:
                 f"cannot resume {where!r} with chunk size {chunk_size}: it was written in "
                 f"chunks of {plan.chunk_size} points (drop the chunk size)"
             )
+        for folder in (self._markers, self._markers / "chunks"):
+            if _kind(folder) != "folder":  # a link would take the markers elsewhere
+                raise SweepError(f"cannot resume {where!r}: {str(folder)!r} is not a folder")
+        check_zarr(self.path, old)  # its arrays are the description's before one is written
         return "complete" if self.complete else "resume"
 
     def plan(self) -> ChunkPlan:
@@ -226,9 +256,28 @@ class ZarrStore:
         atomic_write(self._markers / "complete.json", json.dumps(record, indent=1), force=True)
 
     def dataset(self) -> Any:
-        """Open the stored sweep as an :class:`xarray.Dataset` (read lazily, no dask)."""
+        """Read the stored sweep as an :class:`xarray.Dataset`, after checking its schema.
+
+        Raises
+        ------
+        SweepError
+            Not a sweep store, metadata or chunks that are not its description's
+            (:func:`~phdesign.sweep.schema.check_zarr`), or chunk bytes Zarr cannot decode.
+        """
         import xarray as xr
 
         from phdesign.sweep.dataset import normalized
 
-        return normalized(xr.open_zarr(self.path, chunks=None, consolidated=True, zarr_format=2))
+        stored = self.stored()
+        if stored is None:
+            raise SweepError(f"{str(self.path)!r} is not a phdesign sweep store")
+        check_zarr(self.path, stored[0])
+        try:
+            raw = xr.open_zarr(self.path, chunks=None, consolidated=True, zarr_format=2)
+            return normalized(raw).load()
+        except PhdesignError:
+            raise
+        except Exception as error:  # corrupt chunk bytes: the decoders' own errors
+            raise SweepError(
+                f"cannot read {str(self.path)!r}: {type(error).__name__}: {error}"
+            ) from None
