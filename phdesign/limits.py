@@ -45,6 +45,15 @@ Exact decisions that fall back to a numeric check (and say so)
     ``EXACT_DEFINITENESS_BITS``      4096   largest estimated coefficient size of a minor
     ``EXACT_KAPPA_OPERATIONS``       400    operations in the pencil of the exact κ*
                                             (larger pencils use the float path)
+    ``EXACT_KAPPA_BITS``             256    bits of the integer coefficients of the pencil's
+                                            characteristic polynomial (degree 2 and more)
+                                            whose roots are isolated exactly: sympy factors
+                                            integers of that size there (598 bits took 55 s,
+                                            ``--gain 1e-45,1e45`` on the beam); beyond, the
+                                            float path, which scales the pencil
+    ``EXACT_KAPPA_DEGREE``           64     degree of those coefficients in a constant
+                                            (``exp(100)`` is ``E**100``: 30 s; ``exp(690)``
+                                            ran past 600 s)
     ==============================  =====  ================================================
 
 Searches and numerics (checked at the entry of each library function)
@@ -53,7 +62,14 @@ Searches and numerics (checked at the entry of each library function)
                                              is classified (2^16 - 1 = 65 535 subsets)
     ``MAX_DISCRETE_STATES``     2000         states of one discretization, size n times
                                              (resolution + 1); a dense eigenproblem with
-                                             vectors at 2000 states takes minutes
+                                             vectors at 2000 states takes minutes, and an
+                                             export's verification plant of 2000 states
+                                             (``--plant-resolution 999`` on the beam)
+                                             about 45 s and 1.6 GB
+    ``MAX_NOISE_STATES``        1000         states of the largest discretization of the
+                                             noise figures (dense Lyapunov equations: 13 s
+                                             and 0.5 GB at 1000 states on the beam, 67 s
+                                             and 1.3 GB at 2000)
     ``MAX_SIMULATION_VALUES``   20 000 000   samples times states of a simulation (plant
                                              and observer), 160 MB per copy
     ``MAX_T_END``               1e12         final time of a simulation
@@ -63,8 +79,9 @@ Searches and numerics (checked at the entry of each library function)
     ``MAX_TUNE_ITERATIONS``     10 000       optimizer iterations per start
     ``MAX_TRADEOFF_GAINS``      1000         gains of a trade-off (scales of a ray, or the
                                              product of a grid's counts); each costs a
-                                             spectrum and the noise figures (about 0.5 s on
-                                             the beam), checked before the gains are built
+                                             spectrum and the noise figures (about 0.1 s on
+                                             the beam: 1000 gains take minutes), checked
+                                             before the gains are built
     =========================  ===========  ===============================================
 
 Sweeps (:mod:`phdesign.sweep`, checked before any store is created or worker started)
@@ -106,6 +123,8 @@ __all__ = [
     "EXACT_DEFINITENESS_BITS",
     "EXACT_DEFINITENESS_DEGREE",
     "EXACT_DEFINITENESS_SIZE",
+    "EXACT_KAPPA_BITS",
+    "EXACT_KAPPA_DEGREE",
     "EXACT_KAPPA_OPERATIONS",
     "MAX_DEGREE",
     "MAX_DEPTH",
@@ -114,6 +133,7 @@ __all__ = [
     "MAX_EXPRESSION_LENGTH",
     "MAX_MAGNITUDE",
     "MAX_MODEL_FILE_BYTES",
+    "MAX_NOISE_STATES",
     "MAX_NUMBER_BITS",
     "MAX_NUMBER_DIGITS",
     "MAX_NUMBER_OPERATIONS",
@@ -134,6 +154,7 @@ __all__ = [
     "check_discretization",
     "check_local_workers",
     "check_model_dimensions",
+    "check_noise_resolution",
     "check_parameter_count",
     "check_sensor_outputs",
     "check_simulation",
@@ -162,9 +183,12 @@ EXACT_DEFINITENESS_SIZE = 8
 EXACT_DEFINITENESS_DEGREE = 128
 EXACT_DEFINITENESS_BITS = 4096
 EXACT_KAPPA_OPERATIONS = 400
+EXACT_KAPPA_BITS = 256
+EXACT_KAPPA_DEGREE = 64
 # ---------------------------------------------------------------- searches and numerics
 MAX_SENSOR_OUTPUTS = 16
 MAX_DISCRETE_STATES = 2000
+MAX_NOISE_STATES = 1000
 MAX_SIMULATION_VALUES = 20_000_000
 MAX_T_END = 1e12
 MIN_TIME_STEP = 1e-300
@@ -268,8 +292,25 @@ def check_discretization(nm: Any, method: object, *resolutions: object) -> None:
             raise NumericError(
                 f"resolution {value} gives the {method} discretization of a size-{nm.size} "
                 f"model about {states:,} states; expected at most {MAX_DISCRETE_STATES:,} "
-                f"({_budget('MAX_DISCRETE_STATES')})"
+                f"({_budget('MAX_DISCRETE_STATES')}; at 2,000 states an eigenproblem takes "
+                "minutes, an export's verification plant 45 s and 1.6 GB)"
             )
+
+
+def check_noise_resolution(nm: Any, resolution: int, name: str) -> None:
+    """Refuse noise figures whose largest discretization exceeds :data:`MAX_NOISE_STATES`.
+
+    ``resolution`` is the largest resolution the refinement may reach, ``name`` the
+    argument that sets it (``"resolution"`` or ``"max_resolution"``).
+    """
+    states = _states(nm, resolution)
+    if states > MAX_NOISE_STATES:
+        raise NumericError(
+            f"{name} {resolution} gives the noise figures of a size-{nm.size} model about "
+            f"{states:,} states; expected at most {MAX_NOISE_STATES:,} "
+            f"({_budget('MAX_NOISE_STATES')}: dense Lyapunov equations, 13 s and 0.5 GB at "
+            "1,000 states on the beam, 67 s and 1.3 GB at 2,000)"
+        )
 
 
 def check_simulation(
@@ -365,7 +406,7 @@ def check_tradeoff_gains(count: int, what: str) -> None:
     if count > MAX_TRADEOFF_GAINS:
         raise NumericError(
             f"{what} gives {count:,} gains; a trade-off evaluates at most "
-            f"{MAX_TRADEOFF_GAINS:,} (a spectrum and the noise figures at each, about 0.5 s "
+            f"{MAX_TRADEOFF_GAINS:,} (a spectrum and the noise figures at each, about 0.1 s "
             f"apiece on the beam; {_budget('MAX_TRADEOFF_GAINS')})"
         )
 

@@ -814,6 +814,25 @@ COMMAND_ROWS = [
     row("plot {tmp}/m.zarr -o {tmp}/p.png --select d", "--select expects NAME=VALUE", SweepError),
     # ---- issue 30 (part B): sweep targets, refused points, addresses, caps
     row(
+        f"{TRADE} --scales 0.1:10:100000000",
+        "--scales gives 100,000,000 gains; a trade-off evaluates at most 1,000",
+        NumericError,
+        seconds=10,
+    ),
+    row(
+        f"{TRADE} --grid 0.1:1:1000,0.1:1:1000",
+        "--grid gives 1,000,000 gains; a trade-off evaluates at most 1,000",
+        NumericError,
+        seconds=10,
+    ),
+    row(
+        f"{NOISE} --resolution 999",
+        "resolution 999 gives the noise figures of a size-2 model about 2,000 states; expected "
+        "at most 1,000 (the budget phdesign.limits.MAX_NOISE_STATES: dense Lyapunov",
+        NumericError,
+        seconds=10,
+    ),
+    row(
         f"{MAP} -o {{tmp}}/pipe.zarr --force",
         "output .*pipe.zarr' is a FIFO; a sweep writes its store only where there is nothing",
         OutputFileError,

@@ -372,9 +372,15 @@ class _Check:
             # two lower bounds of the smallest eigenvalue on the cell, the better one kept:
             # Weyl about the midpoint, and Gershgorin's discs of the interval matrix (sharp
             # where an entry touches 0 while the others stay away: diag(sin(2 pi z)^2, e^z))
-            weyl = lam_mid - np.sqrt(np.sum(radius**2, axis=(1, 2)))
-            gershgorin = np.min(floor - np.sum(reach, axis=2), axis=1)
-            bound = np.maximum(weyl, gershgorin) - 1e-13 * scale * n
+            # each less a round-off allowance of its own magnitudes: the cell's for Weyl
+            # (eigvalsh errs by ε‖S(m)‖), the row's for Gershgorin (a sum of that row's
+            # entries); one allowance from the whole matrix's largest entry kept
+            # diag(exp(30 z), 1) unproved (1e-13 · e³⁰ > 1, its smallest eigenvalue)
+            cell = np.max(np.abs(centre) + radius, axis=(1, 2))
+            weyl = lam_mid - np.sqrt(np.sum(radius**2, axis=(1, 2))) - _allowance(cell, n)
+            row = np.abs(floor) + np.sum(reach, axis=2)
+            gershgorin = np.min(floor - np.sum(reach, axis=2) - _allowance(row, n), axis=1)
+            bound = np.maximum(weyl, gershgorin)
             open_cells = ~(bound > 0) if self.strict else ~(bound >= -tolerance)
             examined += lo.size
             if not np.any(open_cells):
@@ -435,6 +441,18 @@ class _Check:
 
 
 # ---------------------------------------------------------------------- helpers
+def _allowance(magnitude: Any, n: int) -> Any:
+    """Round-off allowed in a bound computed from entries of this ``magnitude`` (n x n).
+
+    Relative: the enclosures are rounded outwards already, and what is left (eigvalsh,
+    the sums of Gershgorin's discs) errs in proportion to the entries it adds; the floor
+    keeps an allowance where they underflow.
+    """
+    import numpy as np
+
+    return 1e-13 * n * np.maximum(magnitude, 1e-300)
+
+
 def _without_constant_kernel(
     S: sympy.MatrixBase, a: float, b: float, name: str
 ) -> tuple[sympy.MatrixBase | None, sympy.MatrixBase]:
