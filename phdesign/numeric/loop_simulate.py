@@ -29,6 +29,7 @@ import numpy as np
 from phdesign.errors import LoopError, NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
+from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.loop import NumericLoop, assemble
 from phdesign.numeric.simulate import (
     ENERGY_BALANCE_RTOL,
@@ -179,7 +180,7 @@ def simulate_loop(
     t = np.linspace(0.0, float(t_end), int(samples))
     V = None
     if u is not None:
-        U = np.array([np.asarray(u(float(tk)), dtype=float).reshape(m) for tk in t])
+        U = input_samples(u, t, m)
         driven = [a + 1 for a in loop.actuated if np.any(U[:, a])]
         if driven:
             raise LoopError(

@@ -24,6 +24,7 @@ import numpy as np
 from phdesign.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
+from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.sampling import (
     ContinuousObserver,
@@ -132,9 +133,7 @@ def simulate_sampled(
     zero = lambda z: np.zeros((np.atleast_1d(z).size, nm.size))  # noqa: E731
     U = None
     if u is not None:
-        U = np.array(
-            [np.asarray(u(k * step), dtype=float).reshape(nm.n_ports) for k in range(n_steps + 1)]
-        )
+        U = input_samples(u, step * np.arange(n_steps + 1), nm.n_ports)
     e0 = plant.project(x0 or zero)
     xh0 = d_obs.project(xhat0 or zero)
     kind = None if dt is None else sampler

@@ -54,6 +54,7 @@ from phdesign.numeric.arguments import check_simulate_arguments
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.display import SimulationDisplay
+from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.stepping import (
     MIDPOINT_RTOL,
     SCHEMES,
@@ -388,7 +389,7 @@ def simulate(
     zero = lambda z: np.zeros((np.atleast_1d(z).size, nm.size))  # noqa: E731
     U = None
     if u is not None:
-        U = np.array([np.asarray(u(float(tk)), dtype=float).reshape(nm.n_ports) for tk in t])
+        U = input_samples(u, t, nm.n_ports)
     midpoint_tol = tol if scheme == "midpoint" else None
 
     def run(E: np.ndarray, A: np.ndarray, B: np.ndarray, X0: np.ndarray, inp: Any) -> Trajectory:

@@ -49,6 +49,7 @@ import scipy.linalg as sl
 from phdesign.errors import NumericError, ObserverError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
+from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.noise import noise_intensities
 from phdesign.numeric.simulate import SimulationResult, coupled_system, simulate
 from phdesign.numeric.stepping import dissipation_integral
@@ -186,7 +187,7 @@ def simulate_noisy(
     else:
         extra = np.zeros((t.size, E2.shape[0]))
     eh = np.asarray(base.states) + extra[:, :n]
-    U = None if u is None else np.array([np.asarray(u(float(tk)), float) for tk in t])
+    U = None if u is None else input_samples(u, t, d.n_ports)
     changes: dict[str, Any] = {"states": eh, "H": d.hamiltonian(eh), "y": d.output(eh, U)}
     if C_m is not None and L is not None:
         eo = np.asarray(base.states_hat) + extra[:, n:]

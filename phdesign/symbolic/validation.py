@@ -16,7 +16,13 @@ from typing import TYPE_CHECKING
 
 import sympy
 
-from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
+from phdesign.errors import (
+    ArgumentError,
+    ExpressionError,
+    ModelError,
+    ParameterError,
+    check_shape,
+)
 from phdesign.limits import check_model_dimensions, check_parameter_count
 from phdesign.symbolic.conjugate import conjugate_outputs
 from phdesign.symbolic.definiteness import check_definite
@@ -28,7 +34,7 @@ from phdesign.symbolic.expressions import (
     vanishes,
 )
 from phdesign.symbolic.feedback import check_feedback
-from phdesign.symbolic.parser import check_expression
+from phdesign.symbolic.parser import brief, check_expression
 from phdesign.symbolic.units import check_units
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
@@ -95,7 +101,16 @@ def validate(model: BCPHS) -> list[str]:
         raise ModelError(f"H must be symmetric; found H - H^T = {residual.tolist()}")
     checks.append(check_definite(model.H, "H", model.interval, defaults))
     if model.displacement is not None:
+        from phdesign.symbolic.model import Displacement  # model imports this module
+
         d = model.displacement
+        if not isinstance(d, Displacement) or not all(
+            type(v) is int for v in (d.component, d.integrations)
+        ):
+            raise ArgumentError(
+                "displacement must be a Displacement(component=i, integrations=k) of two "
+                f"integers; found {type(d).__name__} {brief(d, 60)}"
+            )
         if not (1 <= d.component <= n) or d.integrations < 0:
             raise ModelError(
                 f"displacement must name a component in 1..{n} and integrations >= 0; "
