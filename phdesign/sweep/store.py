@@ -177,6 +177,12 @@ class ZarrStore:
                 f"cannot resume {where!r}: it is not a phdesign sweep store (it is a file); "
                 "replace it with --force"
             )
+        self._check_resumable(description, chunk_size)
+        return "complete" if self.complete else "resume"
+
+    def _check_resumable(self, description: SweepDescription, chunk_size: int | None) -> None:
+        """Refuse to resume a folder that is not this sweep's store, exactly as written."""
+        where = str(self.path)
         try:
             stored = self.stored()
         except SweepError as error:
@@ -204,7 +210,6 @@ class ZarrStore:
             if _kind(folder) != "folder":  # a link would take the markers elsewhere
                 raise SweepError(f"cannot resume {where!r}: {str(folder)!r} is not a folder")
         check_zarr(self.path, old)  # its arrays are the description's before one is written
-        return "complete" if self.complete else "resume"
 
     def plan(self) -> ChunkPlan:
         """Return the stored chunk layout."""

@@ -372,10 +372,8 @@ class _Check:
             # two lower bounds of the smallest eigenvalue on the cell, the better one kept:
             # Weyl about the midpoint, and Gershgorin's discs of the interval matrix (sharp
             # where an entry touches 0 while the others stay away: diag(sin(2 pi z)^2, e^z))
-            # each less a round-off allowance of its own magnitudes: the cell's for Weyl
-            # (eigvalsh errs by ε‖S(m)‖), the row's for Gershgorin (a sum of that row's
-            # entries); one allowance from the whole matrix's largest entry kept
-            # diag(exp(30 z), 1) unproved (1e-13 · e³⁰ > 1, its smallest eigenvalue)
+            # each less round-off in its own magnitudes (the cell's, the row's): one from the
+            # largest entry left diag(exp(30 z), 1) unproved (1e-13 e³⁰ > 1 = λ_min)
             cell = np.max(np.abs(centre) + radius, axis=(1, 2))
             weyl = lam_mid - np.sqrt(np.sum(radius**2, axis=(1, 2))) - _allowance(cell, n)
             row = np.abs(floor) + np.sum(reach, axis=2)
@@ -442,15 +440,10 @@ class _Check:
 
 # ---------------------------------------------------------------------- helpers
 def _allowance(magnitude: Any, n: int) -> Any:
-    """Round-off allowed in a bound computed from entries of this ``magnitude`` (n x n).
-
-    Relative: the enclosures are rounded outwards already, and what is left (eigvalsh,
-    the sums of Gershgorin's discs) errs in proportion to the entries it adds; the floor
-    keeps an allowance where they underflow.
-    """
+    """Round-off of a bound from outward-rounded entries of this magnitude (relative)."""
     import numpy as np
 
-    return 1e-13 * n * np.maximum(magnitude, 1e-300)
+    return 1e-13 * n * np.maximum(magnitude, 1e-300)  # the floor: entries that underflow
 
 
 def _without_constant_kernel(

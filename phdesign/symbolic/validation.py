@@ -43,6 +43,24 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 __all__ = ["check_finite", "check_symbols", "validate"]
 
 
+def _check_displacement(d: object, n: int) -> None:
+    """Refuse a displacement that is not a Displacement of a component in 1..n."""
+    from phdesign.symbolic.model import Displacement  # model imports this module
+
+    if not isinstance(d, Displacement) or not all(
+        type(v) is int for v in (d.component, d.integrations)
+    ):
+        raise ArgumentError(
+            "displacement must be a Displacement(component=i, integrations=k) of two "
+            f"integers; found {type(d).__name__} {brief(d, 60)}"
+        )
+    if not (1 <= d.component <= n) or d.integrations < 0:
+        raise ModelError(
+            f"displacement must name a component in 1..{n} and integrations >= 0; "
+            f"found component {d.component}, integrations {d.integrations}"
+        )
+
+
 def validate(model: BCPHS) -> list[str]:
     """Check every structural condition; return how each one was verified."""
     checks: list[str] = []
@@ -101,21 +119,7 @@ def validate(model: BCPHS) -> list[str]:
         raise ModelError(f"H must be symmetric; found H - H^T = {residual.tolist()}")
     checks.append(check_definite(model.H, "H", model.interval, defaults))
     if model.displacement is not None:
-        from phdesign.symbolic.model import Displacement  # model imports this module
-
-        d = model.displacement
-        if not isinstance(d, Displacement) or not all(
-            type(v) is int for v in (d.component, d.integrations)
-        ):
-            raise ArgumentError(
-                "displacement must be a Displacement(component=i, integrations=k) of two "
-                f"integers; found {type(d).__name__} {brief(d, 60)}"
-            )
-        if not (1 <= d.component <= n) or d.integrations < 0:
-            raise ModelError(
-                f"displacement must name a component in 1..{n} and integrations >= 0; "
-                f"found component {d.component}, integrations {d.integrations}"
-            )
+        _check_displacement(model.displacement, n)
     object.__setattr__(
         model, "units", check_units(model.units, model.parameter_names, model.state_names)
     )
