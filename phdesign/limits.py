@@ -85,21 +85,21 @@ Searches and numerics (checked at the entry of each library function)
     =========================  ===========  ===============================================
 
 Sweeps (:mod:`phdesign.sweep`, checked before any store is created or worker started)
-    =========================  ===========  ===============================================
-    ``MAX_SWEEP_POINTS``        1 000 000    points of a sweep (the product of its axes;
-                                             each axis, and the sensor sets ``all``, are
-                                             checked before their values are built): a
-                                             10⁶-point beam map is 3 h on one core
-                                             (``docs/scaling.md``)
-    ``MAX_STORE_METADATA_BYTES`` 64 MiB      a metadata file of a stored sweep (its
-                                             description holds every axis value: 10⁶
-                                             values take about 25 MB), read in one bounded
-                                             piece before it is parsed
-    ``MAX_WORKERS_PER_CORE``    1            workers of a local cluster per core this
-                                             process may use: each is a process of about
-                                             150 MB, and the jobs are CPU-bound (more
-                                             workers than cores cost memory, not time)
-    =========================  ===========  ===============================================
+    ============================  ===========  ============================================
+    ``MAX_SWEEP_POINTS``          1 000 000    points of a sweep (the product of its axes;
+                                               each axis, and the sensor sets ``all``, are
+                                               checked before their values are built): a
+                                               10⁶-point beam map is 3 h on one core
+                                               (``docs/scaling.md``)
+    ``MAX_STORE_METADATA_BYTES``  64 MiB       a metadata file of a stored sweep (its
+                                               description holds every axis value: 10⁶
+                                               values take about 25 MB), read in one
+                                               bounded piece before it is parsed
+    ``MAX_WORKERS_PER_CORE``      1            workers of a local cluster per core this
+                                               process may use: each is a process of about
+                                               150 MB, and the jobs are CPU-bound (more
+                                               workers than cores cost memory, not time)
+    ============================  ===========  ============================================
 
 Examples
 --------
