@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import ExpressionError, NumericError, ParameterError
+from phdesign.errors import ExpressionError, NumericError, ParameterError, PhdesignError
 from phdesign.numeric.bridge import (
     NumericModel,
     _free_symbols_message,
@@ -361,6 +361,8 @@ def input_samples(
     for t in np.asarray(times, dtype=float).ravel():
         try:
             value = np.asarray(u(float(t)), dtype=float)
+        except PhdesignError:  # the input's own refusal (input_function's), as it is
+            raise
         except (TypeError, ValueError) as error:
             raise ArgumentError(f"{name}(t) must return numbers; at t = {t:g}: {error}") from None
         if value.size != count:
