@@ -27,10 +27,12 @@ from phdesign.errors import ArgumentError, NumericError, PhdesignError
 __all__ = [
     "DISCRETIZATION_METHODS",
     "choice",
+    "not_bytes",
     "positive_int",
     "positive_number",
     "require_model",
     "require_numeric_model",
+    "require_path",
 ]
 
 
@@ -56,6 +58,33 @@ def require_model(value: object, name: str = "model") -> None:
         if isinstance(value, str):
             hint = f" (phdesign.load({value!r}) reads a built-in model or a TOML file)"
         raise ArgumentError(f"{name}: expected a BCPHS model{hint}; found {_found(value)}")
+
+
+def not_bytes(value: object, what: str, error: type[PhdesignError]) -> None:
+    """Raise ``error`` when ``value`` is bytes-like: ``list(b"1")`` is ``[49]``, not a number.
+
+    A sequence of numbers is read by iterating over it; bytes iterate as their code points,
+    so ``gain=b"1"`` was read as ``diag(49, 49)``.
+    """
+    if isinstance(value, bytes | bytearray | memoryview):
+        raise error(
+            f"{what} is {type(value).__name__} {bytes(value)[:40]!r}; expected numbers "
+            "(bytes are not numbers: decode them)"
+        )
+
+
+def require_path(value: object, name: str = "path") -> None:
+    """Raise :class:`ArgumentError` unless ``value`` names a file (``str`` or ``os.PathLike``).
+
+    Integers are refused: :func:`open` would take them for file descriptors (``0`` is the
+    standard input); so are bytes, as every path phdesign writes is text.
+    """
+    import os
+
+    if isinstance(value, bool | int) or not isinstance(value, str | os.PathLike):
+        raise ArgumentError(
+            f"{name}: expected a file name (str or os.PathLike); found {_found(value)}"
+        )
 
 
 def require_numeric_model(value: object, name: str = "nm") -> None:

@@ -48,6 +48,7 @@ from typing import Any
 import sympy
 import tomli_w
 
+from phdesign.arguments import require_path
 from phdesign.errors import ModelFileError, PhdesignError
 from phdesign.limits import MAX_MODEL_FILE_BYTES, check_file_size
 from phdesign.outputs import atomic_write, check_output_path
@@ -76,10 +77,13 @@ def read_model(path: str | os.PathLike[str]) -> BCPHS:
 
     Raises
     ------
+    ArgumentError
+        If ``path`` is not a file name (``str`` or :class:`os.PathLike`).
     ModelFileError
         If the file cannot be read or is not valid TOML or lacks keys; model errors
         (:class:`~phdesign.errors.ModelError`, ...) propagate with their own messages.
     """
+    require_path(path, "path")  # an int would be opened as a file descriptor (0: stdin)
     source = str(path)
     try:
         with open(path, "rb") as stream:
@@ -111,6 +115,7 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
     """Build a model from the parsed content of a model file."""
     if not isinstance(data, Mapping):
         raise ModelFileError(f"{source} must be a table; found {type(data).__name__}")
+    _check_names(data, "the file", source)
     missing = [key for key in _REQUIRED if key not in data]
     if missing:
         raise ModelFileError(f"{source} lacks the key(s) {', '.join(missing)}")
@@ -194,7 +199,17 @@ def _table(data: Mapping[str, Any], key: str, source: str) -> Mapping[str, Any]:
     value = data[key]
     if not isinstance(value, Mapping):
         raise ModelFileError(f"{source}: {key} must be a table; found {value!r}")
+    _check_names(value, f"[{key}]", source)
     return value
+
+
+def _check_names(table: Mapping[Any, Any], where: str, source: str) -> None:
+    """Refuse keys that are not text: TOML's never are, a dict from code may hold any."""
+    names = [k for k in table if not isinstance(k, str)]
+    if names:
+        raise ModelFileError(
+            f"{source}: the keys of {where} must be names (text); found {names[0]!r}"
+        )
 
 
 def _toml_number(value: sympy.Expr) -> int | float | str:

@@ -45,6 +45,15 @@ Exact decisions that fall back to a numeric check (and say so)
     ``EXACT_DEFINITENESS_BITS``      4096   largest estimated coefficient size of a minor
     ``EXACT_KAPPA_OPERATIONS``       400    operations in the pencil of the exact κ*
                                             (larger pencils use the float path)
+    ``EXACT_KAPPA_BITS``             256    bits of the integer coefficients of the pencil's
+                                            characteristic polynomial (degree 2 and more)
+                                            whose roots are isolated exactly: sympy factors
+                                            integers of that size there (598 bits took 55 s,
+                                            ``--gain 1e-45,1e45`` on the beam); beyond, the
+                                            float path, which scales the pencil
+    ``EXACT_KAPPA_DEGREE``           64     degree of those coefficients in a constant
+                                            (``exp(100)`` is ``E**100``: 30 s; ``exp(690)``
+                                            ran past 600 s)
     ==============================  =====  ================================================
 
 Searches and numerics (checked at the entry of each library function)
@@ -53,7 +62,14 @@ Searches and numerics (checked at the entry of each library function)
                                              is classified (2^16 - 1 = 65 535 subsets)
     ``MAX_DISCRETE_STATES``     2000         states of one discretization, size n times
                                              (resolution + 1); a dense eigenproblem with
-                                             vectors at 2000 states takes minutes
+                                             vectors at 2000 states takes minutes, and an
+                                             export's verification plant of 2000 states
+                                             (``--plant-resolution 999`` on the beam)
+                                             about 45 s and 1.6 GB
+    ``MAX_NOISE_STATES``        1000         states of the largest discretization of the
+                                             noise figures (dense Lyapunov equations: 13 s
+                                             and 0.5 GB at 1000 states on the beam, 67 s
+                                             and 1.3 GB at 2000)
     ``MAX_SIMULATION_VALUES``   20 000 000   samples times states of a simulation (plant
                                              and observer), 160 MB per copy
     ``MAX_T_END``               1e12         final time of a simulation
@@ -71,7 +87,29 @@ Searches and numerics (checked at the entry of each library function)
                                              the range of doubles
     ``MAX_STARTS``              100          starts of the gain tuning
     ``MAX_TUNE_ITERATIONS``     10 000       optimizer iterations per start
+    ``MAX_TRADEOFF_GAINS``      1000         gains of a trade-off (scales of a ray, or the
+                                             product of a grid's counts); each costs a
+                                             spectrum and the noise figures (about 0.1 s on
+                                             the beam: 1000 gains take minutes), checked
+                                             before the gains are built
     =========================  ===========  ===============================================
+
+Sweeps (:mod:`phdesign.sweep`, checked before any store is created or worker started)
+    ============================  ===========  ============================================
+    ``MAX_SWEEP_POINTS``          1 000 000    points of a sweep (the product of its axes;
+                                               each axis, and the sensor sets ``all``, are
+                                               checked before their values are built): a
+                                               10⁶-point beam map is 3 h on one core
+                                               (``docs/scaling.md``)
+    ``MAX_STORE_METADATA_BYTES``  64 MiB       a metadata file of a stored sweep (its
+                                               description holds every axis value: 10⁶
+                                               values take about 25 MB), read in one
+                                               bounded piece before it is parsed
+    ``MAX_WORKERS_PER_CORE``      1            workers of a local cluster per core this
+                                               process may use: each is a process of about
+                                               150 MB, and the jobs are CPU-bound (more
+                                               workers than cores cost memory, not time)
+    ============================  ===========  ============================================
 
 Examples
 --------
@@ -89,12 +127,14 @@ import numbers
 import operator
 from typing import Any
 
-from phdesign.errors import ModelError, ModelFileError, NumericError, ObserverError
+from phdesign.errors import ModelError, ModelFileError, NumericError, ObserverError, SweepError
 
 __all__ = [
     "EXACT_DEFINITENESS_BITS",
     "EXACT_DEFINITENESS_DEGREE",
     "EXACT_DEFINITENESS_SIZE",
+    "EXACT_KAPPA_BITS",
+    "EXACT_KAPPA_DEGREE",
     "EXACT_KAPPA_OPERATIONS",
     "MAX_DEGREE",
     "MAX_DEPTH",
@@ -104,6 +144,7 @@ __all__ = [
     "MAX_MAGNITUDE",
     "MAX_MODEL_FILE_BYTES",
     "MAX_NOISE_INTENSITY",
+    "MAX_NOISE_STATES",
     "MAX_NUMBER_BITS",
     "MAX_NUMBER_DIGITS",
     "MAX_NUMBER_OPERATIONS",
@@ -115,16 +156,24 @@ __all__ = [
     "MAX_SIMULATION_VALUES",
     "MAX_SIZE",
     "MAX_STARTS",
+    "MAX_STORE_METADATA_BYTES",
+    "MAX_SWEEP_POINTS",
+    "MAX_TRADEOFF_GAINS",
     "MAX_TUNE_ITERATIONS",
     "MAX_T_END",
+    "MAX_WORKERS_PER_CORE",
     "MIN_TIME_STEP",
     "check_discretization",
+    "check_local_workers",
     "check_model_dimensions",
     "check_noise_intensity",
+    "check_noise_resolution",
     "check_parameter_count",
     "check_periods",
     "check_sensor_outputs",
     "check_simulation",
+    "check_sweep_points",
+    "check_tradeoff_gains",
     "check_tuning",
 ]
 
@@ -148,9 +197,12 @@ EXACT_DEFINITENESS_SIZE = 8
 EXACT_DEFINITENESS_DEGREE = 128
 EXACT_DEFINITENESS_BITS = 4096
 EXACT_KAPPA_OPERATIONS = 400
+EXACT_KAPPA_BITS = 256
+EXACT_KAPPA_DEGREE = 64
 # ---------------------------------------------------------------- searches and numerics
 MAX_SENSOR_OUTPUTS = 16
 MAX_DISCRETE_STATES = 2000
+MAX_NOISE_STATES = 1000
 MAX_SIMULATION_VALUES = 20_000_000
 MAX_T_END = 1e12
 MIN_TIME_STEP = 1e-300
@@ -158,6 +210,11 @@ MAX_PERIODS = 1e9
 MAX_NOISE_INTENSITY = 1e100
 MAX_STARTS = 100
 MAX_TUNE_ITERATIONS = 10_000
+MAX_TRADEOFF_GAINS = 1000
+# ---------------------------------------------------------------- sweeps
+MAX_SWEEP_POINTS = 1_000_000
+MAX_STORE_METADATA_BYTES = 64 << 20
+MAX_WORKERS_PER_CORE = 1
 
 #: The resolution a discretization uses when none is given is at most this (the finite
 #: differences' 70 nodes per group; Galerkin uses 40, or 16 for N >= 3): the estimate of
@@ -251,8 +308,25 @@ def check_discretization(nm: Any, method: object, *resolutions: object) -> None:
             raise NumericError(
                 f"resolution {value} gives the {method} discretization of a size-{nm.size} "
                 f"model about {states:,} states; expected at most {MAX_DISCRETE_STATES:,} "
-                f"({_budget('MAX_DISCRETE_STATES')})"
+                f"({_budget('MAX_DISCRETE_STATES')}; at 2,000 states an eigenproblem takes "
+                "minutes, an export's verification plant 45 s and 1.6 GB)"
             )
+
+
+def check_noise_resolution(nm: Any, resolution: int, name: str) -> None:
+    """Refuse noise figures whose largest discretization exceeds :data:`MAX_NOISE_STATES`.
+
+    ``resolution`` is the largest resolution the refinement may reach, ``name`` the
+    argument that sets it (``"resolution"`` or ``"max_resolution"``).
+    """
+    states = _states(nm, resolution)
+    if states > MAX_NOISE_STATES:
+        raise NumericError(
+            f"{name} {resolution} gives the noise figures of a size-{nm.size} model about "
+            f"{states:,} states; expected at most {MAX_NOISE_STATES:,} "
+            f"({_budget('MAX_NOISE_STATES')}: dense Lyapunov equations, 13 s and 0.5 GB at "
+            "1,000 states on the beam, 67 s and 1.3 GB at 2,000)"
+        )
 
 
 def check_simulation(
@@ -393,3 +467,36 @@ def check_tuning(
     if resolution is not None:
         fine = math.ceil(1.5 * _integer(resolution, "resolution", NumericError))
         check_discretization(nm, "galerkin", resolution, fine)
+
+
+def check_tradeoff_gains(count: int, what: str) -> None:
+    """Refuse a trade-off of more than :data:`MAX_TRADEOFF_GAINS` gains (before building them).
+
+    ``what`` names the argument for the message (``"scales"``, ``"grid"``).
+    """
+    if count > MAX_TRADEOFF_GAINS:
+        raise NumericError(
+            f"{what} gives {count:,} gains; a trade-off evaluates at most "
+            f"{MAX_TRADEOFF_GAINS:,} (a spectrum and the noise figures at each, about 0.1 s "
+            f"apiece on the beam; {_budget('MAX_TRADEOFF_GAINS')})"
+        )
+
+
+def check_sweep_points(count: int, what: str) -> None:
+    """Refuse a sweep, or one of its axes, of more than :data:`MAX_SWEEP_POINTS` points."""
+    if count > MAX_SWEEP_POINTS:
+        raise SweepError(
+            f"{what} has {count:,} points; a sweep has at most {MAX_SWEEP_POINTS:,} "
+            f"({_budget('MAX_SWEEP_POINTS')}): split the study into several sweeps"
+        )
+
+
+def check_local_workers(workers: int, cores: int) -> None:
+    """Refuse more local workers than :data:`MAX_WORKERS_PER_CORE` per usable core."""
+    cap = max(1, MAX_WORKERS_PER_CORE * cores)
+    if workers > cap:
+        raise SweepError(
+            f"workers: a local cluster has at most {cap} workers on this machine "
+            f"({MAX_WORKERS_PER_CORE} per core it may use, {_budget('MAX_WORKERS_PER_CORE')}: "
+            f"each worker is a process of about 150 MB); found {workers}"
+        )

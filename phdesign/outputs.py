@@ -46,7 +46,7 @@ from pathlib import Path
 from types import FrameType, TracebackType
 from typing import Any
 
-from phdesign.errors import OutputFileError
+from phdesign.errors import ArgumentError, OutputFileError
 
 __all__ = [
     "OutputFiles",
@@ -189,10 +189,10 @@ class OutputFiles:
 
     def stage(self, path: str | os.PathLike[str], data: str | bytes) -> None:
         """Write the content of a reserved target to its temporary file."""
+        content = _content(data, "data")  # before anything is reserved
         target = Path(path)
         if target not in self._targets:
             target = self.add(target)
-        content = data.encode("utf-8") if isinstance(data, str) else bytes(data)
         if self._targets[target] == "null":
             self._staged[target] = content
             return
@@ -382,10 +382,26 @@ def atomic_write(path: str | os.PathLike[str], text: str | bytes, force: bool = 
 
     Raises
     ------
+    ArgumentError
+        If ``text`` is neither text nor bytes.
     OutputFileError
         If the target is refused (see :func:`check_output_path`) or cannot be written.
     """
+    _content(text, "text")  # refused before the path is looked at
     with OutputFiles(force) as out:
         out.add(path)
         out.stage(path, text)
         out.commit()
+
+
+def _content(data: object, name: str) -> bytes:
+    """Return ``data`` as bytes: text (UTF-8) or bytes-like; refuse anything else by name.
+
+    ``bytes(123)`` is 123 zero bytes, and ``None`` a TypeError from CPython: neither may
+    reach a file.
+    """
+    if isinstance(data, str):
+        return data.encode("utf-8")
+    if isinstance(data, bytes | bytearray | memoryview):
+        return bytes(data)
+    raise ArgumentError(f"{name}: expected text or bytes to write; found {type(data).__name__}")

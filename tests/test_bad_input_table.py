@@ -911,6 +911,107 @@ COMMAND_ROWS = [
         **{"p.png": "an earlier picture"},
     ),
     row("plot {tmp}/m.zarr -o {tmp}/p.png --select d", "--select expects NAME=VALUE", SweepError),
+    # ---- issue 30 (part B): sweep targets, refused points, addresses, caps
+    row(
+        f"{TRADE} --scales 0.1:10:100000000",
+        "--scales gives 100,000,000 gains; a trade-off evaluates at most 1,000",
+        NumericError,
+        seconds=10,
+    ),
+    row(
+        f"{TRADE} --grid 0.1:1:1000,0.1:1:1000",
+        "--grid gives 1,000,000 gains; a trade-off evaluates at most 1,000",
+        NumericError,
+        seconds=10,
+    ),
+    row(
+        f"{NOISE} --resolution 999",
+        "resolution 999 gives the noise figures of a size-2 model about 2,000 states; expected "
+        "at most 1,000 (the budget phdesign.limits.MAX_NOISE_STATES: dense Lyapunov",
+        NumericError,
+        seconds=10,
+    ),
+    row(
+        f"{MAP} -o {{tmp}}/pipe.zarr --force",
+        "output .*pipe.zarr' is a FIFO; a sweep writes its store only where there is nothing",
+        OutputFileError,
+        **{"pipe.zarr": "fifo:"},
+    ),
+    row(
+        f"{MAP} -o {{tmp}}/link.zarr --force",
+        "is a symbolic link; a sweep writes its store only",
+        OutputFileError,
+        **{"link.zarr": "symlink:nowhere/at/all"},
+    ),
+    row(
+        f"{MAP} --resolution 100000 -o {{tmp}}/m.zarr",
+        "resolution 100000 gives the galerkin discretization of a size-2 model about 200,002 "
+        "states; expected at most 2,000",
+        NumericError,
+    ),
+    row(
+        f"{SWEEP} --grid l1=1e-320,1",
+        r"gain axis l1: gains must lie between 1e-300 and 1e\+300, as every gain; found 1e-320",
+        SweepError,
+    ),
+    row(
+        "sweep {tmp}/m.toml --param-grid c=0:1:3 --scheduler synchronous -o {tmp}/m.zarr",
+        # H11 = 1 - 5 c (1 - c) is 1 at both ends and -1/4 at the interior value c = 1/2
+        r"parameter grid c = 0.5: H must be positive definite .*found eigenvalues \[-0.25, 1\]",
+        ModelError,
+        **{
+            "m.toml": tomli_w.dumps(
+                {
+                    "name": "string stiffer at both ends of c",
+                    "interval": [0, 1],
+                    "order": 1,
+                    "parameters": {"c": 0.0},
+                    "matrices": {"P1": [[0, 1], [1, 0]], "H": [["1 - 5*c*(1 - c)", 0], [0, 1]]},
+                    "ports": {"inputs": ["e1(0)", "e2(1)"], "outputs": ["-e2(0)", "e1(1)"]},
+                }
+            )
+        },
+    ),
+    row(
+        f"{SWEEP} --grid l1=0.1:1:3 --scheduler tcp://127.0.0.1:99999",
+        "Port out of range",
+        SweepError,
+    ),
+    row(
+        f"{SWEEP} --grid l1=0.1:1:3 --scheduler tcp://127.0.0.1:0",
+        "the port must be from 1 to 65535; found 0",
+        SweepError,
+    ),
+    row(
+        f"{SWEEP} --grid l1=0.1:1:3 --scheduler tcp://host:port", "malformed .*'port'", SweepError
+    ),
+    row(f"{SWEEP} --grid l1=0.1:1:3 --scheduler tcp://[::1:8786", "Invalid IPv6 URL", SweepError),
+    row(f"{SWEEP} --grid l1=0.1:1:3 --scheduler tcp://h:1:2", "malformed .*'1:2'", SweepError),
+    row(f"{SWEEP} --grid l1=0.1:1:3 --scheduler udp://h:1", "unknown transport 'udp'", SweepError),
+    row(
+        f"{SWEEP} --grid l1=0.1:1:100000000",
+        "grid l1 has 100,000,000 points; a sweep has at most 1,000,000",
+        SweepError,
+        seconds=10,
+    ),
+    row(
+        f"{SWEEP} --grid l1=0.1:1:1000 --param-grid rho=1:2:1001",
+        "the sweep has 1,001,000 points; a sweep has at most 1,000,000",
+        SweepError,
+        seconds=10,
+    ),
+    row(
+        "sweep {tmp}/beams.toml --job classify --sensor-sets all -o {tmp}/m.zarr",
+        "sensor sets 'all' of 32 outputs has 4,294,967,295 points; a sweep has at most",
+        SweepError,
+        seconds=10,
+        **{"beams.toml": beams_toml(8)},
+    ),
+    row(
+        "sweep wave --sensors 2 --grid l1=0.1:1:3 --workers 100000 -o {tmp}/m.zarr",
+        r"workers: a local cluster has at most \d+ workers on this machine .*found 100000",
+        SweepError,
+    ),
 ]
 
 

@@ -22,10 +22,12 @@ from phdesign.cli import main
 from phdesign.errors import (
     ArgumentError,
     ModelError,
+    ModelFileError,
     NumericError,
     ObserverError,
     PhdesignError,
 )
+from phdesign.io import model_from_dict, read_model
 
 
 def run(capsys, *argv):
@@ -177,11 +179,26 @@ def test_numeric_functions_refuse_what_classify_refuses(wave):
 
 # ----------------------------------------------------------------------------- item 8
 def test_public_functions_name_their_arguments(wave, beam):
+    from bad_inputs import BEAM
+
     from phdesign.numeric.bridge import to_numeric
     from phdesign.numeric.simulate import simulate
     from phdesign.numeric.spectrum import spectrum
 
     nm = to_numeric(wave)
+
+    def string(**extra):
+        return phd.BCPHS.define(
+            name="s",
+            interval=(0, 1),
+            order=1,
+            P={1: [[0, 1], [1, 0]]},
+            H=[[1, 0], [0, 1]],
+            inputs=["e1(0)", "e2(1)"],
+            outputs=["-e2(0)", "e1(1)"],
+            **extra,
+        )
+
     cases = [
         (
             lambda: phd.derive_ports("wave"),
@@ -212,16 +229,7 @@ def test_public_functions_name_their_arguments(wave, beam):
         (lambda: phd.search_sensors("wave"), ArgumentError, r"model: expected a BCPHS"),
         (lambda: phd.load(3), ArgumentError, r"source: expected a built-in model name"),
         (
-            lambda: phd.BCPHS.define(
-                name="s",
-                interval=(0, 1),
-                order=1,
-                P={1: [[0, 1], [1, 0]]},
-                H=[[1, 0], [0, 1]],
-                inputs=["e1(0)", "e2(1)"],
-                outputs=["-e2(0)", "e1(1)"],
-                state_names=[1, 2],
-            ),
+            lambda: string(state_names=[1, 2]),
             ModelError,
             r"state label 1 must be non-empty text; found 1",
         ),
@@ -229,6 +237,42 @@ def test_public_functions_name_their_arguments(wave, beam):
             lambda: phd.Observer(wave, sensors=[2], gain=1).statespace("loop"),
             ObserverError,
             r"system must be one of 'plant', 'observer', 'error'",
+        ),
+        # issue 30: foreign errors (numpy's reshape, os, AttributeError) and a silent
+        # reading of bytes as their code points (gain=b"1" was diag(49, 49))
+        (
+            lambda: simulate(nm, u=lambda t: [1], t_end=0.1, samples=3, resolution=4),
+            ArgumentError,
+            r"u\(t\) must return 2 numbers \(one per input\); found 1 at t = 0",
+        ),
+        (
+            lambda: simulate(nm, u=lambda t: [np.nan, 0], t_end=0.1, samples=3, resolution=4),
+            NumericError,
+            r"u\(t\) must be finite; found nan in input u1 at t = 0",
+        ),
+        (lambda: read_model(None), ArgumentError, r"path: expected a file name .*NoneType"),
+        (lambda: read_model(0), ArgumentError, r"path: expected a file name .*found int 0"),
+        (
+            lambda: model_from_dict({**BEAM, "matrices": {**BEAM["matrices"], 2: [[1]]}}),
+            ModelFileError,
+            r"the keys of \[matrices\] must be names \(text\); found 2",
+        ),
+        (
+            lambda: string(displacement=(1, 1)),
+            ArgumentError,
+            r"displacement must be a Displacement\(component=i, integrations=k\) of two "
+            r"integers; found tuple \(1, 1\)",
+        ),
+        (lambda: phd.classify(wave, [[0, 1]], b"1"), ObserverError, r"gain is bytes b'1'"),
+        (
+            lambda: phd.classify(wave, [b"\x00\x01"], 1),
+            ObserverError,
+            r"C_m: row 1 is bytes b'\\x00\\x01'; expected numbers",
+        ),
+        (
+            lambda: phd.gain_matrix(np.array([b"1"]), 1),
+            ObserverError,
+            r"gain: row 1 is bytes",
         ),
     ]
     for call, error, message in cases:
@@ -388,3 +432,15 @@ def test_library_raises_no_plain_value_errors(beam, monkeypatch):
         phd.classify(beam, phd.sensor_matrix([4], 4), 1, method="exact")
     with pytest.raises(ObserverError, match="needs the partition"):
         VARIANTS[8].traces(order=2, size=2)
+
+
+def test_atomic_write_refuses_what_is_neither_text_nor_bytes(tmp_path):
+    """`atomic_write('x.out', 123)` wrote 123 zero bytes (bytes(123)) and raised nothing."""
+    from phdesign.io import atomic_write
+
+    for data in (123, None, 1.5, ["a"]):
+        with pytest.raises(ArgumentError, match="text: expected text or bytes to write"):
+            atomic_write(tmp_path / "x.out", data)
+    assert list(tmp_path.iterdir()) == []
+    atomic_write(tmp_path / "x.out", bytearray(b"kept"))
+    assert (tmp_path / "x.out").read_bytes() == b"kept"

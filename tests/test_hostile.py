@@ -95,6 +95,19 @@ def test_no_sympify_eval_or_lambdify_on_caller_data_in_the_package():
 
 
 # --------------------------------------------------------------------------- items 6, 11
+def graded_string(entry: str) -> BCPHS:
+    """The unit string with H = diag(entry, 1): an entry in z tests parser and checks."""
+    return BCPHS.define(
+        name="tapered string",
+        interval=(0, 1),
+        order=1,
+        P={1: [[0, 1], [1, 0]]},
+        H=[[entry, 0], [0, 1]],
+        inputs=["e1(0)", "e2(1)"],
+        outputs=["-e2(0)", "e1(1)"],
+    )
+
+
 @pytest.mark.parametrize(
     "entry",
     [
@@ -107,15 +120,7 @@ def test_no_sympify_eval_or_lambdify_on_caller_data_in_the_package():
     ],
 )
 def test_show_toml_writes_back_exactly_what_phdesign_accepts(entry, tmp_path):
-    model = BCPHS.define(
-        name="tapered string",
-        interval=(0, 1),
-        order=1,
-        P={1: [[0, 1], [1, 0]]},
-        H=[[entry, 0], [0, 1]],
-        inputs=["e1(0)", "e2(1)"],
-        outputs=["-e2(0)", "e1(1)"],
-    )
+    model = graded_string(entry)
     text = model_to_toml(model)
     assert model_from_toml(text) == model
     path = tmp_path / "m.toml"
@@ -389,3 +394,47 @@ def test_the_float_path_holds_huge_gains_without_overflow(capsys):
 )
 def test_the_sensor_search_holds_huge_gains(capsys):
     assert main(["classify", "wave", "--all-sensors", "--gain", "1e200"]) == 0
+
+
+# --------------------------------------------------------------------------- issue 30 (B)
+@pytest.mark.parametrize("entries", [("exp(100)", 1), ("exp(690)", 1), ("1e-300", "1e300")])
+def test_huge_exact_gains_take_the_float_path_with_the_exact_closed_form(entries):
+    """`--gain 'exp(100),1'` took 42 s (exp(690) over 600 s, 1e-300,1e300 over 60 s): sympy
+    factors the coefficients of the pencil's characteristic polynomial while it isolates
+    its roots (598 bits: 55 s; exp(100) is degree 200 in E).  Over EXACT_KAPPA_BITS or
+    EXACT_KAPPA_DEGREE the certificate takes the float path, which scales the pencil.
+
+    Expected value: the exact path gives κ*(3.4.3) = k/(1 + k²) for L = diag(k, 1) on the
+    beam (k = exp(20): exp(20)/(1 + exp(40)), checked here), the wave damper's form; with
+    L = diag(1/k, k) variant 3.1.2 is k/(1 + k²) too (exact at k = 1e10): 1e-300 at 1e300.
+    """
+    from phdesign.errors import ObserverError
+    from phdesign.symbolic.classify import classify
+    from phdesign.symbolic.observer import gain_matrix, sensor_matrix
+
+    beam, C = load_builtin("euler-bernoulli"), sensor_matrix([3, 4], 4)
+    k = sympy.exp(20)
+    exact = classify(beam, C, gain_matrix(["exp(20)", 1], 2)).result("3.4", 3)
+    assert (exact.path, sympy.simplify(exact.kappa - k / (1 + k**2))) == ("exact", 0)
+    result = classify(beam, C, gain_matrix(list(entries), 2))
+    if entries[0] == "1e-300":
+        case, expected = result.result("3.1", 2), 1e-300
+        moderate = classify(beam, C, gain_matrix(["1e-10", "1e10"], 2)).result("3.1", 2)
+        assert moderate.path == "exact"
+        assert moderate.kappa == sympy.Rational(10**10, 1 + 10**20)  # k/(1 + k²), k = 1e10
+    else:
+        k = sympy.exp(int(entries[0][4:-1]))
+        case, expected = result.result("3.4", 3), float((k / (1 + k**2)).evalf(30))
+    assert case.path == "float"
+    assert case.kappa_float == pytest.approx(expected, rel=1e-12)
+    with pytest.raises(ObserverError, match="exact κ\\* of this pencil is over budget"):
+        classify(beam, C, gain_matrix(list(entries), 2), "exact")
+
+
+def test_a_steep_energy_is_proved_positive():
+    """H = diag(exp(30 z), 1) was refused as "could not be proved": the round-off allowance
+    came from the largest entry (1e-13 · e³⁰ > 1, the smallest eigenvalue); it now comes
+    from the magnitudes each bound is computed from."""
+    for entry in ("exp(30*z)", "exp(-300*z)"):
+        model = graded_string(entry)
+        assert any("proved between the points by interval bounds" in c for c in model.checks)

@@ -160,3 +160,53 @@ def test_a_silent_scheduler_is_an_error_within_its_timeout(tmp_path, monkeypatch
         server.close()
     assert time.monotonic() - start < 5
     assert not any(tmp_path.iterdir()), "nothing is written when the scheduler is unreachable"
+
+
+@pytest.mark.slow
+def test_ctrl_c_on_a_local_cluster_sweep_is_one_line_and_the_workers_end_quietly(tmp_path):
+    """Ctrl-C (SIGINT to the terminal's process group) printed 34 to 68 lines of worker
+    tracebacks.  The sweep runs in a session of its own, so the signal reaches it and its
+    workers as a terminal's would; the child restores the default SIGINT handler, so the
+    test holds when the runner ignores SIGINT (then the child would inherit that)."""
+    import signal
+
+    store = tmp_path / "m.zarr"
+    argv = ["sweep", "euler-bernoulli", "--sensors", "3,4", "--grid", "l1=0.05:3:200:log"]
+    argv += ["--chunk-size", "1", "--workers", "2", "--no-progress", "-o", str(store)]
+    code = (
+        "import signal, sys\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        "from phdesign.cli import main\n"
+        f"sys.exit(main({argv!r}))\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1"}
+    env.pop("DASK_SCHEDULER_ADDRESS", None)
+    child = subprocess.Popen(
+        [sys.executable, "-c", code],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+    )
+    markers = store / ".phdesign" / "chunks"
+    deadline = time.monotonic() + 120  # a guard against a hung child, not a measurement
+    while child.poll() is None and time.monotonic() < deadline:
+        if markers.is_dir() and sum(p.name.isdigit() for p in markers.iterdir()) >= 4:
+            break  # the workers are computing chunks
+        time.sleep(0.01)
+    assert child.poll() is None, child.stderr.read().decode()
+    os.killpg(child.pid, signal.SIGINT)
+    _, err = child.communicate(timeout=120)
+    assert child.returncode == 2, err.decode()
+    assert err.decode() == "phdesign: error: interrupted\n"
+    while time.monotonic() < deadline:  # the workers leave with the cluster
+        try:
+            os.killpg(child.pid, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.05)
+    else:
+        pytest.fail("a process of the sweep's group outlived it")
+    assert not (store / ".phdesign" / "complete.json").exists()  # resumable, not removed
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.zarr"]  # the lock file is gone

@@ -34,6 +34,7 @@ from phdesign.cli.common import (
 )
 from phdesign.cli.design_arguments import add_observer_arguments
 from phdesign.errors import NumericError, ObserverError
+from phdesign.limits import check_tradeoff_gains
 
 __all__ = [
     "add_noise_arguments",
@@ -252,6 +253,7 @@ def _range(text: str, flag: str) -> Any:
             f"{flag}: expected 0 < lo < hi and a count of at least 2 in lo:hi:count; "
             f"found {text!r}"
         )
+    check_tradeoff_gains(count, flag)  # before the values are built
     return np.geomspace(lo, hi, count)
 
 
@@ -273,6 +275,7 @@ def _tradeoff(args: argparse.Namespace) -> int:
     grid = None
     if args.grid is not None:
         grid = [_range(axis, "--grid") for axis in str(args.grid).split(",")]
+        check_tradeoff_gains(math.prod(len(axis) for axis in grid), "--grid")
     scales = None if args.scales is None else _range(args.scales, "--scales")
     # the table and the picture are checked now and written together: both or neither
     with run_outputs(args) as commit:

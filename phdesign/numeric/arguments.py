@@ -38,7 +38,6 @@ __all__ = [
     "check_simulate_arguments",
     "check_spectrum_arguments",
     "check_tune_arguments",
-    "input_samples",
 ]
 
 
@@ -105,50 +104,6 @@ def check_initial_state(x0: Any, nm: Any, name: str) -> None:
             f"{name} must be finite on [{a:g}, {b:g}]; found {values[i, j]} in component "
             f"{j + 1} at z = {z[i]:g}"
         )
-
-
-def input_samples(u: Callable[[float], Any], t: Any, n_ports: int, name: str = "u") -> np.ndarray:
-    """Evaluate the input signal ``u`` at the times ``t``: ``(len(t), n_ports)``, finite.
-
-    The one evaluation of a caller's input signal: a value that is not ``n_ports``
-    numbers, or is not finite, is refused with the time and the input it was found at
-    (a NaN input gave NaN series without an error).
-
-    Examples
-    --------
-    >>> input_samples(lambda t: [t, 1.0], [0.0, 0.5], 2)
-    array([[0. , 1. ],
-           [0.5, 1. ]])
-    >>> input_samples(lambda t: [1.0, np.log(t)], [1.0, 0.0], 2)  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    phdesign.errors.NumericError: u(t) must be finite; found -inf in input u2 at t = 0
-    """
-    times = np.asarray(t, dtype=float).reshape(-1)
-    rows = np.empty((times.size, n_ports))
-    for k, tk in enumerate(times):
-        with np.errstate(all="ignore"):  # a division by zero is reported below, by value
-            value = u(float(tk))
-            try:
-                row = np.asarray(value, dtype=float)
-            except (TypeError, ValueError):
-                raise ArgumentError(
-                    f"{name}(t) must return {n_ports} numbers (one per input); found "
-                    f"{type(value).__name__} {value!r} at t = {tk:g}"
-                ) from None
-        if row.size != n_ports:
-            raise NumericError(
-                f"{name}(t) must return {n_ports} numbers (one per input); found shape "
-                f"{row.shape} at t = {tk:g}"
-            )
-        rows[k] = row.reshape(n_ports)
-        bad = np.flatnonzero(~np.isfinite(rows[k]))
-        if bad.size:
-            raise NumericError(
-                f"{name}(t) must be finite; found {rows[k, bad[0]]} in input u{bad[0] + 1} at "
-                f"t = {tk:g}"
-            )
-    return rows
 
 
 def _common(

@@ -6,6 +6,8 @@ The second half of the crossing from the symbolic layer (:mod:`phdesign.numeric.
   ``e1: ...`` through :math:`x = \mathcal H^{-1} e`, the model's parameters) as a
   vectorized :math:`x_0(z)`;
 * :func:`input_function`: ``"u2: sin(2*t)"`` as :math:`u(t)` over the model's inputs;
+* :func:`input_samples`: a caller's :math:`u(t)` (from :func:`input_function` or their
+  own function) at the sample times, checked: ``n_ports`` finite numbers at each;
 * :func:`trace_row`: a linear combination of boundary traces, ``"e1(1)"``, as a row over
   the trace vector :math:`v` (:mod:`phdesign.numeric.bridge` gives the ordering).
 
@@ -22,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import ExpressionError, NumericError, ParameterError
+from phdesign.errors import ExpressionError, NumericError, ParameterError, PhdesignError
 from phdesign.numeric.bridge import (
     NumericModel,
     _free_symbols_message,
@@ -30,7 +32,7 @@ from phdesign.numeric.bridge import (
     trace_index,
 )
 
-__all__ = ["initial_state_function", "input_function", "trace_row"]
+__all__ = ["initial_state_function", "input_function", "input_samples", "trace_row"]
 
 
 def _evaluate_at(expr: Any, variable: Any, t: float) -> Any:
@@ -325,3 +327,60 @@ def input_function(
         return out
 
     return u
+
+
+def input_samples(
+    u: Callable[[float], Any], times: Any, count: int, name: str = "u"
+) -> np.ndarray:
+    """Return ``u`` at each time, one row of ``count`` finite numbers per time.
+
+    The one evaluation of a caller's input signal.  The function may return any array of
+    ``count`` numbers (a list, a column); anything else is refused before it reaches the
+    time stepping, where numpy's reshape error or a series of NaN would have followed,
+    with the time and the input it was found at.
+
+    Raises
+    ------
+    ArgumentError
+        ``u(t)`` is not numbers, or not ``count`` of them.
+    NumericError
+        ``u(t)`` is not finite.
+
+    Examples
+    --------
+    >>> input_samples(lambda t: [t, 1], [0.0, 0.5], 2)
+    array([[0. , 1. ],
+           [0.5, 1. ]])
+    >>> input_samples(lambda t: [1], [0.0], 2)
+    Traceback (most recent call last):
+    ...
+    phdesign.errors.ArgumentError: u(t) must return 2 numbers (one per input); found 1 at t = 0
+    >>> input_samples(lambda t: [1.0, np.log(t)], [1.0, 0.0], 2)
+    Traceback (most recent call last):
+    ...
+    phdesign.errors.NumericError: u(t) must be finite; found -inf in input u2 at t = 0
+    """
+    from phdesign.errors import ArgumentError
+
+    rows = []
+    for t in np.asarray(times, dtype=float).ravel():
+        try:
+            with np.errstate(all="ignore"):  # a division by zero is reported below, by value
+                value = np.asarray(u(float(t)), dtype=float)
+        except PhdesignError:  # the input's own refusal (input_function's), as it is
+            raise
+        except (TypeError, ValueError) as error:
+            raise ArgumentError(f"{name}(t) must return numbers; at t = {t:g}: {error}") from None
+        if value.size != count:
+            raise ArgumentError(
+                f"{name}(t) must return {count} numbers (one per input); found {value.size} "
+                f"at t = {t:g}"
+            )
+        bad = np.flatnonzero(~np.isfinite(value.ravel()))
+        if bad.size:
+            raise NumericError(
+                f"{name}(t) must be finite; found {value.ravel()[bad[0]]} in input "
+                f"u{bad[0] + 1} at t = {t:g}"
+            )
+        rows.append(value.reshape(count))
+    return np.array(rows).reshape(len(rows), count)

@@ -27,9 +27,9 @@ from typing import Any
 import numpy as np
 
 from phdesign.errors import LoopError, NumericError
-from phdesign.numeric.arguments import input_samples
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
+from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.loop import NumericLoop, assemble
 from phdesign.numeric.simulate import (
     ENERGY_BALANCE_RTOL,

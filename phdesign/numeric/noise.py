@@ -66,6 +66,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from phdesign import limits
 from phdesign.arguments import positive_int, positive_number
 from phdesign.errors import NumericError, ObserverError
 from phdesign.limits import check_noise_intensity
@@ -397,10 +398,13 @@ def noise(
     rtol = RESOLVED_RTOL.get(method, 1e-2)
     p0, pmax = default_resolutions(nm, method)
     p = p0 if resolution is None else positive_int(resolution, "resolution")
+    limits.check_noise_resolution(nm, p, "resolution")
     if max_resolution is None:
-        pmax = max(pmax, p)
+        # the default refinement stops within the budget (a size-16 model: degree 61)
+        pmax = max(p, min(pmax, limits.MAX_NOISE_STATES // nm.size - 1))
     else:
         pmax = positive_int(max_resolution, "max_resolution")
+        limits.check_noise_resolution(nm, pmax, "max_resolution")
         if pmax < p:
             raise NumericError(
                 f"max_resolution must be at least the first resolution {p}; found {pmax}"

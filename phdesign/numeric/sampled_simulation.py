@@ -23,9 +23,9 @@ import numpy as np
 
 from phdesign.errors import NumericError
 from phdesign.limits import check_periods
-from phdesign.numeric.arguments import input_samples
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import discretize
+from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.phs import DiscretePHS
 from phdesign.numeric.sampling import (
     ContinuousObserver,

@@ -50,10 +50,11 @@ from typing import Any
 import numpy as np
 
 from phdesign.errors import NumericError
-from phdesign.numeric.arguments import check_simulate_arguments, input_samples
+from phdesign.numeric.arguments import check_simulate_arguments
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.display import SimulationDisplay
+from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.stepping import (
     MIDPOINT_RTOL,
     SCHEMES,

@@ -48,9 +48,9 @@ import scipy.linalg as sl
 
 from phdesign.arguments import positive_int
 from phdesign.errors import NumericError, ObserverError
-from phdesign.numeric.arguments import input_samples
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, discretize, feedback_matrix
+from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.noise import noise_intensities
 from phdesign.numeric.simulate import SimulationResult, coupled_system, simulate
 from phdesign.numeric.stepping import dissipation_integral

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from phdesign.errors import NumericError
+from phdesign.limits import check_tradeoff_gains
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretize import DiscretePHS, feedback_matrix
 from phdesign.numeric.functionals import Functional, parse_functionals
@@ -298,12 +299,14 @@ def gain_family(
                 raise NumericError(
                     f"grid axis {i + 1}: expected positive finite gains; found {a.tolist()}"
                 )
+        check_tradeoff_gains(math.prod(a.size for a in axes), "grid")  # before building them
         gains = [np.diag(np.array(c)) for c in product(*axes)]
         return gains, [None] * len(gains), None
     L0 = np.eye(q) if direction is None else _floats(direction, "direction")
     if L0.ndim == 1:
         L0 = np.diag(np.broadcast_to(L0, (q,)) if L0.size == 1 else L0)
     s = np.geomspace(0.1, 10.0, 12) if scales is None else _floats(scales, "scales").ravel()
+    check_tradeoff_gains(s.size, "scales")
     if s.size == 0 or not np.all(np.isfinite(s)) or np.any(s <= 0):
         raise NumericError(f"scales: expected positive finite numbers; found {s.tolist()}")
     return [float(v) * L0 for v in s], [float(v) for v in s], L0

@@ -35,11 +35,13 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from phdesign.errors import ParameterError, PhdesignError, SweepError
+from phdesign.limits import MAX_STORE_METADATA_BYTES, check_sweep_points
 from phdesign.sweep.grids import Axis, parse_axis, parse_sensor_sets, sensor_set_indices
 from phdesign.sweep.jobs import Job, get_job
 
@@ -175,25 +177,38 @@ class SweepDescription:
         return json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"), allow_nan=False)
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> SweepDescription:
-        """Inverse of :meth:`to_dict`."""
-        return cls(
-            model_toml=str(data["model_toml"]),
-            model_name=str(data["model"]),
-            n_outputs=int(data["n_outputs"]),
-            parameter_names=tuple(data["parameter_names"]),
-            job=str(data["job"]),
-            options=tuple(sorted(dict(data["options"]).items())),
-            axes=tuple(Axis.from_dict(a) for a in data["axes"]),
-            sensors=None if data["sensors"] is None else tuple(data["sensors"]),
-            gain=None if data["gain"] is None else tuple(float(g) for g in data["gain"]),
-            version=str(data["version"]),
-        )
+    def from_dict(cls, data: Any) -> SweepDescription:
+        """Inverse of :meth:`to_dict`, for data read from a file: every field is checked.
+
+        Raises
+        ------
+        SweepError
+            A field missing, unknown, of the wrong kind or out of range (named), a job or
+            an option the registry does not know, or more points than a sweep may have
+            (:func:`phdesign.sweep.schema.description_fields`).
+        """
+        from phdesign.sweep.schema import description_fields
+
+        return cls(**description_fields(data))
 
     @classmethod
     def from_json(cls, text: str) -> SweepDescription:
-        """Inverse of :meth:`to_json`."""
-        return cls.from_dict(json.loads(text))
+        """Inverse of :meth:`to_json` (refusing, as :meth:`from_dict` does, what is not one).
+
+        Raises
+        ------
+        SweepError
+            Not text, not JSON, or not a description.
+        """
+        if not isinstance(text, str) or len(text) > MAX_STORE_METADATA_BYTES:
+            raise SweepError("a stored description must be JSON text of bounded size")
+        try:
+            data = json.loads(text)
+        except ValueError as error:
+            raise SweepError(f"a stored description is not JSON: {error}") from None
+        except RecursionError:
+            raise SweepError("a stored description is nested too deeply") from None
+        return cls.from_dict(data)
 
     @property
     def fingerprint(self) -> str:
@@ -271,6 +286,33 @@ def _fixed_gain(gain: str | Sequence[float] | float, count: int, per: str) -> tu
                 f"--gain: entry {i + 1} must be a finite positive number (L + Lᵀ ≻ 0); found {v!r}"
             )
     return values
+
+
+#: A parameter axis of at most this many values is checked at every value before the sweep
+#: starts (5 to 10 ms each); a longer one at its ends, and a chunk that meets a refused
+#: value names its point (and a store the sweep created is removed again).
+_CHECKED_PARAMETER_VALUES = 256
+
+
+def _parameter_axis(name: str, text: Any, known: tuple[str, ...]) -> Axis:
+    if name not in known:
+        raise ParameterError(
+            f"unknown parameter {name!r}; the model's parameters are "
+            f"{', '.join(known) if known else 'none'}"
+        )
+    return parse_axis(name, text, "parameter")
+
+
+def _check_parameter_values(model: Any, axis: Axis) -> None:
+    """Refuse a value of a parameter axis the model refuses (the others at their values)."""
+    values = axis.values
+    if len(values) > _CHECKED_PARAMETER_VALUES:
+        values = (values[0], values[-1])
+    for value in values:
+        try:
+            model.with_parameters({axis.name: value})
+        except PhdesignError as error:
+            raise type(error)(f"parameter grid {axis.name} = {value!r}: {error}") from None
 
 
 def describe(
@@ -376,23 +418,7 @@ def describe(
                 "(or l for every entry)"
             )
 
-    param_axes = []
-    for name, text in (param_grid or {}).items():
-        if name not in known:
-            raise ParameterError(
-                f"unknown parameter {name!r}; the model's parameters are "
-                f"{', '.join(known) if known else 'none'}"
-            )
-        axis = parse_axis(name, text, "parameter")
-        # the ends of the axis, the other parameters fixed: cheap, and it catches most bad
-        # ranges before any work; a chunk that meets a refused value names its point
-        for value in sorted({axis.values[0], axis.values[-1]}):
-            try:
-                model.with_parameters({name: value})
-            except PhdesignError as error:
-                raise type(error)(f"parameter grid {name} = {value!r}: {error}") from None
-        param_axes.append(axis)
-
+    param_axes = [_parameter_axis(name, text, known) for name, text in (param_grid or {}).items()]
     axes = tuple(([set_axis] if set_axis else []) + param_axes + gain_axes)
     if not axes:
         raise SweepError(
@@ -400,13 +426,18 @@ def describe(
         )
     if len({a.name for a in axes}) != len(axes):
         raise SweepError("an axis is given twice")
+    check_sweep_points(math.prod(a.size for a in axes), "the sweep")
+    for axis in param_axes:
+        _check_parameter_values(model, axis)
+    option_values = spec.option_values(options)
+    spec.check_options(model, option_values)
     return SweepDescription(
         model_toml=model_to_toml(model),
         model_name=str(model.name),
         n_outputs=n_outputs,
         parameter_names=known,
         job=job,
-        options=tuple(sorted(spec.option_values(options).items())),
+        options=tuple(sorted(option_values.items())),
         axes=axes,
         sensors=fixed_sensors,
         gain=fixed_gain,

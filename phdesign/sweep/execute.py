@@ -16,9 +16,12 @@ synchronous run, a local cluster and a remote one give identical arrays.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sys
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -135,13 +138,19 @@ def run(
     """Compute a described sweep and return its :class:`xarray.Dataset`.
 
     See :func:`phdesign.sweep.sweep` for the parameters.  Everything that can be refused
-    (the output, the scheduler) is checked before anything is written.
+    (the output, the scheduler) is checked before anything is written.  A Zarr store is
+    written under its lock (:class:`~phdesign.sweep.lock.StoreLock`): a second sweep on
+    the same store is refused while the first runs.  When a point is refused (a
+    :class:`~phdesign.errors.PhdesignError` from a chunk), a store this run created is
+    removed again; a store it resumed is left as it was found, with the chunks it added.
     """
-    from phdesign.sweep.schedulers import executor
+    from phdesign.sweep.lock import StoreLock
+    from phdesign.sweep.schedulers import check_scheduler
     from phdesign.sweep.store import ZarrStore
 
     if chunk_size is not None:
         check_chunk_size(chunk_size)
+    check_scheduler(scheduler, workers)
     kind = None if output is None else output_format(output)
     if kind != "zarr" and resume:
         raise SweepError(
@@ -152,20 +161,40 @@ def run(
                 else f"{str(output)!r} is written once, at the end"
             )
         )
-    store = ZarrStore(Path(output)) if kind == "zarr" and output is not None else None
-    action = "memory"
-    if store is not None:
-        action = store.check(description, resume=resume, force=force, chunk_size=chunk_size)
-    elif output is not None:
-        from phdesign.io import check_output_path
+    where = _Where(scheduler, workers, progress)
+    if kind != "zarr" or output is None:
+        if output is not None:
+            from phdesign.io import check_output_path
 
-        check_output_path(output, force)
-    if action in ("resume", "complete") and store is not None:
-        plan = store.plan()
-    else:
-        size = default_chunk_size(description) if chunk_size is None else chunk_size
-        plan = ChunkPlan.for_grid(description.shape, size)
-    record: dict[str, Any] = {
+            check_output_path(output, force)
+        dataset = _run_in_memory(description, chunk_size, where)
+        if output is not None:
+            write_export(dataset, output, force)
+        return dataset
+    store = ZarrStore(Path(output))
+    store.check(description, resume=resume, force=force, chunk_size=chunk_size)  # no lock yet
+    with StoreLock(store.path):
+        # decided again under the lock: a sweep that held it may have changed the store
+        action = store.check(description, resume=resume, force=force, chunk_size=chunk_size)
+        return _run_in_store(description, store, action, chunk_size, where)
+
+
+@dataclass(frozen=True)
+class _Where:
+    """Where and how the chunks run: the executor's arguments and the progress bar."""
+
+    scheduler: Any
+    workers: int | None
+    progress: bool | None
+
+
+def _new_plan(description: SweepDescription, chunk_size: int | None) -> ChunkPlan:
+    size = default_chunk_size(description) if chunk_size is None else chunk_size
+    return ChunkPlan.for_grid(description.shape, size)
+
+
+def _record(plan: ChunkPlan, output: Any) -> dict[str, Any]:
+    return {
         "chunks": plan.n_chunks,
         "chunk_shape": list(plan.chunk_shape),
         "computed": 0,
@@ -175,50 +204,88 @@ def run(
         "scheduler": "none (the store was complete)",
         "output": None if output is None else str(output),
     }
-    if action == "complete" and store is not None:
-        record["reused"] = plan.n_chunks
-        dataset = store.dataset()
-        dataset.attrs[RUN_ATTRIBUTE] = json.dumps(record)
-        return dataset
-    started = time.perf_counter()
+
+
+def _compute(
+    description: SweepDescription,
+    plan: ChunkPlan,
+    ex: Any,
+    done: set[int],
+    write: Callable[[dict[str, Any], tuple[slice, ...]], None],
+    record: dict[str, Any],
+    progress: bool | None,
+) -> None:
+    """Run every chunk not in ``done`` and ``write`` each result as it arrives."""
     text = description.to_json()
-    with executor(scheduler, workers) as ex:
-        done: set[int] = set()
-        arrays = None
-        group = None
-        if store is not None:
-            if action in ("create", "replace"):
-                store.create(
-                    template(description, plan, lazy=True), description, plan, action == "replace"
-                )
-            else:
-                store.remove_stale_markers()
-            done = store.done()
-            group = store.writer()
-        else:
-            arrays = template(description)
-        todo = [(plan.chunk_shape, i) for i in range(plan.n_chunks) if i not in done]
-        record["reused"] = len(done)
-        record["scheduler"] = ex.describe()
-        with _progress(plan.n_chunks, len(done), progress) as bar:
-            for result in ex.map_unordered(run_chunk, text, todo):
-                region = plan.region(result["index"])
-                if store is not None:
-                    store.write_chunk(group, result["index"], region, result["arrays"])
-                else:
-                    assert arrays is not None
-                    for name, block in result["arrays"].items():
-                        arrays[name].values[region] = block
-                record["computed"] += 1
-                record["compute_seconds"] += result["seconds"]
-                bar.update(1)
+    todo = [(plan.chunk_shape, i) for i in range(plan.n_chunks) if i not in done]
+    record["reused"] = len(done)
+    record["scheduler"] = ex.describe()
+    results = ex.map_unordered(run_chunk, text, todo)
+    # closed at once on an error or Ctrl-C (its finally cancels the futures and releases the
+    # scattered description), not when a traceback that holds it is collected
+    with contextlib.closing(results), _progress(plan.n_chunks, len(done), progress) as bar:
+        for result in results:
+            write(result, plan.region(result["index"]))
+            record["computed"] += 1
+            record["compute_seconds"] += result["seconds"]
+            bar.update(1)
+
+
+def _run_in_memory(description: SweepDescription, chunk_size: int | None, where: _Where) -> Any:
+    from phdesign.sweep.schedulers import executor
+
+    plan = _new_plan(description, chunk_size)
+    record = _record(plan, None)
+    started = time.perf_counter()
+    arrays = template(description)
+
+    def write(result: dict[str, Any], region: tuple[slice, ...]) -> None:
+        for name, block in result["arrays"].items():
+            arrays[name].values[region] = block
+
+    with executor(where.scheduler, where.workers) as ex:
+        _compute(description, plan, ex, set(), write, record, where.progress)
     record["seconds"] = time.perf_counter() - started
-    if store is not None:
-        store.mark_complete(record)
-        dataset = store.dataset()
-    else:
-        dataset = arrays
+    arrays.attrs[RUN_ATTRIBUTE] = json.dumps(record)
+    return arrays
+
+
+def _run_in_store(
+    description: SweepDescription, store: Any, action: str, chunk_size: int | None, where: _Where
+) -> Any:
+    """Create, replace, resume or reopen ``store`` (its lock held) and fill it."""
+    from phdesign.sweep.schedulers import executor
+
+    plan = store.plan() if action in ("resume", "complete") else _new_plan(description, chunk_size)
+    record = _record(plan, store.path)
+    if action == "complete":
+        record["reused"] = plan.n_chunks
+        return _finished(store, record)
+    started = time.perf_counter()
+    with executor(where.scheduler, where.workers) as ex:
+        created = action in ("create", "replace")
+        if created:
+            store.create(template(description, plan, lazy=True), description, plan, action)
+        else:
+            store.remove_stale_markers()
+        group = store.writer()
+
+        def write(result: dict[str, Any], region: tuple[slice, ...]) -> None:
+            store.write_chunk(group, result["index"], region, result["arrays"])
+
+        try:
+            _compute(description, plan, ex, store.done(), write, record, where.progress)
+        except PhdesignError:
+            if created:  # a refused point: this sweep can never complete; it was ours
+                store.remove()
+            raise
+    record["seconds"] = time.perf_counter() - started
+    store.mark_complete(record)
+    return _finished(store, record)
+
+
+def _finished(store: Any, record: dict[str, Any]) -> Any:
+    """Return the complete store's Dataset, read while its lock is held (a sweep may follow)."""
+    dataset = store.dataset()
     dataset.attrs[RUN_ATTRIBUTE] = json.dumps(record)
-    if store is None and output is not None:
-        write_export(dataset, output, force)
     return dataset

@@ -98,7 +98,9 @@ def open_sweep(path: str | Path) -> Any:
     OutputFileError
         The path does not exist or has another suffix.
     SweepError
-        A Zarr store that is not a complete phdesign sweep.
+        A store or file that is not a complete phdesign sweep, or whose metadata is not
+        its own description's (:mod:`phdesign.sweep.schema`: checked before any array
+        is read).
     """
     from phdesign.sweep.dataset import normalized
 
@@ -120,12 +122,38 @@ def open_sweep(path: str | Path) -> Any:
             )
         dataset = store.dataset()
     elif kind == "netcdf":
-        import xarray as xr
-
-        try:
-            dataset = xr.open_dataset(target, engine="scipy").load()
-        except (OSError, ValueError, TypeError) as error:
-            raise SweepError(f"cannot read {str(target)!r} as NetCDF: {error}") from None
+        dataset = _read_netcdf(target)
     else:
         raise SweepError(f"cannot read a sweep back from {str(target)!r}: plots read .zarr or .nc")
     return normalized(dataset)  # refuses a file that is not a phdesign sweep
+
+
+def _read_netcdf(target: Path) -> Any:
+    """Open a NetCDF sweep lazily, check it against its own description, then read it."""
+    import os
+    import stat
+
+    import xarray as xr
+
+    from phdesign.errors import PhdesignError
+    from phdesign.sweep.dataset import description_of
+    from phdesign.sweep.schema import check_netcdf
+
+    shown = repr(str(target))
+    if not stat.S_ISREG(os.stat(target).st_mode):  # a FIFO would block the reader
+        raise SweepError(f"cannot read {shown} as NetCDF: it is not a regular file")
+    try:
+        dataset = xr.open_dataset(target, engine="scipy")  # the header only: lazy
+    except Exception as error:  # whatever scipy's parser makes of foreign bytes
+        raise SweepError(f"cannot read {shown} as NetCDF: {error}") from None
+    try:
+        check_netcdf(dataset, description_of(dataset), f"NetCDF file {shown}")
+        return dataset.load()
+    except PhdesignError:
+        raise
+    except Exception as error:  # the data section of a crafted file
+        raise SweepError(
+            f"cannot read {shown} as NetCDF: {type(error).__name__}: {error}"
+        ) from None
+    finally:
+        dataset.close()

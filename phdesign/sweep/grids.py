@@ -38,6 +38,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from phdesign.errors import SweepError
+from phdesign.limits import MAX_MAGNITUDE, check_sweep_points
 
 __all__ = [
     "AXIS_KINDS",
@@ -49,7 +50,7 @@ __all__ = [
 
 AXIS_KINDS = ("gain", "parameter", "sensors")
 _GAIN_NAME = re.compile(r"^l([1-9][0-9]*)?$")
-_MAX_POINTS = 10**9  # per axis: beyond this the count is a typo, not a study
+_SENSOR_SET = re.compile(r"[1-9][0-9]{0,2}(,[1-9][0-9]{0,2})*", re.ASCII)
 
 
 @dataclass(frozen=True)
@@ -98,6 +99,15 @@ class Axis:
             raise SweepError(
                 f"gain axis {self.name}: gains must be positive (L + Lᵀ ≻ 0); found {values[0]!r}"
             )
+        if (
+            self.kind == "gain"
+            and not 1 / MAX_MAGNITUDE <= values[0] <= values[-1] <= MAX_MAGNITUDE
+        ):
+            bad = values[0] if values[0] < 1 / MAX_MAGNITUDE else values[-1]
+            raise SweepError(
+                f"gain axis {self.name}: gains must lie between {1 / MAX_MAGNITUDE:g} and "
+                f"{MAX_MAGNITUDE:g}, as every gain; found {bad!r}"
+            )
         if self.scale == "log" and values[0] <= 0:
             raise SweepError(
                 f"axis {self.name}: a log grid needs positive values; found {values[0]!r}"
@@ -120,15 +130,40 @@ class Axis:
         }
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Axis:
-        """Inverse of :meth:`to_dict`."""
-        return cls(
-            str(data["name"]),
-            str(data["kind"]),
-            tuple(data["values"]),
-            str(data["scale"]),
-            str(data["spec"]),
-        )
+    def from_dict(cls, data: Any) -> Axis:
+        """Inverse of :meth:`to_dict`, for data read from a file: every field is checked.
+
+        Raises
+        ------
+        SweepError
+            Not the five fields of an axis, of their kinds: a name, kind, scale and spec of
+            text, and at most :data:`~phdesign.limits.MAX_SWEEP_POINTS` values (numbers,
+            or sensor sets such as ``"3,4"``), valid as :class:`Axis` requires.
+        """
+        fields = ("name", "kind", "values", "scale", "spec")
+        if not isinstance(data, dict) or set(data) != set(fields):
+            found = sorted(map(str, data)) if isinstance(data, dict) else type(data).__name__
+            raise SweepError(
+                f"a stored axis must have the fields {', '.join(fields)}; found {found}"
+            )
+        name, kind, values, scale, spec = (data[f] for f in fields)
+        if not all(isinstance(x, str) and len(x) <= 1000 for x in (name, kind, scale, spec)):
+            raise SweepError("a stored axis must have a name, kind, scale and spec of short text")
+        if scale not in ("linear", "log", "sets") or not isinstance(values, list):
+            raise SweepError(
+                f"stored axis {name!r}: unknown scale {scale!r}, or no list of values"
+            )
+        check_sweep_points(len(values), f"stored axis {name!r}")
+        if kind == "gain" and not _GAIN_NAME.fullmatch(name):
+            raise SweepError(f"stored gain axis {name!r}: expected l1, l2, ... or l")
+        if kind == "sensors":
+            if not all(isinstance(v, str) and _SENSOR_SET.fullmatch(v) for v in values):
+                raise SweepError(
+                    f"stored axis {name!r}: sensor sets must be 1-based indices such as '3,4'"
+                )
+        elif not all(type(v) in (int, float) for v in values):
+            raise SweepError(f"stored axis {name!r}: expected numbers as values")
+        return cls(name, kind, tuple(values), scale, spec)
 
     def __repr__(self) -> str:
         first, last = self.values[0], self.values[-1]
@@ -164,8 +199,7 @@ def _range(name: str, spec: str) -> tuple[tuple[float, ...], str]:
     log = len(parts) == 4
     if count == 0:
         raise SweepError(f"grid {name}: count must be at least 1; found zero points in {spec!r}")
-    if count > _MAX_POINTS:
-        raise SweepError(f"grid {name}: count must be at most {_MAX_POINTS}; found {count}")
+    check_sweep_points(count, f"grid {name}")  # before the values are built
     if log and (start <= 0 or stop <= 0):
         raise SweepError(
             f"grid {name}: a log grid needs start > 0 and stop > 0; "
@@ -210,6 +244,8 @@ def parse_axis(name: str, spec: str | Sequence[float], kind: str) -> Axis:
             "(the same gain on every sensor)"
         )
     if not isinstance(spec, str):
+        if hasattr(spec, "__len__"):
+            check_sweep_points(len(spec), f"grid {name}")
         values = tuple(float(v) for v in spec)
         text = ",".join(repr(v) for v in values)
         if not values:
@@ -223,7 +259,9 @@ def parse_axis(name: str, spec: str | Sequence[float], kind: str) -> Axis:
     if ":" in text:
         values, scale = _range(name, text)
     else:
-        values = tuple(_number(p.strip(), f"grid {name} value") for p in text.split(","))
+        items = text.split(",")
+        check_sweep_points(len(items), f"grid {name}")
+        values = tuple(_number(p.strip(), f"grid {name} value") for p in items)
         scale = "linear"
     return Axis(name, kind, values, scale, text)
 
@@ -245,6 +283,7 @@ def parse_sensor_sets(spec: str | Sequence[Sequence[int]], n_outputs: int) -> Ax
     if isinstance(spec, str):
         text = spec.strip()
         if text == "all":
+            check_sweep_points(2**n_outputs - 1, f"sensor sets 'all' of {n_outputs} outputs")
             sets = [
                 combo
                 for size in range(1, n_outputs + 1)

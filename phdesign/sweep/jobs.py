@@ -154,6 +154,10 @@ class Job:
         discretization serve every point of the chunk): about half a second of work.
     settings_per_chunk : int
         Points per task when every point is a new setting (no gain axis).
+    check : str
+        ``"module:function"`` of ``check(model, options)``, which refuses options the
+        evaluator would refuse at every point (a resolution over budget) before the sweep
+        starts; empty: nothing to check.
     """
 
     name: str
@@ -164,6 +168,7 @@ class Job:
     needs_sensors: bool
     points_per_chunk: int
     settings_per_chunk: int
+    check: str = ""
 
     def option_values(self, given: Mapping[str, Any] | None) -> dict[str, Any]:
         """Every option of the job, validated, with defaults for those not given.
@@ -183,13 +188,21 @@ class Job:
                 )
         return {o.name: o.check(given.get(o.name, o.default)) for o in self.options}
 
+    def check_options(self, model: Any, options: Mapping[str, Any]) -> None:
+        """Refuse, before the sweep, options that every point would refuse (see ``check``)."""
+        if self.check:
+            _load(self.check)(model, options)
+
     def evaluator_factory(self) -> Callable[..., Callable[[Any], PointFigures]]:
         """Import and return the evaluator factory ``prepare(model, sensors, options)``."""
-        module, _, function = self.prepare.partition(":")
-        factory: Callable[..., Callable[[Any], PointFigures]] = getattr(
-            importlib.import_module(module), function
-        )
+        factory: Callable[..., Callable[[Any], PointFigures]] = _load(self.prepare)
         return factory
+
+
+def _load(target: str) -> Any:
+    """Return the function named ``"module:function"`` (imported when needed)."""
+    module, _, function = target.partition(":")
+    return getattr(importlib.import_module(module), function)
 
 
 _METHOD = Option(
@@ -222,6 +235,7 @@ JOBS: dict[str, Job] = {
         needs_sensors=False,
         points_per_chunk=32,
         settings_per_chunk=4,
+        check="phdesign.sweep.spectrum_job:check_options",
     ),
     "classify": Job(
         name="classify",

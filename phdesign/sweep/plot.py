@@ -72,8 +72,10 @@ def select_points(dataset: Any, select: Mapping[str, Any] | None) -> Any:
         else:
             try:
                 number = float(value)
-            except ValueError:
-                raise SweepError(f"select: {name} expects a number; found {value!r}") from None
+            except (TypeError, ValueError):
+                number = math.nan
+            if not math.isfinite(number):  # NaN has no nearest value: a KeyError in xarray
+                raise SweepError(f"select: {name} expects a finite number; found {value!r}")
             picked = picked.sel({name: number}, method="nearest")
     return picked
 

@@ -24,7 +24,9 @@ floating-point operations the same wherever it runs.
 from __future__ import annotations
 
 import os
+import signal
 import socket
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -32,8 +34,17 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from phdesign.errors import SweepError
+from phdesign.limits import check_local_workers
 
-__all__ = ["CONNECT_TIMEOUT", "WORKER_TIMEOUT", "Executor", "executor", "usable_cores"]
+__all__ = [
+    "CONNECT_TIMEOUT",
+    "WORKER_TIMEOUT",
+    "Executor",
+    "check_address",
+    "check_scheduler",
+    "executor",
+    "usable_cores",
+]
 
 CONNECT_TIMEOUT = 4.0  # seconds to reach a scheduler: an error within 10 s, imports included
 WORKER_TIMEOUT = 30.0  # seconds for a reachable cluster to offer a worker
@@ -157,7 +168,16 @@ def _connect(address: str) -> Any:
     return client
 
 
-def _validate(scheduler: Any, workers: int | None) -> None:
+def check_scheduler(scheduler: Any, workers: int | None) -> None:
+    """Refuse a malformed scheduler or worker count before anything starts or is written.
+
+    Raises
+    ------
+    SweepError
+        A worker count that is not a positive integer or exceeds the machine's cores
+        (:func:`phdesign.limits.check_local_workers`), workers with a scheduler of its own,
+        a name that is not a scheduler, or a malformed address (:func:`check_address`).
+    """
     if workers is not None and (
         isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
     ):
@@ -167,9 +187,14 @@ def _validate(scheduler: Any, workers: int | None) -> None:
             "workers sizes the local cluster a sweep starts; it does not apply to "
             f"scheduler {scheduler!r}"
         )
+    if workers is not None:
+        check_local_workers(workers, usable_cores())
     if scheduler is None or not isinstance(scheduler, str):
         return
-    if scheduler in ("synchronous", "local") or "://" in scheduler:
+    if scheduler in ("synchronous", "local"):
+        return
+    if "://" in scheduler:
+        check_address(scheduler)
         return
     raise SweepError(
         f"scheduler: expected 'synchronous', 'local' or an address such as "
@@ -177,11 +202,72 @@ def _validate(scheduler: Any, workers: int | None) -> None:
     )
 
 
+#: The transports of Dask addresses; those with a host and a port are checked in full.
+_TRANSPORTS = ("tcp", "tls", "ws", "wss", "inproc", "ucx")
+_NETWORK = ("tcp", "tls", "ws", "wss")
+
+
+def check_address(address: str) -> None:
+    """Refuse a Dask address that no scheduler can have (before any connection).
+
+    Examples
+    --------
+    >>> check_address("tcp://127.0.0.1:8786")
+    >>> check_address("tcp://[::1]:8786")
+    >>> check_address("tcp://127.0.0.1:0")
+    Traceback (most recent call last):
+    ...
+    phdesign.errors.SweepError: scheduler address 'tcp://127.0.0.1:0': the port must be from 1 ...
+    """
+    shown = f"scheduler address {address!r}"
+    expected = "expected tcp://HOST:PORT with a port from 1 to 65535"
+    try:
+        parts = urlsplit(address)
+        port = parts.port
+    except ValueError as error:  # an unclosed IPv6 bracket, a port that is not a number
+        raise SweepError(f"{shown} is malformed ({error}); {expected}") from None
+    if parts.scheme not in _TRANSPORTS:
+        raise SweepError(
+            f"{shown}: unknown transport {parts.scheme!r}; expected one of "
+            f"{', '.join(_TRANSPORTS)}, as in tcp://HOST:PORT"
+        )
+    if parts.scheme not in _NETWORK:
+        return
+    if not parts.hostname or parts.path not in ("", "/") or parts.query or parts.fragment:
+        raise SweepError(f"{shown} is malformed; {expected}")
+    if parts.username is not None or parts.password is not None:
+        raise SweepError(f"{shown} holds a user name; {expected}")
+    if port is not None and not 1 <= port <= 65535:
+        raise SweepError(f"{shown}: the port must be from 1 to 65535; found {port}")
+
+
 _GUARD = (
     "a script that runs a sweep on a local cluster must call it under "
     "'if __name__ == \"__main__\":' (the worker processes import the script again), or "
     "pass scheduler='synchronous'"
 )
+
+
+@contextmanager
+def _workers_ignore_sigint() -> Iterator[None]:
+    """Ignore SIGINT while a local cluster spawns its workers, so that they ignore it too.
+
+    Ctrl-C reaches every process of the terminal's process group: the workers died of it
+    with 34 to 68 lines of tracebacks, and the scheduler logged the data they lost.  An
+    ignored signal stays ignored across the spawn (a handler or a blocked mask does not),
+    and Python leaves a SIGINT it finds ignored alone, so the workers never see Ctrl-C;
+    this process alone handles it once its handler is back, and closes the cluster, whose
+    workers then shut down quietly.  A Ctrl-C while the workers start (a second or two)
+    is lost.  Only the main thread may change a handler: elsewhere nothing changes.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _local_cluster(n_workers: int) -> Any:
@@ -196,13 +282,14 @@ def _local_cluster(n_workers: int) -> Any:
     from dask.distributed import LocalCluster
 
     try:
-        return LocalCluster(
-            n_workers=n_workers,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",  # any free port: never a clash with another 8787
-            silence_logs=logging.ERROR,
-        )
+        with _workers_ignore_sigint():
+            return LocalCluster(
+                n_workers=n_workers,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # any free port: never a clash with another 8787
+                silence_logs=logging.ERROR,
+            )
     except RuntimeError as error:
         main = sys.modules.get("__main__")
         if getattr(main, "__file__", None) and getattr(main, "__spec__", None) is None:
@@ -225,7 +312,7 @@ def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Exec
     SweepError
         A malformed scheduler, an unreachable one, or a cluster without workers.
     """
-    _validate(scheduler, workers)
+    check_scheduler(scheduler, workers)
     if scheduler == "synchronous":
         yield Executor("synchronous", 1)
         return
@@ -252,13 +339,15 @@ def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Exec
         finally:
             client.close()
         return
-    cluster = _local_cluster(workers or usable_cores())
     from dask.distributed import Client
 
-    n_workers = len(cluster.workers)
-    client = Client(cluster)
-    try:
-        yield Executor("LocalCluster", n_workers, client)
+    cluster = client = None
+    try:  # one finally for both: a Ctrl-C between the two starts closes the cluster too
+        cluster = _local_cluster(workers or usable_cores())
+        client = Client(cluster)
+        yield Executor("LocalCluster", len(cluster.workers), client)
     finally:
-        client.close()
-        cluster.close()
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()

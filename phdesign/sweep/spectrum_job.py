@@ -27,7 +27,7 @@ from phdesign.numeric.bridge import NumericModel, to_numeric
 from phdesign.numeric.spectrum import SpectrumReport, spectrum
 from phdesign.numeric.spectrum_refinement import Discretizations
 
-__all__ = ["ChunkSpectrum", "abscissa_evaluator", "figures_of_report", "prepare"]
+__all__ = ["ChunkSpectrum", "abscissa_evaluator", "check_options", "figures_of_report", "prepare"]
 
 
 def figures_of_report(report: SpectrumReport) -> dict[str, Any]:
@@ -112,6 +112,18 @@ def abscissa_evaluator(
         max_resolution=options.get("max_resolution"),
         tol=options.get("tol"),
     )
+
+
+def check_options(model: Any, options: Mapping[str, Any]) -> None:
+    """Refuse resolutions over the discretization budget before the sweep starts.
+
+    Every point would refuse them (:func:`phdesign.limits.check_discretization`, the check
+    :func:`~phdesign.numeric.spectrum.spectrum` makes); the model's size decides.
+    """
+    from phdesign.limits import check_discretization
+
+    method = options.get("method") or "galerkin"
+    check_discretization(model, method, options.get("resolution"), options.get("max_resolution"))
 
 
 def prepare(

@@ -54,7 +54,7 @@ import sympy
 from sympy.polys.matrices import DomainMatrix
 
 from phdesign.errors import ObserverError
-from phdesign.limits import EXACT_KAPPA_OPERATIONS
+from phdesign.limits import EXACT_KAPPA_BITS, EXACT_KAPPA_DEGREE, EXACT_KAPPA_OPERATIONS
 from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.observer import ErrorSystem
 
@@ -180,7 +180,17 @@ def certify(
             f"> {EXACT_KAPPA_OPERATIONS}, phdesign.limits.EXACT_KAPPA_OPERATIONS); "
             "use method='float'"
         )
-    if method in ("auto", "exact") and affordable:
+    exact_path = method in ("auto", "exact") and affordable
+    if exact_path and (size := _root_size(_characteristic(A_r, B_r))) is not None:
+        # isolating roots factors integers (and polynomials in e or pi) of this size: 598 bits
+        # took 55 s, exp(100) (degree 200 in e) 30 s; the float path scales them instead
+        if method == "exact":
+            raise ObserverError(
+                f"the exact κ* of this pencil is over budget ({size}, "
+                "phdesign.limits.EXACT_KAPPA_BITS and EXACT_KAPPA_DEGREE); use method='float'"
+            )
+        exact_path = False
+    if exact_path:
         exact = _exact_kappa(A_r, B_r)
         if exact is not None:
             return Certificate(
@@ -216,9 +226,13 @@ def _scaled_float_kappa(
     With :math:`\alpha = \max|A_{ij}|`, :math:`\beta = \max|B_{ij}|` (exact), the pencil
     :math:`(A/\alpha, B/\beta)` has entries of order one and
     :math:`\kappa^* = \kappa^*(A/\alpha, B/\beta)\, \alpha/\beta`: gains of 1e200 neither
-    overflow nor turn κ* into 0. Returns κ* as a 15-digit sympy number when a double cannot
-    hold it (then the float is ``None``), else ``(None, float)``.
+    overflow nor turn κ* into 0. Before that both are scaled by the same diagonal
+    :func:`_equilibrated`, so that ``L = diag(1e-300, 1e300)`` keeps both diagonal entries
+    of :math:`A` (one scale for the whole matrix would lose the small one). Returns κ* as a
+    15-digit sympy number when a double cannot hold it (then the float is ``None``), else
+    ``(None, float)``.
     """
+    A_r, B_r = _equilibrated(A_r, B_r)
     alpha = max((abs(x) for x in A_r), key=lambda x: float(sympy.log(x + 1e-300).evalf(15)))
     beta = max((abs(x) for x in B_r), key=lambda x: float(sympy.log(x + 1e-300).evalf(15)))
     if alpha == 0 or beta == 0:
@@ -231,8 +245,8 @@ def _scaled_float_kappa(
     return (None, as_float) if as_float is not None else (value, None)
 
 
-def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | None:
-    r"""Exact :math:`1/\mu_{\max}`, or ``None`` if the roots cannot be isolated exactly."""
+def _characteristic(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Poly:
+    r"""Return the characteristic polynomial of :math:`A^{-1}B` in :math:`\mu` (exact)."""
     try:
         dA = DomainMatrix.from_Matrix(A_r).to_field()
         dB = DomainMatrix.from_Matrix(B_r).to_field()
@@ -241,9 +255,59 @@ def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | N
         M = dA.inv() * dB
         coefficients = M.charpoly()
         domain = M.domain
-        poly = sympy.Poly([domain.to_sympy(c) for c in coefficients], _MU)
+        return sympy.Poly([domain.to_sympy(c) for c in coefficients], _MU)
     except Exception:
-        poly = sympy.Poly((B_r - _MU * A_r).det(method="berkowitz"), _MU)
+        return sympy.Poly((B_r - _MU * A_r).det(method="berkowitz"), _MU)
+
+
+def _root_size(poly: sympy.Poly) -> str | None:
+    r"""Say why isolating the roots of ``poly`` is over budget, or ``None`` when it is not.
+
+    The measure: the bits of the integer coefficients of its numerator, a polynomial in
+    :math:`\mu` and the constants it holds (``E`` for ``exp(1)``, ``pi``), and its degree
+    in those constants (``exp(100)`` is ``E**100``).  Degree 1 is a division: no budget.
+    """
+    if poly.degree() <= 1:
+        return None
+    try:
+        numerator, _ = sympy.fraction(sympy.together(poly.as_expr()))
+        _, full = sympy.Poly(numerator).clear_denoms(convert=True)
+        bits = max(abs(int(c)).bit_length() for c in full.coeffs())
+    except (sympy.PolynomialError, sympy.DomainError, TypeError, ValueError):
+        return "coefficients that are not polynomials in constants"
+    degree = max(
+        (d for gen, d in zip(full.gens, full.degree_list(), strict=True) if gen != _MU), default=0
+    )
+    if bits > EXACT_KAPPA_BITS:
+        return f"coefficients of {bits} bits > {EXACT_KAPPA_BITS}"
+    if degree > EXACT_KAPPA_DEGREE:
+        return f"degree {degree} in a constant > {EXACT_KAPPA_DEGREE}"
+    return None
+
+
+def _equilibrated(
+    A_r: sympy.MatrixBase, B_r: sympy.MatrixBase
+) -> tuple[sympy.MatrixBase, sympy.MatrixBase]:
+    r"""Return the pencil :math:`(DAD, DBD)` scaled by powers of two on the diagonal.
+
+    :math:`D = \operatorname{diag}(2^{-k_i})` with :math:`4^{k_i} \approx A_{ii}`.  The
+    pencil keeps its eigenvalues (:math:`Bv = \mu Av` with :math:`v = Dw`), the diagonal
+    of :math:`A` (positive: :math:`A \succ 0`) comes within a factor 2 of 1 and, by
+    Cauchy-Schwarz, so does every entry of :math:`A`.  Powers of two keep it exact.
+    """
+    exponents = []
+    for i in range(A_r.rows):
+        entry = A_r[i, i]
+        if not entry.is_positive:
+            return A_r, B_r  # not definite: left to the float path as it is
+        exponents.append(round(float(sympy.log(entry, 2).evalf(15)) / 2))
+    D = sympy.diag(*[sympy.Rational(2) ** -k for k in exponents])
+    return sympy.ImmutableMatrix(D * A_r * D), sympy.ImmutableMatrix(D * B_r * D)
+
+
+def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | None:
+    r"""Exact :math:`1/\mu_{\max}`, or ``None`` if the roots cannot be isolated exactly."""
+    poly = _characteristic(A_r, B_r)
     try:
         roots = sympy.real_roots(poly)
     except (sympy.PolynomialError, NotImplementedError, sympy.DomainError):

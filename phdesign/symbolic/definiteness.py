@@ -372,9 +372,13 @@ class _Check:
             # two lower bounds of the smallest eigenvalue on the cell, the better one kept:
             # Weyl about the midpoint, and Gershgorin's discs of the interval matrix (sharp
             # where an entry touches 0 while the others stay away: diag(sin(2 pi z)^2, e^z))
-            weyl = lam_mid - np.sqrt(np.sum(radius**2, axis=(1, 2)))
-            gershgorin = np.min(floor - np.sum(reach, axis=2), axis=1)
-            bound = np.maximum(weyl, gershgorin) - 1e-13 * scale * n
+            # each less round-off in its own magnitudes (the cell's, the row's): one from the
+            # largest entry left diag(exp(30 z), 1) unproved (1e-13 e³⁰ > 1 = λ_min)
+            cell = np.max(np.abs(centre) + radius, axis=(1, 2))
+            weyl = lam_mid - np.sqrt(np.sum(radius**2, axis=(1, 2))) - _allowance(cell, n)
+            row = np.abs(floor) + np.sum(reach, axis=2)
+            gershgorin = np.min(floor - np.sum(reach, axis=2) - _allowance(row, n), axis=1)
+            bound = np.maximum(weyl, gershgorin)
             open_cells = ~(bound > 0) if self.strict else ~(bound >= -tolerance)
             examined += lo.size
             if not np.any(open_cells):
@@ -435,6 +439,13 @@ class _Check:
 
 
 # ---------------------------------------------------------------------- helpers
+def _allowance(magnitude: Any, n: int) -> Any:
+    """Round-off of a bound from outward-rounded entries of this magnitude (relative)."""
+    import numpy as np
+
+    return 1e-13 * n * np.maximum(magnitude, 1e-300)  # the floor: entries that underflow
+
+
 def _without_constant_kernel(
     S: sympy.MatrixBase, a: float, b: float, name: str
 ) -> tuple[sympy.MatrixBase | None, sympy.MatrixBase]:

@@ -36,6 +36,7 @@ from typing import Literal
 
 import sympy
 
+from phdesign.arguments import not_bytes
 from phdesign.errors import ExpressionError
 from phdesign.limits import MAX_NUMBER_OPERATIONS
 from phdesign.symbolic.parser import CONSTANTS, FUNCTIONS, Token, brief, check_text, parse
@@ -236,6 +237,8 @@ def exact_matrix(value: object, what: str, symbols: bool = False) -> sympy.Immut
         raise ExpressionError(
             f"{what} must be a non-empty matrix (a list of rows); found {_brief(value)}"
         )
+    for i, r in enumerate(rows):
+        not_bytes(r, f"{what} row {i + 1}", ExpressionError)
     table = [list(r) if isinstance(r, Sequence) and not isinstance(r, str) else r for r in rows]
     if not all(isinstance(r, list) and r for r in table):
         raise ExpressionError(

@@ -31,6 +31,7 @@ from typing import Any
 
 import sympy
 
+from phdesign.arguments import not_bytes
 from phdesign.errors import ExpressionError, ObserverError, check_shape
 from phdesign.symbolic.expressions import exact_matrix, exact_number
 
@@ -204,6 +205,7 @@ def gain_matrix(
         definite (symbolic gains must be diagonal and positive).
     """
     _check_count(q, "q (the number of sensors)")
+    not_bytes(gain, name, ObserverError)
     if isinstance(gain, str):
         text = gain.strip()
         if text == "symbolic":
@@ -329,7 +331,10 @@ def _rows(value: Any, what: str) -> list[list[Any]]:
         raise ObserverError(
             f"{what}: expected a matrix (rows of numbers); found {type(value).__name__}"
         )
-    rows = [list(r) if isinstance(r, Iterable) and not isinstance(r, str) else r for r in value]
+    items = list(value)
+    for i, r in enumerate(items):
+        not_bytes(r, f"{what}: row {i + 1}", ObserverError)
+    rows = [list(r) if isinstance(r, Iterable) and not isinstance(r, str) else r for r in items]
     if not rows or not all(isinstance(r, list) and r for r in rows):
         raise ObserverError(f"{what}: expected a non-empty list of non-empty rows; found {rows!r}")
     width = len(rows[0])

@@ -16,7 +16,13 @@ from typing import TYPE_CHECKING
 
 import sympy
 
-from phdesign.errors import ExpressionError, ModelError, ParameterError, check_shape
+from phdesign.errors import (
+    ArgumentError,
+    ExpressionError,
+    ModelError,
+    ParameterError,
+    check_shape,
+)
 from phdesign.limits import check_model_dimensions, check_parameter_count
 from phdesign.symbolic.conjugate import conjugate_outputs
 from phdesign.symbolic.definiteness import check_definite
@@ -28,13 +34,31 @@ from phdesign.symbolic.expressions import (
     vanishes,
 )
 from phdesign.symbolic.feedback import check_feedback
-from phdesign.symbolic.parser import check_expression
+from phdesign.symbolic.parser import brief, check_expression
 from phdesign.symbolic.units import check_units
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.model import BCPHS
 
 __all__ = ["check_finite", "check_symbols", "validate"]
+
+
+def _check_displacement(d: object, n: int) -> None:
+    """Refuse a displacement that is not a Displacement of a component in 1..n."""
+    from phdesign.symbolic.model import Displacement  # model imports this module
+
+    if not isinstance(d, Displacement) or not all(
+        type(v) is int for v in (d.component, d.integrations)
+    ):
+        raise ArgumentError(
+            "displacement must be a Displacement(component=i, integrations=k) of two "
+            f"integers; found {type(d).__name__} {brief(d, 60)}"
+        )
+    if not (1 <= d.component <= n) or d.integrations < 0:
+        raise ModelError(
+            f"displacement must name a component in 1..{n} and integrations >= 0; "
+            f"found component {d.component}, integrations {d.integrations}"
+        )
 
 
 def validate(model: BCPHS) -> list[str]:
@@ -95,12 +119,7 @@ def validate(model: BCPHS) -> list[str]:
         raise ModelError(f"H must be symmetric; found H - H^T = {residual.tolist()}")
     checks.append(check_definite(model.H, "H", model.interval, defaults))
     if model.displacement is not None:
-        d = model.displacement
-        if not (1 <= d.component <= n) or d.integrations < 0:
-            raise ModelError(
-                f"displacement must name a component in 1..{n} and integrations >= 0; "
-                f"found component {d.component}, integrations {d.integrations}"
-            )
+        _check_displacement(model.displacement, n)
     object.__setattr__(
         model, "units", check_units(model.units, model.parameter_names, model.state_names)
     )
