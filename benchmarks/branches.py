@@ -24,8 +24,8 @@ import numpy as np
 
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.spectrum import spectrum
-from phdesign.numeric.spectrum_refinement import _STRUCTURES, Discretizations
+from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.spectrum.refinement import _STRUCTURES, Discretizations
 from phdesign.numeric.threads import small_dense_threads
 from phdesign.symbolic.model import BCPHS
 

@@ -29,8 +29,8 @@ from _timing import PYTHON, report, time_command
 
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.sampled import export_observer
-from phdesign.numeric.spectrum import spectrum
+from phdesign.numeric.sampled.export import export_observer
+from phdesign.numeric.spectrum.converged import spectrum
 
 SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
 GAIN = np.diag([0.1, 1.0])

@@ -24,10 +24,10 @@ import numpy as np
 from phdesign import plots
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.evaluator import AbscissaEvaluator
 from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.simulate import simulate
-from phdesign.numeric.tune import tune
+from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
+from phdesign.numeric.time.simulation import simulate
+from phdesign.numeric.tuning.search import tune
 
 MAX_BYTES = 200_000
 DESIGNS = {"design 1": (0.03, 0.3), "design 2": (0.1, 1.0), "design 3": (0.2, 2.0)}

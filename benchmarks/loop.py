@@ -20,9 +20,9 @@ from _timing import timed
 
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.loop import NumericLoop
-from phdesign.numeric.loop_spectrum import loop_spectrum
-from phdesign.numeric.spectrum import spectrum
+from phdesign.numeric.control.assembly import NumericLoop
+from phdesign.numeric.control.spectrum import loop_spectrum
+from phdesign.numeric.spectrum.converged import spectrum
 
 TARGET = 1.0  # seconds, wall, median
 

@@ -24,9 +24,9 @@ import scipy.linalg as sl
 
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretize import discretize
-from phdesign.numeric.noise import noise, noise_input
-from phdesign.numeric.tradeoff import tradeoff
+from phdesign.numeric.discretization.registry import discretize
+from phdesign.numeric.noise.figures import noise, noise_input
+from phdesign.numeric.noise.tradeoff import tradeoff
 
 SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
 GAIN = np.diag([0.1, 1.0])

@@ -37,9 +37,9 @@ from scipy.sparse.linalg import expm_multiply
 
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretize import discretize, feedback_matrix
+from phdesign.numeric.discretization.registry import discretize, feedback_matrix
 from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.simulate import coupled_system, simulate, step_lti
+from phdesign.numeric.time.simulation import coupled_system, simulate, step_lti
 
 
 def best_of(fn, repeat):
@@ -70,9 +70,9 @@ def changes() -> bool:
     import control
     from numpy.polynomial import legendre as leg
 
-    from phdesign.numeric import galerkin as gal
-    from phdesign.numeric.export import error_statespace
-    from phdesign.numeric.stepping import integrate
+    from phdesign.numeric.discretization import galerkin as gal
+    from phdesign.numeric.statespace import error_statespace
+    from phdesign.numeric.time.stepping import integrate
 
     nm, x0, C_m, L, d = paper_setup("galerkin", 40)
     K = feedback_matrix(C_m, L, 4)

@@ -22,9 +22,9 @@ import scipy.linalg as sl
 
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretize import discretize, feedback_matrix
-from phdesign.numeric.evaluator import AbscissaEvaluator
-from phdesign.numeric.spectrum import resolved_abscissa, spectrum
+from phdesign.numeric.discretization.registry import discretize, feedback_matrix
+from phdesign.numeric.spectrum.converged import resolved_abscissa, spectrum
+from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
 from phdesign.numeric.threads import small_dense_threads
 
 

@@ -7,7 +7,8 @@ Targets (issue 10), measured in the same run:
   medians);
 * the same optimum: the abscissa at the returned gain within 1e-3 of the triple-root
   optimum -5.8333507598 (three real eigenvalues coalesce there; the value solves
-  F = F' = F'' = 0 for the characteristic function in mpmath, tests/test_numeric_tune.py,
+  F = F' = F'' = 0 for the characteristic function in mpmath,
+  tests/numeric/tuning/test_numeric_tune.py,
   which also checks the true abscissa at the returned gain).
 
 It also prints the evaluations (gains evaluated) and what the library's one-BLAS-thread
@@ -35,9 +36,9 @@ from threadpoolctl import threadpool_info
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.threads import small_dense_threads
-from phdesign.numeric.tune import tune
+from phdesign.numeric.tuning.search import tune
 
-TRIPLE_ROOT = -5.833350759830179  # mpmath, tests/test_numeric_tune.py::triple_root
+TRIPLE_ROOT = -5.833350759830179  # mpmath, tests/numeric/tuning/test_numeric_tune.py::triple_root
 SPECTRUM = [PYTHON, "-m", "phdesign", "spectrum", "euler-bernoulli", "--sensors", "3,4"]
 SPECTRUM += ["--gain", "0.1,1"]
 TUNE = [PYTHON, "-m", "phdesign", "tune", "euler-bernoulli", "--sensors", "3,4", "--json"]

@@ -31,11 +31,11 @@ from scipy.optimize import minimize
 from phdesign import plots
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.evaluator import AbscissaEvaluator
 from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.simulate import simulate
-from phdesign.numeric.spectrum import spectrum
-from phdesign.numeric.tune import tune
+from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
+from phdesign.numeric.time.simulation import simulate
+from phdesign.numeric.tuning.search import tune
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 from phdesign.symbolic.ports import derive_ports

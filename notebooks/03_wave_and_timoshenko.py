@@ -26,8 +26,8 @@ from phdesign import plots
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.simulate import simulate
-from phdesign.numeric.spectrum import spectrum
+from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.time.simulation import simulate
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 from phdesign.symbolic.search import search_sensors

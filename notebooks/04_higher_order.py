@@ -29,8 +29,8 @@ import numpy as np
 from phdesign import plots
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretize import discretize, feedback_matrix
-from phdesign.numeric.spectrum import eigen, spectrum
+from phdesign.numeric.discretization.registry import discretize, feedback_matrix
+from phdesign.numeric.spectrum.converged import eigen, spectrum
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 from phdesign.symbolic.ports import derive_ports

@@ -28,11 +28,11 @@ import numpy as np
 
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretize import discretize
-from phdesign.numeric.noise import error_statistics, noise
-from phdesign.numeric.spectrum import spectrum
-from phdesign.numeric.stochastic import noisy_coupled_system, sampled_noise
-from phdesign.numeric.tradeoff import tradeoff
+from phdesign.numeric.discretization.registry import discretize
+from phdesign.numeric.noise.figures import error_statistics, noise
+from phdesign.numeric.noise.tradeoff import tradeoff
+from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.time.stochastic import noisy_coupled_system, sampled_noise
 
 beam = load_builtin("euler-bernoulli")
 nm = to_numeric(beam)

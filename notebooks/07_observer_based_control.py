@@ -33,7 +33,7 @@
 import numpy as np
 
 from phdesign import plots
-from phdesign.loop import Loop
+from phdesign.design.loop import Loop
 from phdesign.models import load_builtin
 
 beam = load_builtin("euler-bernoulli")

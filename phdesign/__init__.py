@@ -46,23 +46,23 @@ _EXPORTS: dict[str, str] = {
     "search_sensors": "phdesign.symbolic.search",
     "SensorSearch": "phdesign.symbolic.search",
     # the design objects
-    "Observer": "phdesign.design",
-    "Plant": "phdesign.plant",
-    "Loop": "phdesign.loop",
+    "Observer": "phdesign.design.observer",
+    "Plant": "phdesign.design.plant",
+    "Loop": "phdesign.design.loop",
     # numbers
     "to_numeric": "phdesign.numeric.bridge",
-    "discretize": "phdesign.numeric.discretize",
-    "spectrum": "phdesign.numeric.spectrum",
-    "SpectrumReport": "phdesign.numeric.spectrum",
-    "simulate": "phdesign.numeric.simulate",
-    "SimulationResult": "phdesign.numeric.simulate",
-    "tune": "phdesign.numeric.tune",
-    "TuneResult": "phdesign.numeric.tune",
-    "NoiseReport": "phdesign.numeric.noise_report",
-    "Tradeoff": "phdesign.numeric.tradeoff",
-    "SampledObserver": "phdesign.numeric.sampled",
+    "discretize": "phdesign.numeric.discretization.registry",
+    "spectrum": "phdesign.numeric.spectrum.converged",
+    "SpectrumReport": "phdesign.numeric.spectrum.converged",
+    "simulate": "phdesign.numeric.time.simulation",
+    "SimulationResult": "phdesign.numeric.time.simulation",
+    "tune": "phdesign.numeric.tuning.search",
+    "TuneResult": "phdesign.numeric.tuning.search",
+    "NoiseReport": "phdesign.numeric.noise.report",
+    "Tradeoff": "phdesign.numeric.noise.tradeoff",
+    "SampledObserver": "phdesign.numeric.sampled.export",
     # errors
-    "PhdesignError": "phdesign.errors",
+    "PhdesignError": "phdesign.core.errors",
 }
 
 __all__ = [
@@ -104,20 +104,20 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDEs
-    from phdesign.design import Observer
-    from phdesign.errors import PhdesignError
+    from phdesign.core.errors import PhdesignError
+    from phdesign.design.loop import Loop
+    from phdesign.design.observer import Observer
+    from phdesign.design.plant import Plant
     from phdesign.io import model_from_toml, model_to_toml, read_model, write_model
-    from phdesign.loop import Loop
     from phdesign.models import builtin_names, load, load_builtin
     from phdesign.numeric.bridge import to_numeric
-    from phdesign.numeric.discretize import discretize
-    from phdesign.numeric.noise_report import NoiseReport
-    from phdesign.numeric.sampled import SampledObserver
-    from phdesign.numeric.simulate import SimulationResult, simulate
-    from phdesign.numeric.spectrum import SpectrumReport, spectrum
-    from phdesign.numeric.tradeoff import Tradeoff
-    from phdesign.numeric.tune import TuneResult, tune
-    from phdesign.plant import Plant
+    from phdesign.numeric.discretization.registry import discretize
+    from phdesign.numeric.noise.report import NoiseReport
+    from phdesign.numeric.noise.tradeoff import Tradeoff
+    from phdesign.numeric.sampled.export import SampledObserver
+    from phdesign.numeric.spectrum.converged import SpectrumReport, spectrum
+    from phdesign.numeric.time.simulation import SimulationResult, simulate
+    from phdesign.numeric.tuning.search import TuneResult, tune
     from phdesign.symbolic.classify import Classification, classify
     from phdesign.symbolic.model import BCPHS, Displacement
     from phdesign.symbolic.observer import (

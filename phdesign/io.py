@@ -48,10 +48,10 @@ from typing import Any
 import sympy
 import tomli_w
 
-from phdesign.arguments import require_path
-from phdesign.errors import ModelFileError, PhdesignError
-from phdesign.limits import MAX_MODEL_FILE_BYTES, check_file_size
-from phdesign.outputs import atomic_write, check_output_path
+from phdesign.core.checks import require_path
+from phdesign.core.errors import ModelFileError, PhdesignError
+from phdesign.core.files import atomic_write, check_output_path
+from phdesign.core.limits import MAX_MODEL_FILE_BYTES, check_file_size
 from phdesign.symbolic.model import BCPHS, Displacement
 from phdesign.symbolic.printing import format_expression
 
@@ -81,7 +81,7 @@ def read_model(path: str | os.PathLike[str]) -> BCPHS:
         If ``path`` is not a file name (``str`` or :class:`os.PathLike`).
     ModelFileError
         If the file cannot be read or is not valid TOML or lacks keys; model errors
-        (:class:`~phdesign.errors.ModelError`, ...) propagate with their own messages.
+        (:class:`~phdesign.core.errors.ModelError`, ...) propagate with their own messages.
     """
     require_path(path, "path")  # an int would be opened as a file descriptor (0: stdin)
     source = str(path)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import copy
 import tomllib
 
-from phdesign.errors import (
+from phdesign.core.errors import (
     ExpressionError,
     ModelError,
     ModelFileError,

@@ -18,7 +18,7 @@ import tomli_w
 from bad_inputs import BAD_MODELS, beam_with
 
 from phdesign.cli import main
-from phdesign.errors import (
+from phdesign.core.errors import (
     ExpressionError,
     LoopError,
     ModelError,
@@ -334,7 +334,7 @@ COMMAND_ROWS = [
     row(
         f"{SIM} --noise-intensity 1e101",
         r"--noise-intensity: intensities must be at most 1e\+100 \(variances per unit time\); "
-        r"found 1e\+101 \(the budget phdesign.limits.MAX_NOISE_INTENSITY\)",
+        r"found 1e\+101 \(the budget phdesign.core.limits.MAX_NOISE_INTENSITY\)",
         NumericError,
     ),
     row(
@@ -382,7 +382,7 @@ COMMAND_ROWS = [
     row(
         f"{EXPORT} --dt 1e-300 --verify -o {{tmp}}/o.json",
         r"--t-end / --dt = 5e\+300 sampling periods; expected at most 1e\+09 \(the budget "
-        r"phdesign.limits.MAX_PERIODS\)",
+        r"phdesign.core.limits.MAX_PERIODS\)",
         NumericError,
     ),
     row(f"{SIM} --dt 1e300", r"--dt = 1e\+300 s is longer than --t-end = 5 s", NumericError),
@@ -927,7 +927,7 @@ COMMAND_ROWS = [
     row(
         f"{NOISE} --resolution 999",
         "resolution 999 gives the noise figures of a size-2 model about 2,000 states; expected "
-        "at most 1,000 (the budget phdesign.limits.MAX_NOISE_STATES: dense Lyapunov",
+        "at most 1,000 (the budget phdesign.core.limits.MAX_NOISE_STATES: dense Lyapunov",
         NumericError,
         seconds=10,
     ),

@@ -2,7 +2,7 @@
 
 CI runs the ``ci`` hypothesis profile (a few hundred examples per test); the nightly-style
 run is ``HYPOTHESIS_PROFILE=nightly python -m pytest tests/test_fuzz.py`` (10,000 examples
-per test). "Documented" means a subclass of :class:`phdesign.errors.PhdesignError`, which
+per test). "Documented" means a subclass of :class:`phdesign.core.errors.PhdesignError`, which
 are all ValueErrors: anything else (KeyError, RecursionError, sympy internals) is a bug.
 """
 
@@ -17,7 +17,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from phdesign.errors import PhdesignError
+from phdesign.core.errors import PhdesignError
 from phdesign.io import check_output_path, model_from_dict, model_from_toml
 from phdesign.models import builtin_names, builtin_toml
 from phdesign.symbolic.expressions import parse_scalar, parse_trace_expression
@@ -211,7 +211,7 @@ HOSTILE = st.one_of(
 def _targets():
     """(name, function, valid positional arguments, valid keyword arguments)."""
     import phdesign
-    from phdesign import limits
+    from phdesign.core import limits
     from phdesign.io import model_from_dict, model_to_toml
     from phdesign.symbolic import expressions, printing
     from phdesign.symbolic.definiteness import check_definite

@@ -18,8 +18,8 @@ from phdesign.cli import main
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.simulate import ENERGY_BALANCE_RTOL, simulate
-from phdesign.numeric.spectrum import spectrum
+from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.time.simulation import ENERGY_BALANCE_RTOL, simulate
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 

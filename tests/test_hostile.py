@@ -19,10 +19,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from phdesign.cli import main
-from phdesign.errors import OutputFileError, PhdesignError
+from phdesign.core.errors import OutputFileError, PhdesignError
+from phdesign.core.files import OutputFiles
 from phdesign.io import model_from_toml, model_to_toml, read_model
 from phdesign.models import load_builtin
-from phdesign.outputs import OutputFiles
 from phdesign.symbolic.expressions import (
     Trace,
     Z,
@@ -239,7 +239,7 @@ def test_a_mathtext_model_name_does_not_leave_the_csv_without_the_picture(tmp_pa
 @pytest.fixture(scope="module")
 def _plots_imported():
     """Import matplotlib once in this process, so that the forked runs are cheap."""
-    import phdesign.numeric.simulate
+    import phdesign.numeric.time.simulation
     import phdesign.plots
 
     phdesign.plots.new_figure()
@@ -263,8 +263,8 @@ def _forked_run(argv: list[str], kill: str, signum: int) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, 1)
         os.dup2(devnull, 2)
-        import phdesign.numeric.simulate as simulate_module
-        import phdesign.outputs as outputs
+        import phdesign.core.files as outputs
+        import phdesign.numeric.time.simulation as simulate_module
 
         def self_signal() -> None:
             os.kill(os.getpid(), signum)
@@ -408,7 +408,7 @@ def test_huge_exact_gains_take_the_float_path_with_the_exact_closed_form(entries
     beam (k = exp(20): exp(20)/(1 + exp(40)), checked here), the wave damper's form; with
     L = diag(1/k, k) variant 3.1.2 is k/(1 + k²) too (exact at k = 1e10): 1e-300 at 1e300.
     """
-    from phdesign.errors import ObserverError
+    from phdesign.core.errors import ObserverError
     from phdesign.symbolic.classify import classify
     from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 

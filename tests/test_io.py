@@ -10,7 +10,7 @@ import sympy
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from phdesign.errors import ModelFileError, OutputFileError
+from phdesign.core.errors import ModelFileError, OutputFileError
 from phdesign.io import atomic_write, model_from_toml, model_to_toml, read_model, write_model
 from phdesign.models import builtin_names, builtin_toml, load_builtin
 from phdesign.symbolic.model import BCPHS

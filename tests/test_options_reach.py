@@ -299,7 +299,7 @@ def test_tune_seed_reaches_the_random_grid(monkeypatch):
     """``--seed`` acts on the random grid of more than 625 points (five or more gains)."""
     import types
 
-    import phdesign.numeric.tune as tune_module
+    import phdesign.numeric.tuning.search as tune_module
 
     original, seeds = tune_module._grid, []
 
@@ -317,7 +317,7 @@ def test_tune_seed_reaches_the_random_grid(monkeypatch):
 
 
 def test_loop_tune_passes_full_and_starts_to_both_searches(monkeypatch):
-    import phdesign.numeric.loop_tune as loop_tune
+    import phdesign.numeric.control.tuning as loop_tune
 
     original, calls = loop_tune.tune, []
 

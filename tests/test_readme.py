@@ -44,7 +44,8 @@ def test_readme_api_block_runs_and_its_numbers_hold():
     # paper §IV-D corrected: 3.4 variant 3 holds with κ* = min(l2, l1/(1 + l1²)) = 10/101
     assert classification.verdict == "exponential"
     assert classification.result("3.4", 3).kappa == sympy.Rational(10, 101)
-    # converged abscissa of the error system (tests/test_numeric_spectrum.py, 13 digits)
+    # converged abscissa of the error system (tests/numeric/spectrum/test_numeric_spectrum.py, 13
+    # digits)
     assert report.converged
     assert abs(report.spectral_abscissa - (-2.9106562986)) < 1e-8
     # H̃/H̃(0) < 1e-2 after about 0.92 s (the README states it; 2-digit claim)
@@ -56,7 +57,7 @@ def test_readme_api_block_runs_and_its_numbers_hold():
     assert tuned.tuning.spectral_abscissa < report.spectral_abscissa - 1.0
     assert sympy.diag(sympy.Rational(1, 10), 1) == namespace["obs"].L  # unchanged
     assert isinstance(error_system, control.StateSpace)
-    # the minimal exponential sensor sets of the beam (derived in tests/test_search.py)
+    # the minimal exponential sensor sets of the beam (derived in tests/symbolic/test_search.py)
     assert search.minimal["exponential"] == ((2,), (4,))
     for value in (classification, run, tuned, search):
         assert len(repr(value)) <= 300, type(value).__name__

@@ -6,7 +6,7 @@ and ``phdesign classify`` start without numpy-heavy backends, control or matplot
 
 Exit status: 0 on success, 2 on bad input with exactly one line on stderr
 (``phdesign: error: ...``), never a traceback.  Bad input is what phdesign's own errors
-(:class:`~phdesign.errors.PhdesignError`) report; any other exception is a bug and is
+(:class:`~phdesign.core.errors.PhdesignError`) report; any other exception is a bug and is
 not disguised as bad input.
 """
 
@@ -18,7 +18,7 @@ import sys
 from collections.abc import Sequence
 
 from phdesign.cli.design_arguments import join_negative_values
-from phdesign.errors import PhdesignError
+from phdesign.core.errors import PhdesignError
 
 __all__ = ["build_parser", "main", "run"]
 

@@ -24,7 +24,7 @@ from phdesign.cli.design_arguments import (
     parse_gain_text,
     with_option_names,
 )
-from phdesign.errors import ObserverError
+from phdesign.core.errors import ObserverError
 
 __all__ = ["register"]
 

@@ -8,7 +8,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
-from phdesign.errors import NumericError, ParameterError
+from phdesign.core.errors import NumericError, ParameterError
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.model import BCPHS
@@ -158,14 +158,14 @@ def run_outputs(args: argparse.Namespace) -> Iterator[Callable[[str, Any], None]
     """Reserve ``-o`` and ``--plot`` before a run; yield ``commit(text, result)``.
 
     Every output is checked before the (possibly long) work and written together at the
-    end (:class:`phdesign.outputs.OutputFiles`): on any failure or interrupt none is left,
+    end (:class:`phdesign.core.files.OutputFiles`): on any failure or interrupt none is left,
     and no temporary file.  ``commit`` stages the text (or prints it without ``-o``) and
     ``result.plot()``'s figure, then writes them; warnings raised during the block (e.g.
     matplotlib's) are printed afterwards as ``phdesign: warning:`` lines.
     """
     import warnings
 
-    from phdesign.outputs import OutputFiles
+    from phdesign.core.files import OutputFiles
 
     with OutputFiles(args.force) as out, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -23,7 +23,7 @@ import json
 import re
 from typing import Any
 
-from phdesign.errors import ObserverError
+from phdesign.core.errors import ObserverError
 
 __all__ = [
     "add_observer_arguments",
@@ -127,7 +127,7 @@ def observer_from_args(
     (spectrum, simulate) refuses sensors given without ``--gain``, and ``--gain`` without
     sensors is always refused.  ``method`` and ``resolution`` are the discretization.
     """
-    from phdesign.design import Observer
+    from phdesign.design.observer import Observer
 
     sensors = getattr(args, "sensors", None)
     cm = getattr(args, "cm", None)

@@ -1,7 +1,7 @@
 """Command ``export`` (the observer for a controller) and the sampled-loop flags of ``simulate``.
 
 Argument parsing and printing only: the observer comes from
-:func:`phdesign.numeric.sampled.export_observer`, the files from :mod:`phdesign.codegen`.
+:func:`phdesign.numeric.sampled.export.export_observer`, the files from :mod:`phdesign.codegen`.
 Every check that can fail (the output path, the period, the sampler, the order against the
 verification plant, jinja2 for the rendered formats) runs before any computation, so a bad
 command writes nothing.
@@ -24,12 +24,12 @@ from phdesign.cli.common import (
     load_model,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
-from phdesign.errors import NumericError, ObserverError, OutputFileError
-from phdesign.export_defaults import EXPORT
+from phdesign.core.defaults import EXPORT
+from phdesign.core.errors import NumericError, ObserverError, OutputFileError
 
 __all__ = ["add_sampling_arguments", "register", "sampled_simulation"]
 
-SAMPLER_CHOICES = ("average", "point")  # phdesign.numeric.sampling.SAMPLERS, without numpy
+SAMPLER_CHOICES = ("average", "point")  # phdesign.numeric.sampled.samplers.SAMPLERS, without numpy
 FORMAT_CHOICES = ("json", "c", "npz", "statespace")  # phdesign.codegen.FORMATS
 
 
@@ -128,7 +128,7 @@ def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
     """Parse ``--at`` (numbers; their checks are the library's)."""
     if text is None:
         return None
-    from phdesign.numeric.sampled import displacement_points
+    from phdesign.numeric.sampled.export import displacement_points
 
     a, b = nm.interval
     points = []
@@ -144,10 +144,10 @@ def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
 
 def _export(args: argparse.Namespace) -> int:
     from phdesign.codegen import check_export_path
-    from phdesign.limits import check_periods
+    from phdesign.core.limits import check_periods
     from phdesign.numeric.inputs import initial_state_function
-    from phdesign.numeric.sampled import export_observer, verification_plant_degree
-    from phdesign.numeric.sampling import check_sampling
+    from phdesign.numeric.sampled.export import export_observer, verification_plant_degree
+    from phdesign.numeric.sampled.samplers import check_sampling
 
     dt = check_sampling(args.dt, args.sampler, dt_name="--dt")
     _finite_positive("--t-end", args.t_end)
@@ -225,9 +225,9 @@ def sampled_simulation(
     """
     if args.dt is None and args.sampler is None and args.observer_resolution is None:
         return None
-    from phdesign.limits import check_periods
-    from phdesign.numeric.sampled_simulation import simulate_sampled
-    from phdesign.numeric.sampling import check_sampling
+    from phdesign.core.limits import check_periods
+    from phdesign.numeric.sampled.samplers import check_sampling
+    from phdesign.numeric.sampled.simulation import simulate_sampled
 
     if C_m is None:
         raise NumericError(

@@ -3,7 +3,7 @@
 ``phdesign loop {classify,spectrum,simulate,tune} MODEL --actuate 3 --feedback 1
 --sensors 4 --gain 1 [--json]``: the plant's input u3 is driven by −K ŷ3, the observer's
 estimate of its collocated output, the observer measuring y4.  Argument parsing and
-printing only: the design is :class:`phdesign.loop.Loop`, each result prints itself.
+printing only: the design is :class:`phdesign.design.loop.Loop`, each result prints itself.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from phdesign.cli.common import (
     warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
-from phdesign.errors import LoopError, NumericError
+from phdesign.core.errors import LoopError, NumericError
 
 __all__ = ["register"]
 
@@ -129,8 +129,8 @@ def _numeric_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _loop(args: argparse.Namespace, numeric: bool = True) -> Any:
     from phdesign.cli.design_arguments import parse_gain_text
-    from phdesign.loop import Loop
-    from phdesign.symbolic.loop import parse_indices
+    from phdesign.design.loop import Loop
+    from phdesign.symbolic.control import parse_indices
 
     model = load_model(args)
     observer = observer_from_args(args, model, default_gain=1)

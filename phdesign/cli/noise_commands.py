@@ -1,8 +1,8 @@
 """Commands ``noise`` and ``tradeoff``, and the noise options of ``simulate`` and ``tune``.
 
 Argument parsing and printing only: the figures come from
-:mod:`phdesign.numeric.noise`, :mod:`phdesign.numeric.tradeoff`,
-:mod:`phdesign.numeric.noise_tune` and :mod:`phdesign.numeric.stochastic`, imported inside
+:mod:`phdesign.numeric.noise.figures`, :mod:`phdesign.numeric.noise.tradeoff`,
+:mod:`phdesign.numeric.noise.tuning` and :mod:`phdesign.numeric.time.stochastic`, imported inside
 the handlers.  Each command prints ``str(result)`` or ``result.to_dict()`` as JSON.
 
 Noise options (shared):
@@ -33,8 +33,8 @@ from phdesign.cli.common import (
     run_outputs,
 )
 from phdesign.cli.design_arguments import add_observer_arguments
-from phdesign.errors import NumericError, ObserverError
-from phdesign.limits import check_tradeoff_gains
+from phdesign.core.errors import NumericError, ObserverError
+from phdesign.core.limits import check_tradeoff_gains
 
 __all__ = [
     "add_noise_arguments",
@@ -153,13 +153,13 @@ def _numbers(text: str, flag: str) -> list[float]:
 def _intensities(text: str | None, count: int, flag: str) -> Any:
     if text is None:
         return None
-    from phdesign.numeric.noise import check_intensity
+    from phdesign.numeric.noise.figures import check_intensity
 
     return check_intensity(_numbers(text, flag), count, flag)
 
 
 def _performance(args: argparse.Namespace, nm: Any, model: Any) -> list[Any] | None:
-    from phdesign.numeric import functionals as fn
+    from phdesign.numeric.discretization import functionals as fn
 
     items: list[Any] = []
     if args.at is not None:
@@ -188,7 +188,7 @@ def _observer(args: argparse.Namespace, command: str) -> tuple[Any, Any, Any, An
             f"{command} needs --sensors or --cm: the noise enters through the observer's "
             "measurements"
         )
-    from phdesign.design import numeric_matrix
+    from phdesign.design.observer import numeric_matrix
 
     C_m = numeric_matrix(observer.C_m, "C_m", command)
     L = None if family else observer.numeric_gain(command)[1]
@@ -206,7 +206,7 @@ def _noise_inputs(args: argparse.Namespace, nm: Any, model: Any, q: int) -> dict
 
 # ----------------------------------------------------------------------------- commands
 def _noise(args: argparse.Namespace) -> int:
-    from phdesign.numeric.noise import noise
+    from phdesign.numeric.noise.figures import noise
 
     check_positive("--resolution", args.resolution)
     check_positive("--tol", args.tol)
@@ -258,7 +258,7 @@ def _range(text: str, flag: str) -> Any:
 
 
 def _tradeoff(args: argparse.Namespace) -> int:
-    from phdesign.numeric.tradeoff import tradeoff
+    from phdesign.numeric.noise.tradeoff import tradeoff
 
     model, nm, C_m, _ = _observer(args, "tradeoff")
     q = C_m.shape[0]
@@ -333,7 +333,7 @@ def stochastic_simulation(args: argparse.Namespace) -> Any:
         )
     from functools import partial
 
-    from phdesign.numeric.stochastic import simulate_noisy
+    from phdesign.numeric.time.stochastic import simulate_noisy
 
     sensors = getattr(args, "sensors", None) or getattr(args, "cm", None)
     if args.noise_intensity is not None and sensors is None:
@@ -419,8 +419,8 @@ def noise_tuning(args: argparse.Namespace) -> int | None:
         raise NumericError("--objective rms needs --min-decay A (the decay rate to keep)")
     from phdesign.cli.common import load_model
     from phdesign.cli.design_arguments import observer_from_args
-    from phdesign.design import numeric_matrix
-    from phdesign.numeric.noise_tune import tune_noise
+    from phdesign.design.observer import numeric_matrix
+    from phdesign.numeric.noise.tuning import tune_noise
 
     model = load_model(args)
     observer = observer_from_args(args, model)  # argparse requires --sensors or --cm here

@@ -37,7 +37,7 @@ from phdesign.cli.noise_commands import (
     noise_tuning,
     stochastic_simulation,
 )
-from phdesign.errors import NumericError
+from phdesign.core.errors import NumericError
 
 __all__ = ["register"]
 
@@ -166,7 +166,7 @@ def _numeric_setup(args: argparse.Namespace, command: str) -> tuple[Any, Any, An
     The sensors and gain go through :class:`phdesign.Observer` (one validation for every
     command); ``--param`` is applied by :func:`load_model`.
     """
-    from phdesign.design import Plant
+    from phdesign.design.observer import Plant
 
     model = load_model(args)
     observer = observer_from_args(
@@ -179,7 +179,7 @@ def _numeric_setup(args: argparse.Namespace, command: str) -> tuple[Any, Any, An
 
 
 def _spectrum(args: argparse.Namespace) -> int:
-    from phdesign.numeric.spectrum import spectrum
+    from phdesign.numeric.spectrum.converged import spectrum
 
     check_positive("--resolution", args.resolution)
     check_positive("--tol", args.tol)
@@ -202,7 +202,7 @@ def _spectrum(args: argparse.Namespace) -> int:
 def _simulate(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from phdesign.design import Plant
+    from phdesign.design.observer import Plant
     from phdesign.numeric.inputs import input_function
 
     check_positive("--resolution", args.resolution)
@@ -319,8 +319,8 @@ class _Progress:
 
 
 def _tune(args: argparse.Namespace) -> int:
-    from phdesign.design import numeric_matrix
-    from phdesign.numeric.tune import tune
+    from phdesign.design.observer import numeric_matrix
+    from phdesign.numeric.tuning.search import tune
 
     if (noisy := noise_tuning(args)) is not None:  # --max-rms / --objective rms
         return noisy

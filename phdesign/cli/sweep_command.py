@@ -19,7 +19,7 @@ from phdesign.cli.common import (
     emit_result,
     load_model,
 )
-from phdesign.errors import SweepError
+from phdesign.core.errors import SweepError
 from phdesign.sweep.jobs import JOBS
 
 __all__ = ["register"]

@@ -23,10 +23,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from phdesign.codegen.folder import MARKER, check_export_folder, write_directory
-from phdesign.errors import NumericError, OutputFileError
+from phdesign.core.errors import NumericError, OutputFileError
 
 if TYPE_CHECKING:
-    from phdesign.numeric.sampled import SampledObserver
+    from phdesign.numeric.sampled.export import SampledObserver
 
 __all__ = [
     "FORMATS",

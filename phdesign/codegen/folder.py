@@ -25,8 +25,8 @@ import tempfile
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 
-from phdesign.errors import OutputFileError
-from phdesign.outputs import TEMPORARY_PREFIX, TEMPORARY_SUFFIX, terminate_as_interrupt
+from phdesign.core.errors import OutputFileError
+from phdesign.core.files import TEMPORARY_PREFIX, TEMPORARY_SUFFIX, terminate_as_interrupt
 
 __all__ = ["MARKER", "check_export_folder", "write_directory"]
 

@@ -22,7 +22,7 @@ from functools import cache
 from importlib import resources
 from pathlib import Path
 
-from phdesign.errors import ArgumentError, ModelFileError, ParameterError
+from phdesign.core.errors import ArgumentError, ModelFileError, ParameterError
 from phdesign.symbolic.model import BCPHS
 
 __all__ = ["builtin_names", "builtin_toml", "load", "load_builtin"]

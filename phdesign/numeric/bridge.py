@@ -27,7 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import ModelError, ParameterError, check_shape
+from phdesign.core.checks import found_text
+from phdesign.core.errors import ArgumentError, ModelError, ParameterError, check_shape
 from phdesign.symbolic.ports import trace_index
 
 __all__ = [
@@ -36,6 +37,7 @@ __all__ = [
     "PortFeedback",
     "constant_H",
     "gain_to_numeric",
+    "require_numeric_model",
     "to_numeric",
     "trace_index",
 ]
@@ -168,13 +170,18 @@ class NumericModel:
             object.__setattr__(self, "state_names", tuple(f"x{i + 1}" for i in range(n)))
 
     def _check_dissipative(self) -> None:
-        r"""Refuse a model that is not dissipative (:mod:`phdesign.numeric.invariants`).
+        r"""Refuse a model that is not dissipative.
 
+        The checks of :mod:`phdesign.numeric.discretization.invariants`:
         :math:`H(z) \succ 0` (the energy is positive) and :math:`P_0 + P_0^\top \preceq 0`
         on a grid of the interval, and the plant's own feedback :math:`K + K^\top \succeq
         0`, to round-off.
         """
-        from phdesign.numeric.invariants import GRID_POINTS, require_definite, require_semidefinite
+        from phdesign.numeric.discretization.invariants import (
+            GRID_POINTS,
+            require_definite,
+            require_semidefinite,
+        )
 
         z = np.linspace(self.interval[0], self.interval[1], GRID_POINTS)
         require_definite("H(z)", self.H_at(z), ModelError, points=z)
@@ -286,9 +293,8 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         When a parameter is unknown or a symbol other than z stays free (the message
         names them).
     """
-    from phdesign.arguments import require_model
     from phdesign.symbolic.expressions import exact_matrix, exact_number
-    from phdesign.symbolic.model import Z
+    from phdesign.symbolic.model import Z, require_model
 
     require_model(model)
     if parameters is not None and not isinstance(parameters, Mapping):
@@ -393,3 +399,12 @@ def gain_to_numeric(matrix: Any, name: str = "L") -> np.ndarray:
         return np.array(matrix, dtype=float)
     except (TypeError, ValueError) as exc:
         raise ParameterError(f"{name}: cannot convert to a numeric matrix ({exc})") from exc
+
+
+def require_numeric_model(value: object, name: str = "nm") -> None:
+    """Raise :class:`ArgumentError` unless ``value`` is a numeric model (the bridge's output)."""
+    if not isinstance(value, NumericModel):
+        hint = ""
+        if isinstance(value, str) or type(value).__name__ == "BCPHS":
+            hint = " (phdesign.numeric.bridge.to_numeric(model) makes one from a model)"
+        raise ArgumentError(f"{name}: expected a NumericModel{hint}; found {found_text(value)}")

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import ExpressionError, NumericError, ParameterError, PhdesignError
+from phdesign.core.errors import ExpressionError, NumericError, ParameterError, PhdesignError
 from phdesign.numeric.bridge import (
     NumericModel,
     _free_symbols_message,
@@ -117,7 +117,7 @@ def initial_state_function(
     >>> initial_state_function("e1: 2*z", nm)(np.array([0.5]))
     array([[0.5]])
     """
-    from phdesign.arguments import require_numeric_model
+    from phdesign.numeric.bridge import require_numeric_model
 
     require_numeric_model(nm)
     if text is not None and not isinstance(text, str):
@@ -354,13 +354,14 @@ def input_samples(
     >>> input_samples(lambda t: [1], [0.0], 2)
     Traceback (most recent call last):
     ...
-    phdesign.errors.ArgumentError: u(t) must return 2 numbers (one per input); found 1 at t = 0
+    phdesign.core.errors.ArgumentError: u(t) must return 2 numbers (one per input); found 1 at t =
+    0
     >>> input_samples(lambda t: [1.0, np.log(t)], [1.0, 0.0], 2)
     Traceback (most recent call last):
     ...
-    phdesign.errors.NumericError: u(t) must be finite; found -inf in input u2 at t = 0
+    phdesign.core.errors.NumericError: u(t) must be finite; found -inf in input u2 at t = 0
     """
-    from phdesign.errors import ArgumentError
+    from phdesign.core.errors import ArgumentError
 
     rows = []
     for t in np.asarray(times, dtype=float).ravel():

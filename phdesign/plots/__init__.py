@@ -1,8 +1,9 @@
 r"""Plots for observer design: energies, deflections, outputs, spectra and gain maps.
 
 A front end: every function draws data that a lower layer computed
-(:class:`phdesign.numeric.simulate.SimulationResult`, eigenvalues from
-:mod:`phdesign.numeric.spectrum`, abscissas from :mod:`phdesign.numeric.tune`) and returns
+(:class:`phdesign.numeric.time.simulation.SimulationResult`, eigenvalues from
+:mod:`phdesign.numeric.spectrum.converged`, abscissas from :mod:`phdesign.numeric.tuning.search`)
+and returns
 the :class:`matplotlib.figure.Figure` it drew on.  Functions that draw one panel accept an
 optional ``ax``; without it they make a new figure (:func:`new_figure`).  Result objects
 draw themselves with these (``result.plot()``).

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.errors import NumericError
+from phdesign.core.errors import NumericError
 from phdesign.symbolic.units import with_unit
 
 if TYPE_CHECKING:  # pragma: no cover - typing only

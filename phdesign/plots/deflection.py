@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.errors import NumericError
+from phdesign.core.errors import NumericError
 from phdesign.plots._figures import (
     DESIGN_COLORS,
     OBSERVER_COLOR,

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.errors import NumericError
+from phdesign.core.errors import NumericError
 from phdesign.plots._figures import (
     DESIGN_COLORS,
     ERROR_COLOR,
@@ -41,7 +41,7 @@ def plot_hamiltonians(result: Any, axes: Sequence[Axes] | None = None) -> Figure
     Parameters
     ----------
     result : SimulationResult
-        From :func:`phdesign.numeric.simulate.simulate`.
+        From :func:`phdesign.numeric.time.simulation.simulate`.
     axes : pair of Axes, optional
         Where to draw (linear, log); a new 1 x 2 figure otherwise.
 

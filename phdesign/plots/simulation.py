@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.errors import OutputFileError
+from phdesign.core.errors import OutputFileError
 from phdesign.plots._figures import (
     DESIGN_COLORS,
     legend_in_view,

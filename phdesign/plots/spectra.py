@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from phdesign.errors import NumericError
+from phdesign.core.errors import NumericError
 from phdesign.plots._figures import (
     ABSCISSA_LABEL,
     IM_LABEL,
@@ -37,7 +37,7 @@ def plot_spectrum(
     """Eigenvalues in the complex plane, resolved and unresolved ones marked differently.
 
     Resolved eigenvalues (those that agree between two resolutions, see
-    :func:`phdesign.numeric.spectrum.match_resolved`) are filled blue dots; unresolved
+    :func:`phdesign.numeric.spectrum.converged.match_resolved`) are filled blue dots; unresolved
     ones are grey crosses: they are artefacts of the discretization and the spectral
     abscissa ignores them.  The legend, below the axes, lists only what the view shows.
 

@@ -149,7 +149,7 @@ def sweep(
     if parameters:
         overlap = sorted(set(parameters) & set(param_grid or {}))
         if overlap:
-            from phdesign.errors import SweepError
+            from phdesign.core.errors import SweepError
 
             raise SweepError(f"parameter {overlap[0]} is both fixed and on an axis; give it once")
         model = model.with_parameters(dict(parameters))

@@ -60,7 +60,7 @@ def description_of(dataset: Any) -> SweepDescription:
     SweepError
         The Dataset is not a phdesign sweep.
     """
-    from phdesign.errors import SweepError
+    from phdesign.core.errors import SweepError
 
     text = dataset.attrs.get(SWEEP_ATTRIBUTE)
     if not isinstance(text, str):

@@ -40,8 +40,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from phdesign.errors import ParameterError, PhdesignError, SweepError
-from phdesign.limits import MAX_STORE_METADATA_BYTES, check_sweep_points
+from phdesign.core.errors import ParameterError, PhdesignError, SweepError
+from phdesign.core.limits import MAX_STORE_METADATA_BYTES, check_sweep_points
 from phdesign.sweep.grids import Axis, parse_axis, parse_sensor_sets, sensor_set_indices
 from phdesign.sweep.jobs import Job, get_job
 
@@ -251,7 +251,7 @@ def _sensor_indices(sensors: str | Sequence[int], n_outputs: int) -> tuple[int, 
     """Read ``"3,4"`` or ``[3, 4]`` as 1-based output indices, checked against the model."""
     import operator
 
-    from phdesign.errors import ObserverError
+    from phdesign.core.errors import ObserverError
     from phdesign.symbolic.observer import parse_sensor_indices, sensor_matrix
 
     if isinstance(sensors, str):
@@ -270,7 +270,7 @@ def _sensor_indices(sensors: str | Sequence[int], n_outputs: int) -> tuple[int, 
 
 def _fixed_gain(gain: str | Sequence[float] | float, count: int, per: str) -> tuple[float, ...]:
     """Read fixed diagonal entries of L (``count`` of them, or one for all) exactly."""
-    from phdesign.errors import ObserverError
+    from phdesign.core.errors import ObserverError
     from phdesign.symbolic.observer import diagonal_values
 
     if isinstance(gain, str):

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import PhdesignError, SweepError
+from phdesign.core.errors import PhdesignError, SweepError
 from phdesign.sweep.dataset import RUN_ATTRIBUTE, template
 from phdesign.sweep.description import SweepDescription
 from phdesign.sweep.export import output_format, write_export
@@ -141,7 +141,7 @@ def run(
     (the output, the scheduler) is checked before anything is written.  A Zarr store is
     written under its lock (:class:`~phdesign.sweep.lock.StoreLock`): a second sweep on
     the same store is refused while the first runs.  When a point is refused (a
-    :class:`~phdesign.errors.PhdesignError` from a chunk), a store this run created is
+    :class:`~phdesign.core.errors.PhdesignError` from a chunk), a store this run created is
     removed again; a store it resumed is left as it was found, with the chunks it added.
     """
     from phdesign.sweep.lock import StoreLock

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import OutputFileError, SweepError
+from phdesign.core.errors import OutputFileError, SweepError
 
 __all__ = ["FORMATS", "open_sweep", "output_format", "to_csv", "write_export"]
 
@@ -135,7 +135,7 @@ def _read_netcdf(target: Path) -> Any:
 
     import xarray as xr
 
-    from phdesign.errors import PhdesignError
+    from phdesign.core.errors import PhdesignError
     from phdesign.sweep.dataset import description_of
     from phdesign.sweep.schema import check_netcdf
 

@@ -37,8 +37,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from phdesign.errors import SweepError
-from phdesign.limits import MAX_MAGNITUDE, check_sweep_points
+from phdesign.core.errors import SweepError
+from phdesign.core.limits import MAX_MAGNITUDE, check_sweep_points
 
 __all__ = [
     "AXIS_KINDS",
@@ -137,7 +137,7 @@ class Axis:
         ------
         SweepError
             Not the five fields of an axis, of their kinds: a name, kind, scale and spec of
-            text, and at most :data:`~phdesign.limits.MAX_SWEEP_POINTS` values (numbers,
+            text, and at most :data:`~phdesign.core.limits.MAX_SWEEP_POINTS` values (numbers,
             or sensor sets such as ``"3,4"``), valid as :class:`Axis` requires.
         """
         fields = ("name", "kind", "values", "scale", "spec")

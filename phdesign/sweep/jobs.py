@@ -19,7 +19,7 @@ Adding a job is one entry in :data:`JOBS`, e.g. for noise figures::
         summary="steady-state error energy under boundary sensor noise",
         figures=(Figure("error_energy", "float64", "E[H̃] [J]"), ...),
         options=(Option("resolution", "int", None, "Galerkin degree"), ...),
-        prepare="phdesign.numeric.noise:sweep_evaluator",
+        prepare="phdesign.numeric.noise.figures:sweep_evaluator",
         needs_sensors=True,
     ),
 
@@ -39,7 +39,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from phdesign.errors import SweepError
+from phdesign.core.errors import SweepError
 
 __all__ = ["JOBS", "Figure", "Job", "Option", "get_job"]
 

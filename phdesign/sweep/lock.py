@@ -35,7 +35,7 @@ import stat
 from pathlib import Path
 from types import TracebackType
 
-from phdesign.errors import OutputFileError, SweepError
+from phdesign.core.errors import OutputFileError, SweepError
 
 __all__ = ["MARKER", "StoreLock", "lock_path"]
 

@@ -25,7 +25,7 @@ import itertools
 import math
 from dataclasses import dataclass
 
-from phdesign.errors import SweepError
+from phdesign.core.errors import SweepError
 
 __all__ = ["ChunkPlan", "check_chunk_size"]
 

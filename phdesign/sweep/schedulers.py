@@ -33,8 +33,8 @@ from dataclasses import dataclass
 from typing import Any
 from urllib.parse import urlsplit
 
-from phdesign.errors import SweepError
-from phdesign.limits import check_local_workers
+from phdesign.core.errors import SweepError
+from phdesign.core.limits import check_local_workers
 
 __all__ = [
     "CONNECT_TIMEOUT",
@@ -175,7 +175,7 @@ def check_scheduler(scheduler: Any, workers: int | None) -> None:
     ------
     SweepError
         A worker count that is not a positive integer or exceeds the machine's cores
-        (:func:`phdesign.limits.check_local_workers`), workers with a scheduler of its own,
+        (:func:`phdesign.core.limits.check_local_workers`), workers with a scheduler of its own,
         a name that is not a scheduler, or a malformed address (:func:`check_address`).
     """
     if workers is not None and (
@@ -217,7 +217,8 @@ def check_address(address: str) -> None:
     >>> check_address("tcp://127.0.0.1:0")
     Traceback (most recent call last):
     ...
-    phdesign.errors.SweepError: scheduler address 'tcp://127.0.0.1:0': the port must be from 1 ...
+    phdesign.core.errors.SweepError: scheduler address 'tcp://127.0.0.1:0': the port must be from 1
+    ...
     """
     shown = f"scheduler address {address!r}"
     expected = "expected tcp://HOST:PORT with a port from 1 to 65535"

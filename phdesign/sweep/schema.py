@@ -9,9 +9,9 @@ dtype or an object codec such as pickle), its fill value and its CF attributes (
 ``units`` of ``"days since ..."`` would turn a figure into dates).  Zarr chunks are
 checked too: regular files (a link to ``/dev/zero`` is refused), none larger than its
 chunk (the Blosc header declares the size it decompresses to).  Everything else is
-refused with one :class:`~phdesign.errors.SweepError` that says what was found; so is
+refused with one :class:`~phdesign.core.errors.SweepError` that says what was found; so is
 any metadata file that is not a regular file, is larger than
-:data:`~phdesign.limits.MAX_STORE_METADATA_BYTES` or is not JSON.
+:data:`~phdesign.core.limits.MAX_STORE_METADATA_BYTES` or is not JSON.
 
 Examples
 --------
@@ -21,7 +21,7 @@ Examples
 >>> read_json(path, "the store's sweep.json")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-phdesign.errors.SweepError: the store's sweep.json is not JSON: Expecting ',' delimiter...
+phdesign.core.errors.SweepError: the store's sweep.json is not JSON: Expecting ',' delimiter...
 """
 
 from __future__ import annotations
@@ -37,8 +37,8 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import SweepError
-from phdesign.limits import (
+from phdesign.core.errors import SweepError
+from phdesign.core.limits import (
     MAX_MODEL_FILE_BYTES,
     MAX_PARAMETERS,
     MAX_PORTS,
@@ -81,7 +81,7 @@ def read_json(path: Path, what: str) -> Any:
     if len(data) > MAX_STORE_METADATA_BYTES:
         raise SweepError(
             f"{what} is larger than {MAX_STORE_METADATA_BYTES:,} bytes "
-            "(the budget phdesign.limits.MAX_STORE_METADATA_BYTES)"
+            "(the budget phdesign.core.limits.MAX_STORE_METADATA_BYTES)"
         )
     try:
         return json.loads(data.decode("utf-8"))

@@ -1,12 +1,13 @@
 r"""The ``spectrum`` job: converged spectral abscissa at every gain of a chunk.
 
-Each point is exactly what :func:`phdesign.numeric.spectrum.spectrum` reports at its gain:
+Each point is exactly what :func:`phdesign.numeric.spectrum.converged.spectrum` reports at its
+gain:
 the same refinement of the resolution pair, the same drift test, choice of the abscissa
 and convergence rule, so a stored abscissa carries the ``converged`` flag and the digits
 that ``spectrum()`` gives, and no number that did not converge is stored as if it had.
 Discretizing is most of a spectrum's cost on the beam (two Galerkin assemblies of ~20 ms
 against ~7 ms of eigenvalues) and does not depend on the gain, so a chunk shares one
-:class:`~phdesign.numeric.spectrum_refinement.Discretizations`: every resolution is
+:class:`~phdesign.numeric.spectrum.refinement.Discretizations`: every resolution is
 discretized once per chunk, whatever the number of gains, and each gain solves
 
 .. math::
@@ -24,14 +25,14 @@ from typing import Any
 import numpy as np
 
 from phdesign.numeric.bridge import NumericModel, to_numeric
-from phdesign.numeric.spectrum import SpectrumReport, spectrum
-from phdesign.numeric.spectrum_refinement import Discretizations
+from phdesign.numeric.spectrum.converged import SpectrumReport, spectrum
+from phdesign.numeric.spectrum.refinement import Discretizations
 
 __all__ = ["ChunkSpectrum", "abscissa_evaluator", "check_options", "figures_of_report", "prepare"]
 
 
 def figures_of_report(report: SpectrumReport) -> dict[str, Any]:
-    """Return the job's figures from a :class:`~phdesign.numeric.spectrum.SpectrumReport`."""
+    """Return the job's figures from a spectrum report (:mod:`phdesign.numeric.spectrum`)."""
     return {
         "spectral_abscissa": report.spectral_abscissa,
         "converged": report.converged,
@@ -52,9 +53,9 @@ class ChunkSpectrum:
         Sensor matrix (``None``: the plant with u = 0, gains ignored).
     method : {"galerkin", "fd"}
     resolution, max_resolution : int, optional
-        As for :func:`~phdesign.numeric.spectrum.spectrum`.
+        As for :func:`~phdesign.numeric.spectrum.converged.spectrum`.
     tol : float, optional
-        As for :func:`~phdesign.numeric.spectrum.spectrum`.
+        As for :func:`~phdesign.numeric.spectrum.converged.spectrum`.
 
     Examples
     --------
@@ -117,10 +118,10 @@ def abscissa_evaluator(
 def check_options(model: Any, options: Mapping[str, Any]) -> None:
     """Refuse resolutions over the discretization budget before the sweep starts.
 
-    Every point would refuse them (:func:`phdesign.limits.check_discretization`, the check
-    :func:`~phdesign.numeric.spectrum.spectrum` makes); the model's size decides.
+    Every point would refuse them (:func:`phdesign.core.limits.check_discretization`, the check
+    :func:`~phdesign.numeric.spectrum.converged.spectrum` makes); the model's size decides.
     """
-    from phdesign.limits import check_discretization
+    from phdesign.core.limits import check_discretization
 
     method = options.get("method") or "galerkin"
     check_discretization(model, method, options.get("resolution"), options.get("max_resolution"))

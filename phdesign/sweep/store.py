@@ -36,9 +36,9 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.errors import OutputFileError, PhdesignError, SweepError
+from phdesign.core.errors import OutputFileError, PhdesignError, SweepError
+from phdesign.core.files import remove_stale_temporaries
 from phdesign.io import atomic_write
-from phdesign.outputs import remove_stale_temporaries
 from phdesign.sweep.description import SweepDescription
 from phdesign.sweep.plan import ChunkPlan
 from phdesign.sweep.schema import check_zarr, read_json

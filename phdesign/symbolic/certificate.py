@@ -53,8 +53,8 @@ from typing import Any
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
-from phdesign.errors import ObserverError
-from phdesign.limits import EXACT_KAPPA_BITS, EXACT_KAPPA_DEGREE, EXACT_KAPPA_OPERATIONS
+from phdesign.core.errors import ObserverError
+from phdesign.core.limits import EXACT_KAPPA_BITS, EXACT_KAPPA_DEGREE, EXACT_KAPPA_OPERATIONS
 from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.observer import ErrorSystem
 
@@ -177,7 +177,7 @@ def certify(
     if method == "exact" and not affordable:
         raise ObserverError(
             f"the exact κ* of this pencil is over budget ({_operations(A_r, B_r)} operations "
-            f"> {EXACT_KAPPA_OPERATIONS}, phdesign.limits.EXACT_KAPPA_OPERATIONS); "
+            f"> {EXACT_KAPPA_OPERATIONS}, phdesign.core.limits.EXACT_KAPPA_OPERATIONS); "
             "use method='float'"
         )
     exact_path = method in ("auto", "exact") and affordable
@@ -187,7 +187,7 @@ def certify(
         if method == "exact":
             raise ObserverError(
                 f"the exact κ* of this pencil is over budget ({size}, "
-                "phdesign.limits.EXACT_KAPPA_BITS and EXACT_KAPPA_DEGREE); use method='float'"
+                "phdesign.core.limits.EXACT_KAPPA_BITS and EXACT_KAPPA_DEGREE); use method='float'"
             )
         exact_path = False
     if exact_path:
@@ -371,7 +371,7 @@ def _tidy(expr: sympy.Expr) -> sympy.Expr:
     ``simplify`` of the root of a quadratic factor in two gains (a square root of a
     polynomial of degree 8) costs about 0.15 s and shortens it by 5 %; the common
     denominator with the common factors pulled out costs a sixth of that, for the same
-    size (measured on the random models of tests/test_classify_properties.py).
+    size (measured on the random models of tests/symbolic/test_classify_properties.py).
     """
     if any(not p.exp.is_Integer for p in expr.atoms(sympy.Pow)):
         return sympy.factor_terms(sympy.together(expr))

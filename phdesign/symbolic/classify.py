@@ -45,7 +45,9 @@ from typing import Any
 
 import sympy
 
-from phdesign._display import (
+from phdesign.core.checks import choice
+from phdesign.core.errors import ObserverError
+from phdesign.core.text import (
     REPR_LIMIT,
     html_table,
     kappa_text,
@@ -54,8 +56,6 @@ from phdesign._display import (
     sensors_text,
     shorten,
 )
-from phdesign.arguments import choice
-from phdesign.errors import ObserverError
 from phdesign.symbolic.assumption import AssumptionCheck, Partition, model_assumption
 from phdesign.symbolic.certificate import Certificate, certify
 from phdesign.symbolic.expressions import Trace

@@ -50,7 +50,7 @@ from collections.abc import Mapping, Sequence
 
 import sympy
 
-from phdesign.errors import PortError
+from phdesign.core.errors import PortError
 from phdesign.symbolic.expressions import canonical, vanishes
 from phdesign.symbolic.printing import format_expression
 

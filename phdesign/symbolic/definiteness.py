@@ -9,14 +9,14 @@ expressions in :math:`z` and the parameters (substituted by their defaults), one
     \qquad \text{for every } z \in [a, b],
 
 and returns one line saying how it was verified (it goes into ``BCPHS.checks``), or
-raises :class:`~phdesign.errors.ModelError` naming the matrix and giving what was found.
+raises :class:`~phdesign.core.errors.ModelError` naming the matrix and giving what was found.
 The model uses it for :math:`\mathcal H(z) \succ 0` and :math:`P_0 + P_0^\top \preceq 0`.
 With :math:`S = \pm M` the relation is :math:`S \succ 0` (or :math:`\succeq 0`):
 
 *Constant* :math:`S`: sympy's exact test (``is_positive_definite``).
 
 *Rational in z with rational coefficients*, within the budgets
-``EXACT_DEFINITENESS_*`` of :mod:`phdesign.limits` (estimated before any work): every
+``EXACT_DEFINITENESS_*`` of :mod:`phdesign.core.limits` (estimated before any work): every
 denominator must be free of roots on :math:`[a, b]` (else :math:`M` is unbounded there);
 multiplying row :math:`i` by the least common multiple :math:`\ell_i` of its denominators
 (of constant sign on :math:`[a, b]`) turns each minor into a polynomial :math:`p`, and
@@ -71,8 +71,8 @@ from typing import Any
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
-from phdesign.errors import ExpressionError, ModelError
-from phdesign.limits import (
+from phdesign.core.errors import ExpressionError, ModelError
+from phdesign.core.limits import (
     EXACT_DEFINITENESS_BITS,
     EXACT_DEFINITENESS_DEGREE,
     EXACT_DEFINITENESS_SIZE,

@@ -21,7 +21,7 @@ from typing import Any
 
 import sympy
 
-from phdesign._display import REPR_LIMIT, html_table, number_text, shorten
+from phdesign.core.text import REPR_LIMIT, html_table, number_text, shorten
 
 __all__ = ["IDENTITY_STATEMENTS", "ModelDisplay", "PortsDisplay"]
 

@@ -5,7 +5,7 @@ of points by walking its tree with numpy: it replaces :func:`sympy.lambdify`, wh
 an expression as Python source and executes it, so no expression a caller built can run
 code. Only the grammar's operations are known (sums, products, powers, the functions of
 :mod:`phdesign.symbolic.parser`, ``Abs`` and ``cot``); anything else is an
-:class:`~phdesign.errors.ExpressionError`.
+:class:`~phdesign.core.errors.ExpressionError`.
 
 :func:`enclose` bounds the same expression on intervals :math:`[l_i, h_i]` (interval
 arithmetic, rounded outwards by a few units in the last place per operation), which is
@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 import sympy
 
-from phdesign.errors import ExpressionError
+from phdesign.core.errors import ExpressionError
 from phdesign.symbolic.expressions import Z
 
 __all__ = ["enclose", "evaluate"]

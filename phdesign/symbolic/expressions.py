@@ -36,9 +36,9 @@ from typing import Literal
 
 import sympy
 
-from phdesign.arguments import not_bytes
-from phdesign.errors import ExpressionError
-from phdesign.limits import MAX_NUMBER_OPERATIONS
+from phdesign.core.checks import not_bytes
+from phdesign.core.errors import ExpressionError
+from phdesign.core.limits import MAX_NUMBER_OPERATIONS
 from phdesign.symbolic.parser import CONSTANTS, FUNCTIONS, Token, brief, check_text, parse
 
 __all__ = [

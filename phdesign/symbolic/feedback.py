@@ -90,7 +90,7 @@ from typing import TYPE_CHECKING, Any
 
 import sympy
 
-from phdesign.errors import ModelError, PortError
+from phdesign.core.errors import ModelError, PortError
 from phdesign.symbolic.expressions import canonical, vanishes
 from phdesign.symbolic.printing import format_expression
 

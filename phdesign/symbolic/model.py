@@ -39,8 +39,9 @@ from typing import TYPE_CHECKING, Any
 
 import sympy
 
-from phdesign.errors import ExpressionError, ModelError, ParameterError
-from phdesign.limits import check_model_dimensions, check_parameter_count
+from phdesign.core.checks import found_text
+from phdesign.core.errors import ArgumentError, ExpressionError, ModelError, ParameterError
+from phdesign.core.limits import check_model_dimensions, check_parameter_count
 from phdesign.symbolic.display import ModelDisplay
 from phdesign.symbolic.expressions import (
     Z,
@@ -63,7 +64,7 @@ from phdesign.symbolic.validation import validate
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.ports import Ports
 
-__all__ = ["BCPHS", "Displacement", "Feedback", "Z", "parse_matrix"]
+__all__ = ["BCPHS", "Displacement", "Feedback", "Z", "parse_matrix", "require_model"]
 
 
 @dataclass(frozen=True)
@@ -86,8 +87,9 @@ class BCPHS(ModelDisplay):
 
     Build one with :meth:`define` (from strings and numbers) or from a model file
     with :func:`phdesign.io.read_model`. Construction validates every condition and
-    raises :class:`~phdesign.errors.ModelError`, :class:`~phdesign.errors.ExpressionError`
-    or :class:`~phdesign.errors.PortError` naming what is wrong.
+    raises :class:`~phdesign.core.errors.ModelError`,
+    :class:`~phdesign.core.errors.ExpressionError`
+    or :class:`~phdesign.core.errors.PortError` naming what is wrong.
 
     Attributes
     ----------
@@ -415,3 +417,12 @@ def _entry(value: object, what: str, parameters: Sequence[str], allow_z: bool) -
     # sympy builds (z + d)/atan(1) as 4*(d + z)/pi, which reads back as (4*d + 4*z)/pi:
     # keep the form that reads back as itself, so that written models read back exactly
     return parse_scalar(format_expression(expr), parameters, allow_z=allow_z, what=what)
+
+
+def require_model(value: object, name: str = "model") -> None:
+    """Raise :class:`ArgumentError` unless ``value`` is a :class:`~phdesign.BCPHS`."""
+    if not isinstance(value, BCPHS):
+        hint = ""
+        if isinstance(value, str):
+            hint = f" (phdesign.load({value!r}) reads a built-in model or a TOML file)"
+        raise ArgumentError(f"{name}: expected a BCPHS model{hint}; found {found_text(value)}")

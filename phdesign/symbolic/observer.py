@@ -66,7 +66,7 @@ import sympy
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
-from phdesign.errors import ObserverError
+from phdesign.core.errors import ObserverError
 from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.feedback import error_dissipation, plant_feedback
 from phdesign.symbolic.model import BCPHS
@@ -133,7 +133,7 @@ def port_inverse(model: BCPHS) -> sympy.ImmutableMatrix:
     [1, 0,  0, 0],
     [0, 0, -1, 0]])
     """
-    from phdesign.arguments import require_model
+    from phdesign.symbolic.model import require_model
 
     require_model(model)
     return _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(*port_matrices(model))))
@@ -280,7 +280,7 @@ class ObserverDesign:
     L: sympy.ImmutableMatrix
 
     def __post_init__(self) -> None:
-        from phdesign.arguments import require_model
+        from phdesign.symbolic.model import require_model
 
         require_model(self.model)
         C_m, L = sensors_and_gain(self.C_m, self.L, self.model.n_ports)

@@ -7,7 +7,7 @@ traces ``e<i><primes>(<point>)`` by a caller-supplied factory. Euler's number is
 ``exp(1)``: ``E`` is an ordinary name (Young's modulus is a parameter like any other).
 
 Sizes are bounded so that hostile text cannot exhaust time or memory (the budgets of
-:mod:`phdesign.limits`): length, nesting depth, exponents as written, the degree of the
+:mod:`phdesign.core.limits`): length, nesting depth, exponents as written, the degree of the
 built expression (``z*z*…*z`` is ``z**k``), the bits of exact numbers, and the magnitude of
 constants (``exp(exp(exp(5)))`` and ``exp(1e300)`` are refused before they are evaluated).
 The result is real: ``sqrt(-1)``, ``log(0)`` and ``tan(pi/2)`` are refused.
@@ -36,8 +36,8 @@ from dataclasses import dataclass
 
 import sympy
 
-from phdesign.errors import ExpressionError
-from phdesign.limits import (
+from phdesign.core.errors import ExpressionError
+from phdesign.core.limits import (
     MAX_DEGREE,
     MAX_DEPTH,
     MAX_EXPONENT,
@@ -376,7 +376,7 @@ def check_expression(expr: sympy.Expr, what: str) -> sympy.Expr:
 
     The same checks apply to expressions a caller builds with sympy: finite and real,
     only the grammar's functions, exact numbers within ``MAX_NUMBER_BITS`` and a degree
-    within ``MAX_DEGREE`` (:mod:`phdesign.limits`).
+    within ``MAX_DEGREE`` (:mod:`phdesign.core.limits`).
 
     Raises
     ------
@@ -404,7 +404,7 @@ def check_expression(expr: sympy.Expr, what: str) -> sympy.Expr:
     if degree > MAX_DEGREE:
         raise ExpressionError(
             f"{what} has degree {degree} once built; expected at most "
-            f"{MAX_DEGREE} (the budget phdesign.limits.MAX_DEGREE)"
+            f"{MAX_DEGREE} (the budget phdesign.core.limits.MAX_DEGREE)"
         )
     return expr
 

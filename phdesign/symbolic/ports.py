@@ -55,8 +55,7 @@ from sympy.polys.constructor import construct_domain
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
-from phdesign.arguments import require_model
-from phdesign.errors import PortError
+from phdesign.core.errors import PortError
 from phdesign.symbolic.display import PortsDisplay
 from phdesign.symbolic.expressions import (
     Trace,
@@ -66,6 +65,7 @@ from phdesign.symbolic.expressions import (
     trace_symbol,
     vanishes,
 )
+from phdesign.symbolic.model import require_model
 
 
 class PortedSystem(Protocol):

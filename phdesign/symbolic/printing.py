@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import sympy
 from sympy.printing.str import StrPrinter
 
-from phdesign.errors import ExpressionError
+from phdesign.core.errors import ExpressionError
 from phdesign.symbolic.expressions import trace_of
 
 __all__ = ["format_expression", "format_number"]

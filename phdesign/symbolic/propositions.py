@@ -58,7 +58,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
-from phdesign.errors import ObserverError
+from phdesign.core.errors import ObserverError
 from phdesign.symbolic.expressions import Trace
 from phdesign.symbolic.ports import trace_index
 

@@ -55,8 +55,9 @@ from typing import Any
 
 import sympy
 
-from phdesign import limits
-from phdesign._display import (
+from phdesign.core import limits
+from phdesign.core.errors import ObserverError
+from phdesign.core.text import (
     REPR_LIMIT,
     html_table,
     kappa_text,
@@ -64,12 +65,10 @@ from phdesign._display import (
     number_text,
     shorten,
 )
-from phdesign.arguments import require_model
-from phdesign.errors import ObserverError
 from phdesign.symbolic.assumption import Partition, model_assumption
 from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.feedback import external_indices, plant_feedback
-from phdesign.symbolic.model import BCPHS
+from phdesign.symbolic.model import BCPHS, require_model
 from phdesign.symbolic.observer import gain_matrix, port_inverse
 from phdesign.symbolic.propositions import VERDICTS, Case, strength, variant_cases, verdict_of
 

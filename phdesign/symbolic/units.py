@@ -30,7 +30,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping, Sequence
 
-from phdesign.errors import ModelError
+from phdesign.core.errors import ModelError
 
 __all__ = ["MAX_UNIT_LENGTH", "RESERVED_QUANTITIES", "check_units", "with_unit"]
 

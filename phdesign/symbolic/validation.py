@@ -16,14 +16,14 @@ from typing import TYPE_CHECKING
 
 import sympy
 
-from phdesign.errors import (
+from phdesign.core.errors import (
     ArgumentError,
     ExpressionError,
     ModelError,
     ParameterError,
     check_shape,
 )
-from phdesign.limits import check_model_dimensions, check_parameter_count
+from phdesign.core.limits import check_model_dimensions, check_parameter_count
 from phdesign.symbolic.conjugate import conjugate_outputs
 from phdesign.symbolic.definiteness import check_definite
 from phdesign.symbolic.expressions import (

@@ -1,0 +1,383 @@
+r"""The observer-based loop as a design object: actuate, feed back the estimate, ask.
+
+.. math::
+
+    u_a = -K \hat y_a,\ K + K^\top \succ 0, \qquad
+    \hat u = u + C_m^\top L (y_m - \hat y_m), \qquad u_r = v \text{ (zero by default)} .
+
+A notebook user describes the loop once and asks it questions::
+
+    from phdesign.design.loop import Loop
+    loop = Loop(beam, actuate=3, feedback=1, sensors=[4], gain=1)
+    loop.classify()     # controlled plant, error system and loop verdicts (separation)
+    loop.spectrum()     # converged spectrum of the assembled loop, and of its two blocks
+    loop.simulate(x0="x1: 0, x2: z - 0.9", t_end=5)
+    loop.tune()         # K on the controlled plant, L on the error system
+    loop.statespace()   # control.StateSpace of plant + observer + feedback
+
+The mathematics is in :mod:`phdesign.symbolic.control` (certificates and the separation
+structure) and :mod:`phdesign.numeric.control.assembly` (the assembled loop).
+:meth:`Loop.from_parts`
+builds a loop from what an observer design holds (model, :math:`C_m`, :math:`L`,
+parameter overrides).
+
+Examples
+--------
+>>> from phdesign.models import load_builtin
+>>> loop = Loop(load_builtin("euler-bernoulli"), actuate=4, feedback=1, sensors=[2], gain=1)
+>>> loop.classify().verdict
+'exponential'
+>>> loop.actuate, loop.K, loop.source
+((4,), Matrix([[1]]), 'estimate')
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+import sympy
+
+from phdesign.core.errors import LoopError
+from phdesign.symbolic.control import (
+    FEEDBACK_SOURCES,
+    LoopClassification,
+    actuated_indices,
+    check_collocated,
+    check_measured,
+    classify_loop,
+    controlled_plant,
+    feedback_gain,
+)
+from phdesign.symbolic.model import BCPHS
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from phdesign.numeric.bridge import NumericModel
+    from phdesign.numeric.control.assembly import LoopSystem, NumericLoop
+    from phdesign.numeric.control.simulation import LoopSimulation
+    from phdesign.numeric.control.spectrum import LoopSpectrum
+    from phdesign.numeric.control.tuning import LoopTuneResult
+
+__all__ = ["Loop"]
+
+
+def _sensors(model: BCPHS, sensors: Any, C_m: Any) -> sympy.ImmutableMatrix:
+    """Read the observer's sensors with the library's one reader (as an Observer does)."""
+    from phdesign.symbolic.observer import measurement_matrix, sensor_matrix
+
+    if (sensors is None) == (C_m is None):
+        raise LoopError("give the observer's sensors (sensors=[4]) or C_m in full, not both")
+    if C_m is not None:
+        return measurement_matrix(C_m, model.n_ports)
+    return sensor_matrix(sensors, model.n_ports)
+
+
+@dataclass(frozen=True, init=False)
+class Loop:
+    r"""An observer-based boundary control loop (module docstring).
+
+    Parameters
+    ----------
+    model : BCPHS or Observer
+        The plant; or an :class:`~phdesign.design.observer.Observer`, whose model, sensors, gain,
+        parameters and discretization the loop takes (``phd.Loop(obs, actuate=3)``).
+    actuate : int or sequence of int
+        1-based indices into the model's external inputs.
+    feedback : number, sequence, matrix or text
+        :math:`K` (:func:`~phdesign.symbolic.control.feedback_gain`), default 1.
+    sensors : int or sequence of int, optional
+        The observer's measured outputs (1-based); or give ``C_m`` in full.
+    gain : number, sequence or matrix
+        The observer gain :math:`L` (default the identity), read as
+        :func:`~phdesign.symbolic.observer.gain_matrix` reads it.
+    C_m : matrix, optional
+    feedback_source : {"estimate", "measured"}
+        Feed back :math:`\hat y_a` (the loop) or the measured :math:`y_a` (to compare;
+        only where :math:`y_a` is measured).
+    feedback_outputs : int or sequence of int, optional
+        The outputs fed back; they must be the collocated ones (the default).
+    parameters : mapping, optional
+        Parameter overrides (applied to the model).
+    method : {"galerkin", "fd"}
+    resolution : int, optional
+        Discretization used by :meth:`simulate`, :meth:`statespace`, :meth:`assemble`, and
+        the first resolution of :meth:`spectrum`'s refinement (unless it is given one).
+    """
+
+    model: BCPHS
+    actuate: tuple[int, ...]
+    K: sympy.ImmutableMatrix
+    C_m: sympy.ImmutableMatrix
+    L: sympy.ImmutableMatrix
+    source: str
+    method: str
+    resolution: int | None
+
+    def __init__(
+        self,
+        model: Any,
+        actuate: int | Sequence[int],
+        feedback: Any = 1,
+        sensors: int | Sequence[int] | None = None,
+        gain: Any = 1,
+        *,
+        C_m: Any = None,
+        feedback_source: str = "estimate",
+        feedback_outputs: int | Sequence[int] | None = None,
+        parameters: Mapping[str, Any] | None = None,
+        method: str = "galerkin",
+        resolution: int | None = None,
+    ) -> None:
+        from phdesign.design.observer import Observer
+        from phdesign.symbolic.observer import ObserverDesign, gain_matrix
+
+        if isinstance(model, Observer):  # phd.Loop(observer, actuate=..., feedback=...)
+            observer = model
+            if sensors is not None or C_m is not None:
+                raise LoopError("the observer gives the sensors: drop sensors= and C_m=")
+            if observer.L is None:
+                raise LoopError("the observer has no gain yet: give one (or tune it) first")
+            model, C_m, gain = observer.model, observer.C_m, observer.L
+            parameters = {**observer.plant.parameters, **dict(parameters or {})}
+            method, resolution = observer.plant.method, observer.plant.resolution
+        if not isinstance(model, BCPHS):
+            raise LoopError(f"model must be a BCPHS; found {type(model).__name__}")
+        if parameters:
+            model = model.with_parameters({str(k): v for k, v in parameters.items()})
+        acts = actuated_indices(actuate, model)
+        check_collocated(acts, feedback_outputs, model)
+        if feedback_source not in FEEDBACK_SOURCES:
+            raise LoopError(
+                f"feedback_source must be one of {FEEDBACK_SOURCES}; found {feedback_source!r}"
+            )
+        if method not in ("galerkin", "fd"):
+            raise LoopError(f"method must be 'galerkin' or 'fd'; found {method!r}")
+        C = _sensors(model, sensors, C_m)
+        design = ObserverDesign(model, C, gain_matrix(gain, C.rows))  # checks C_m and L
+        if feedback_source == "measured":
+            check_measured(acts, design.C_m, model)
+        for name, value in (
+            ("model", model),
+            ("actuate", acts),
+            ("K", feedback_gain(feedback, len(acts))),
+            ("C_m", design.C_m),
+            ("L", design.L),
+            ("source", feedback_source),
+            ("method", method),
+            ("resolution", resolution),
+        ):
+            object.__setattr__(self, name, value)
+
+    @classmethod
+    def from_parts(
+        cls,
+        model: BCPHS,
+        C_m: Any,
+        L: Any,
+        *,
+        actuate: int | Sequence[int],
+        feedback: Any = 1,
+        feedback_source: str = "estimate",
+        feedback_outputs: int | Sequence[int] | None = None,
+        parameters: Mapping[str, Any] | None = None,
+        method: str = "galerkin",
+        resolution: int | None = None,
+    ) -> Loop:
+        """Build a loop from what an observer design holds: model, C_m, L, parameters."""
+        return cls(
+            model,
+            actuate,
+            feedback,
+            gain=L,
+            C_m=C_m,
+            feedback_source=feedback_source,
+            feedback_outputs=feedback_outputs,
+            parameters=parameters,
+            method=method,
+            resolution=resolution,
+        )
+
+    def with_gains(self, feedback: Any = None, gain: Any = None) -> Loop:
+        """Return the same loop with a new K and/or L (e.g. from :meth:`tune`)."""
+        return Loop.from_parts(
+            self.model,
+            self.C_m,
+            self.L if gain is None else gain,
+            actuate=self.actuate,
+            feedback=self.K if feedback is None else feedback,
+            feedback_source=self.source,
+            method=self.method,
+            resolution=self.resolution,
+        )
+
+    # ------------------------------------------------------------------ symbolic
+    def controlled_plant(self) -> BCPHS:
+        """Return the plant closed by :math:`u_a = -K y_a` (a BC-PHS, dissipative boundary)."""
+        return controlled_plant(self.model, self.actuate, self.K)
+
+    def classify(self, method: str = "auto") -> LoopClassification:
+        """Certificates: the controlled plant, the error system and the loop's verdict."""
+        return classify_loop(
+            self.model, self.actuate, self.K, self.C_m, self.L, self.source, method
+        )
+
+    # ------------------------------------------------------------------ numeric
+    @cached_property
+    def numeric_model(self) -> NumericModel:
+        """The plant through the bridge (parameters substituted)."""
+        from phdesign.numeric.bridge import to_numeric
+
+        return to_numeric(self.model)
+
+    @cached_property
+    def numeric(self) -> NumericLoop:
+        """The loop's numbers (0-based actuated ports, K, C_m, L as floats)."""
+        from phdesign.numeric.bridge import gain_to_numeric
+        from phdesign.numeric.control.assembly import NumericLoop
+
+        return NumericLoop(
+            tuple(a - 1 for a in self.actuate),
+            gain_to_numeric(self.K, "feedback K"),
+            gain_to_numeric(self.C_m, "C_m"),
+            gain_to_numeric(self.L, "L"),
+            self.source,
+        )
+
+    def design_label(self) -> str:
+        """``u3 = -K ŷ3, K = [[1]]; sensors [[0, 0, 0, 1]], L = [[1]]`` (for reports)."""
+        feed = "ŷ" if self.source == "estimate" else "y"
+        act = ",".join(f"u{a}" for a in self.actuate)
+        out = ",".join(f"{feed}{a}" for a in self.actuate)
+        return (
+            f"{act} = -K {out}, K = {self.K.tolist()}; C_m = {self.C_m.tolist()}, "
+            f"L = {self.L.tolist()}"
+        )
+
+    def spectrum(
+        self,
+        *,
+        tol: float | None = None,
+        count: int = 6,
+        resolution: int | None = None,
+        max_resolution: int | None = None,
+    ) -> LoopSpectrum:
+        """Return the loop's converged spectrum (:func:`.numeric.loop_spectrum.loop_spectrum`).
+
+        ``resolution`` defaults to the loop's own (its refinement's first resolution).
+        """
+        from phdesign.numeric.control.spectrum import loop_spectrum
+
+        return loop_spectrum(
+            self.numeric_model,
+            self.numeric,
+            method=self.method,
+            resolution=self.resolution if resolution is None else resolution,
+            max_resolution=max_resolution,
+            tol=tol,
+            count=count,
+            design=self.design_label(),
+        )
+
+    def simulate(
+        self,
+        *,
+        x0: str | Callable[[Any], Any] | None = None,
+        xhat0: str | Callable[[Any], Any] | None = None,
+        u: str | Callable[[float], Any] | None = None,
+        t_end: float = 5.0,
+        samples: int = 501,
+        scheme: str = "expm",
+    ) -> LoopSimulation:
+        """Simulate the loop (:func:`~phdesign.numeric.control.simulation.simulate_loop`).
+
+        ``x0``, ``xhat0`` and ``u`` may be text (``"x1: 0, x2: z - 0.9"``,
+        ``"u1: sin(t)"``), read as on the command line, or callables.
+        """
+        from phdesign.numeric.control.simulation import simulate_loop
+        from phdesign.numeric.inputs import initial_state_function, input_function
+
+        nm = self.numeric_model
+
+        def state(value: Any) -> Any:
+            return (
+                initial_state_function(value, nm, model=self.model)
+                if (value is None or isinstance(value, str))
+                else value
+            )
+
+        inputs = (
+            input_function(u, nm, model=self.model) if (u is None or isinstance(u, str)) else u
+        )
+        return simulate_loop(
+            nm,
+            self.numeric,
+            x0=state(x0),
+            xhat0=state(xhat0),
+            u=inputs,
+            t_end=t_end,
+            samples=samples,
+            method=self.method,
+            resolution=self.resolution,
+            scheme=scheme,
+        )
+
+    def tune(
+        self, target: str = "both", *, full: bool = False, starts: int = 6, seed: int = 0
+    ) -> LoopTuneResult:
+        """Tune K, L or both on the loop's converged abscissa, by separation.
+
+        ``loop.with_gains(result.loop.K, result.loop.L)`` is the tuned loop.
+        """
+        from phdesign.numeric.control.tuning import tune_loop
+
+        return tune_loop(
+            self.numeric_model, self.numeric, target=target, full=full, starts=starts, seed=seed
+        )
+
+    def assemble(self) -> LoopSystem:
+        """Return the assembled loop matrices (:mod:`phdesign.numeric.control.assembly`)."""
+        from phdesign.numeric.control.assembly import assemble
+        from phdesign.numeric.discretization.registry import discretize
+
+        return assemble(discretize(self.numeric_model, self.method, self.resolution), self.numeric)
+
+    def statespace(self, name: str = "loop") -> Any:
+        """Export the loop as ``control.StateSpace`` (:func:`.numeric.loop.loop_statespace`)."""
+        from phdesign.numeric.control.assembly import loop_statespace
+
+        return loop_statespace(self.assemble(), name)
+
+    # ------------------------------------------------------------------ printing
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready description of the design (exact entries as text)."""
+        return {
+            "model": self.model.name,
+            "actuate": list(self.actuate),
+            "feedback": [[str(x) for x in row] for row in self.K.tolist()],
+            "sensors": [[str(x) for x in row] for row in self.C_m.tolist()],
+            "gain": [[str(x) for x in row] for row in self.L.tolist()],
+            "feedback_source": self.source,
+            "method": self.method,
+            "resolution": self.resolution,
+        }
+
+    def __repr__(self) -> str:
+        return (
+            f"Loop(model={self.model.name!r}, actuate={self.actuate}, "
+            f"feedback={self.K.tolist()}, sensors={self.C_m.tolist()}, gain={self.L.tolist()}, "
+            f"source={self.source!r})"
+        )[:300]
+
+    def __str__(self) -> str:
+        return f"loop on {self.model.name}: {self.design_label()} ({self.source})"
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        rows = "".join(
+            f"<tr><td>{escape(k)}</td><td>{escape(str(v))}</td></tr>"
+            for k, v in self.to_dict().items()
+        )
+        return f"<table><caption>observer-based loop</caption>{rows}</table>"

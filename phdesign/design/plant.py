@@ -1,0 +1,222 @@
+r"""The numeric plumbing of a design: a model, its parameter overrides, its discretization.
+
+:class:`Plant` is the model with its parameter overrides and discretization options, and
+the numeric model it caches (the bridge runs once per plant).  Designs built on a plant
+(:class:`~phdesign.design.observer.Observer`, an observer-based loop) share it.
+:func:`numeric_matrix` turns an exact :math:`C_m` or :math:`L` into floats, refusing
+symbols with a message that says what to do.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+import sympy
+
+from phdesign.core.checks import DISCRETIZATION_METHODS, choice, positive_int
+from phdesign.core.errors import ArgumentError, ObserverError, ParameterError
+from phdesign.core.text import REPR_LIMIT, matrix_text, shorten
+from phdesign.symbolic.model import BCPHS, require_model
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    import numpy as np
+
+    from phdesign.numeric.bridge import NumericModel
+    from phdesign.numeric.discretization.phs import DiscretePHS
+    from phdesign.numeric.spectrum.converged import SpectrumReport
+    from phdesign.numeric.time.simulation import SimulationResult
+
+__all__ = ["Plant", "numeric_matrix"]
+
+
+def numeric_matrix(M: sympy.MatrixBase, name: str, what: str) -> np.ndarray:
+    """Return an exact numeric matrix as floats; refuse symbols, saying what to do.
+
+    Parameters
+    ----------
+    M : sympy matrix
+        :math:`C_m` or :math:`L`.
+    name : str
+        Its name in messages.
+    what : str
+        The numeric computation that needs it (``"spectrum"``, ``"simulate"``).
+    """
+    import numpy as np
+
+    if M.free_symbols:
+        names = ", ".join(sorted(map(str, M.free_symbols)))
+        raise ObserverError(
+            f"{what} needs numbers for {name}; {name} = {matrix_text(M)} is symbolic ({names}): "
+            "give numbers (the gain [0.1, 1], or --gain 0.1,1 on the command line) or tune "
+            "one; symbolic gains are for classify, which answers for all their positive values"
+        )
+    return np.array(M.evalf(17).tolist(), dtype=float)
+
+
+@dataclass(frozen=True, repr=False)
+class Plant:
+    """A model with its parameter overrides and discretization: the numeric plumbing.
+
+    Parameters
+    ----------
+    model : BCPHS
+        The symbolic model (:func:`phdesign.load`).
+    parameters : mapping of str to number, optional
+        Overrides of the model's parameter defaults (``{"d": 0.5}``), used by the
+        classification and by the numbers alike.
+    method : {"galerkin", "fd"}
+        Discretization (:func:`phdesign.numeric.discretization.registry.discretize`).
+    resolution : int, optional
+        Degree or nodes per group; for spectra, the first resolution of the refinement.
+
+    Examples
+    --------
+    >>> from phdesign.models import load_builtin
+    >>> plant = Plant(load_builtin("euler-bernoulli"), parameters={"d": 0.5})
+    >>> plant.numeric.parameters["d"]
+    0.5
+    >>> round(plant.spectrum().spectral_abscissa, 10)  # every mode has Re λ = -d/2
+    -0.25
+    """
+
+    model: BCPHS
+    parameters: Mapping[str, Any] = field(default_factory=dict, hash=False)
+    method: str = "galerkin"
+    resolution: int | None = None
+
+    def __post_init__(self) -> None:
+        require_model(self.model)
+        if not isinstance(self.parameters, Mapping):
+            raise ParameterError(
+                "parameters must be a mapping of names to values such as {'d': 0.5}; found "
+                f"{type(self.parameters).__name__}"
+            )
+        choice(self.method, "method", DISCRETIZATION_METHODS)
+        if self.resolution is not None:
+            positive_int(self.resolution, "resolution")
+        object.__setattr__(self, "parameters", dict(self.parameters))
+        self.design_model  # noqa: B018 - checks the overrides now, not at first use
+
+    @cached_property
+    def design_model(self) -> BCPHS:
+        """The model with the parameter overrides as its defaults."""
+        return self.model.with_parameters(self.parameters) if self.parameters else self.model
+
+    @cached_property
+    def numeric(self) -> NumericModel:
+        """The numeric model (parameters substituted), made once."""
+        from phdesign.numeric.bridge import to_numeric
+
+        return to_numeric(self.model, self.parameters or None)
+
+    def discrete(self, resolution: int | None = None) -> DiscretePHS:
+        """Return the discretized plant at ``resolution`` (default: the plant's)."""
+        from phdesign.numeric.discretization.registry import discretize
+
+        return discretize(self.numeric, self.method, resolution or self.resolution)
+
+    def initial_state(self, x0: str | Callable[[Any], Any] | None, name: str) -> Any:
+        """Return an initial state as a function of z (text ``"x1: z - 0.9"`` is parsed)."""
+        if x0 is None or callable(x0):
+            return x0
+        if not isinstance(x0, str):
+            raise ArgumentError(
+                f"{name} must be text such as 'x1: 0, x2: z - 0.9' or a function of z; "
+                f"found {type(x0).__name__}"
+            )
+        from phdesign.numeric.inputs import initial_state_function
+
+        return initial_state_function(x0, self.numeric)
+
+    def spectrum(
+        self, *, max_resolution: int | None = None, tol: float | None = None, count: int = 6
+    ) -> SpectrumReport:
+        """Return the converged spectrum of the plant with u = 0."""
+        return self.closed_spectrum(
+            None, None, max_resolution=max_resolution, tol=tol, count=count
+        )
+
+    def closed_spectrum(
+        self,
+        C_m: np.ndarray | None,
+        L: np.ndarray | None,
+        *,
+        max_resolution: int | None = None,
+        tol: float | None = None,
+        count: int = 6,
+    ) -> SpectrumReport:
+        r"""Return the converged spectrum with :math:`u = -C_m^\top L C_m y` (u = 0 without)."""
+        from phdesign.numeric.spectrum.converged import spectrum
+
+        return spectrum(
+            self.numeric,
+            C_m,
+            L,
+            method=self.method,
+            resolution=self.resolution,
+            max_resolution=max_resolution,
+            tol=tol,
+            count=count,
+        )
+
+    def simulate(
+        self,
+        x0: str | Callable[[Any], Any] | None = None,
+        *,
+        t_end: float = 5.0,
+        samples: int = 501,
+        u: Callable[[float], Any] | None = None,
+        scheme: str = "expm",
+        tol: float = 1e-6,
+    ) -> SimulationResult:
+        """Simulate the plant alone from ``x0`` (text or a function of z; zero by default).
+
+        ``tol`` bounds the error of ``scheme="midpoint"`` (its substeps are chosen to meet
+        it; :func:`phdesign.numeric.time.simulation.simulate`).
+        """
+        return self.run(None, None, x0, t_end=t_end, samples=samples, u=u, scheme=scheme, tol=tol)
+
+    def run(
+        self,
+        C_m: np.ndarray | None,
+        L: np.ndarray | None,
+        x0: str | Callable[[Any], Any] | None = None,
+        *,
+        xhat0: str | Callable[[Any], Any] | None = None,
+        labels: Mapping[str, str] | None = None,
+        **options: Any,
+    ) -> SimulationResult:
+        """Simulate the plant, with the observer of ``(C_m, L)`` when given.
+
+        ``options`` are those of :func:`phdesign.numeric.time.simulation.simulate` (``t_end``,
+        ``samples``, ``u``, ``scheme``, ``z_w``), checked there; ``labels`` name the design
+        in the result (presentation only: the plots' titles and the JSON).
+        """
+        from phdesign.numeric.time.simulation import simulate
+
+        result = simulate(
+            self.numeric,
+            C_m,
+            L,
+            x0=self.initial_state(x0, "x0"),
+            xhat0=self.initial_state(xhat0, "xhat0"),
+            method=self.method,
+            resolution=self.resolution,
+            **options,
+        )
+        return self.labelled(result, **(labels or {}))
+
+    def labelled(self, result: SimulationResult, **labels: str) -> SimulationResult:
+        """Return the result with the model's name (and the design's ``labels``) in its ``info``.
+
+        Presentation only: the plots' titles and the JSON name what was simulated.
+        """
+        return replace(result, info={**result.info, "model": self.model.name, **labels})
+
+    def __repr__(self) -> str:
+        extra = f", parameters={self.parameters}" if self.parameters else ""
+        text = f"Plant(model={self.model.name!r}{extra}, method={self.method!r})"
+        return shorten(text, REPR_LIMIT)

@@ -1,0 +1,1 @@
+"""Observer-based boundary control: the assembled loop, its spectrum, simulation and tuning."""

@@ -1,0 +1,1 @@
+"""Structure-preserving discretizations: the port-Hamiltonian result type and its methods."""

@@ -1,0 +1,207 @@
+r"""Performance outputs: linear functionals of the state whose estimation error is scored.
+
+A performance output is a linear functional :math:`z = c(x)` of the state; the noise
+figures report the steady-state variance of its estimation error
+:math:`\tilde z = c(x) - c(\hat x) = c(\tilde x)`.  Three kinds:
+
+``"w(z0)"`` (:func:`displacement_at`)
+    The model's physical displacement at a point (the beam's deflection
+    :math:`w(z_0) = \int_a^{z_0} (z_0 - s)\, x_2(s)\, ds`, two integrations of the
+    curvature from the clamped end); needs a model that defines one.
+``"e1(1)"``, ``"(e1(0) - e2(0))/sqrt(2)"`` (:func:`trace_functional`)
+    A combination of boundary traces of the efforts, in the model-file syntax.
+``"x2: sin(pi*z)"`` (:func:`integral_functional`)
+    :math:`\int_a^b \sum_i w_i(z)\, x_i(z)\, dz` for weights given per state component,
+    in the initial-state syntax (``"x1: 1, x2: z"`` weighs two components).
+
+On a discretization each becomes a row ``c`` with :math:`z = c\, \hat e`
+(:meth:`Functional.row`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.polynomial import legendre as leg
+
+from phdesign.core.errors import NumericError, ParameterError
+from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.discretization.phs import DiscretePHS
+from phdesign.numeric.inputs import initial_state_function, trace_row
+
+__all__ = [
+    "Functional",
+    "default_performance",
+    "displacement_at",
+    "integral_functional",
+    "parse_functional",
+    "parse_functionals",
+    "trace_functional",
+]
+
+_DISPLACEMENT = re.compile(r"\s*w\s*\((?P<point>[^()]*)\)\s*\Z")
+
+
+@dataclass(frozen=True)
+class Functional:
+    """A named linear functional of the state (see the module docstring).
+
+    Attributes
+    ----------
+    name : str
+        How reports name it: ``"w(1)"``, ``"e1(1)"``, ``"int(x2: sin(pi*z))"``.
+    kind : {"displacement", "trace", "integral"}
+    point : float or None
+        The point of a displacement.
+    trace : ndarray or None
+        The row over the trace vector v of a trace combination.
+    weight : callable or None
+        ``weight(z) -> (m, n)`` of an integral (weights on the state components).
+    """
+
+    name: str
+    kind: str
+    point: float | None = None
+    trace: np.ndarray | None = field(default=None, compare=False, repr=False)
+    weight: Callable[[np.ndarray], np.ndarray] | None = field(
+        default=None, compare=False, repr=False
+    )
+
+    def row(self, d: DiscretePHS) -> np.ndarray:
+        """Return ``c`` with the functional equal to ``c @ ê`` on the discretization ``d``."""
+        if self.kind == "displacement":
+            if d.displacement_basis is None:
+                raise NumericError(
+                    f"{self.name}: the model {d.model.name!r} defines no displacement; "
+                    "give a trace or an integral of a state component instead"
+                )
+            return np.asarray(d.displacement_basis(np.array([self.point]))[0], dtype=float)
+        if self.kind == "trace":
+            T = d.info.get("T")
+            if T is None or self.trace is None:
+                raise NumericError(
+                    f"{self.name}: boundary traces need the trace map of the Galerkin "
+                    f"discretization; the {d.method!r} method has none (use galerkin)"
+                )
+            return np.asarray(self.trace @ T, dtype=float)
+        if self.kind == "integral" and self.weight is not None:
+            return _integral_row(d, self.weight)
+        raise NumericError(f"unknown kind of functional {self.kind!r}")  # pragma: no cover
+
+
+def displacement_at(nm: NumericModel, point: float | str) -> Functional:
+    """Return the displacement ``w(point)`` of a model that defines one.
+
+    Raises
+    ------
+    NumericError
+        The model defines no displacement, or the point is not a number of [a, b].
+    """
+    a, b = nm.interval
+    text = str(point).strip()
+    value = {"a": a, "b": b}.get(text)
+    if value is None:
+        try:
+            value = float(text)
+        except ValueError:
+            raise NumericError(
+                f"displacement point: expected a number in [{a:g}, {b:g}]; found {text!r}"
+            ) from None
+    if not math.isfinite(value) or not a <= value <= b:
+        raise NumericError(
+            f"displacement point {text} is outside the interval [{a:g}, {b:g}]; "
+            "expected a point of it"
+        )
+    if nm.displacement is None:
+        raise NumericError(
+            f"w({text}): the model {nm.name!r} defines no displacement; give a boundary "
+            "trace (e.g. e1(1)) or an integral of a state component (e.g. 'x2: 1') instead"
+        )
+    return Functional(f"w({value:g})", "displacement", point=value)
+
+
+def trace_functional(nm: NumericModel, text: str, model: Any = None) -> Functional:
+    """Return a combination of boundary traces, e.g. ``"e1(1)"`` (parsed by the bridge)."""
+    return Functional(" ".join(str(text).split()), "trace", trace=trace_row(text, nm, model))
+
+
+def integral_functional(nm: NumericModel, text: str, model: Any = None) -> Functional:
+    """Return the integral of state components against weights, e.g. ``"x2: sin(pi*z)"``."""
+    key = str(text).split(":", 1)[0].strip()
+    efforts = {f"e{i + 1}" for i in range(nm.size)}
+    if key in efforts:
+        raise ParameterError(
+            f"integral {text!r}: {key!r} is an effort; weigh state components "
+            f"({', '.join(f'x{i + 1}' for i in range(nm.size))} or the model's state names)"
+        )
+    weight = initial_state_function(text, nm, model=model, what="integral weight")
+    return Functional(f"int({' '.join(str(text).split())})", "integral", weight=weight)
+
+
+def parse_functional(text: str, nm: NumericModel, model: Any = None) -> Functional:
+    """Read a performance output from text: ``"w(1)"``, a trace, or ``"x2: weight"``.
+
+    Examples
+    --------
+    >>> from phdesign.models import load_builtin
+    >>> from phdesign.numeric.bridge import to_numeric
+    >>> beam = load_builtin("euler-bernoulli")
+    >>> [parse_functional(t, to_numeric(beam), beam).name for t in ("w(1)", "e1(1)", "x2: 1")]
+    ['w(1)', 'e1(1)', 'int(x2: 1)']
+    """
+    if not isinstance(text, str) or not text.strip():
+        raise NumericError(f"performance output: expected text like 'w(1)'; found {text!r}")
+    match = _DISPLACEMENT.match(text)
+    if match:
+        return displacement_at(nm, match.group("point"))
+    if ":" in text:
+        return integral_functional(nm, text, model)
+    return trace_functional(nm, text, model)
+
+
+def parse_functionals(
+    items: Sequence[Functional | str] | None, nm: NumericModel, model: Any = None
+) -> tuple[Functional, ...]:
+    """Read a list of performance outputs; ``None`` gives :func:`default_performance`."""
+    if items is None:
+        return default_performance(nm)
+    if isinstance(items, (str, Functional)) or not isinstance(items, Iterable):
+        items = [items]  # one output; a non-text one is refused by parse_functional
+    out = tuple(
+        item if isinstance(item, Functional) else parse_functional(item, nm, model)
+        for item in items
+    )
+    names = [f.name for f in out]
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
+        raise NumericError(f"performance outputs: {', '.join(repeated)} given twice")
+    return out
+
+
+def default_performance(nm: NumericModel) -> tuple[Functional, ...]:
+    """Return the displacement at b when the model defines one, else no output."""
+    if nm.displacement is None:
+        return ()
+    return (displacement_at(nm, "b"),)
+
+
+def _integral_row(d: DiscretePHS, weight: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    r"""Row of :math:`\int \sum_i w_i x_i \, dz` with :math:`x = \mathcal H^{-1} e`, by Gauss.
+
+    The rule has enough points to be exact for a polynomial weight against the Galerkin
+    efforts (degree p) when H is constant; for a smooth weight it converges spectrally.
+    """
+    a, b = d.model.interval
+    nq = max(64, 2 * d.dim)
+    t, wq = leg.leggauss(nq)
+    z = 0.5 * (a + b) + 0.5 * (b - a) * t
+    wq = 0.5 * (b - a) * wq
+    W = np.asarray(weight(z), dtype=float).reshape(z.size, d.model.size)
+    Hinv_W = np.linalg.solve(d.model.H_at(z), W[:, :, None])[:, :, 0]  # H symmetric
+    basis = d.effort_basis(z)  # (nq, n, dim)
+    return np.einsum("q,qi,qid->d", wq, Hinv_W, basis)

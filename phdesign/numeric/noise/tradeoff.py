@@ -1,0 +1,415 @@
+r"""The speed/noise trade-off of an observer gain: decay rate against error RMS.
+
+A larger gain L damps the error faster (up to a coalescence, beyond which the boundary
+damper over-damps and the decay slows again) but feeds more sensor noise into the
+estimate.  :func:`tradeoff` evaluates, for a family of gains, the converged spectral
+abscissa α of the error system (:func:`phdesign.numeric.spectrum.converged.spectrum`; the decay
+rate is −α) and the noise figures (:func:`phdesign.numeric.noise.figures.noise`), and marks the
+Pareto-optimal gains: those that no other gain of the family beats in both the decay
+rate and the RMS of the first performance output.
+
+Families: a ray :math:`L(s) = s L_0` with log-spaced scales s, or a grid of diagonal
+gains (every combination of per-sensor values).  Only figures that converged under
+refinement take part in the Pareto comparison; the others are listed and flagged.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from itertools import product
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from phdesign.core.errors import NumericError
+from phdesign.core.limits import check_tradeoff_gains
+from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.discretization.functionals import Functional, parse_functionals
+from phdesign.numeric.discretization.registry import DiscretePHS, feedback_matrix
+from phdesign.numeric.noise.figures import noise, sensor_rows
+from phdesign.numeric.noise.report import NoiseReport, describe_gain, describe_sensors, html_table
+from phdesign.numeric.noise.settle import finite_or_none
+from phdesign.numeric.spectrum.converged import spectrum
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from matplotlib.figure import Figure
+
+__all__ = ["Tradeoff", "TradeoffPoint", "gain_family", "pareto_mask", "tradeoff"]
+
+
+@dataclass(frozen=True)
+class TradeoffPoint:
+    """One gain of a trade-off: its decay and its noise figures.
+
+    Attributes
+    ----------
+    gain : ndarray
+    scale : float or None
+        s of a ray ``s L_0`` (None on a grid).
+    spectral_abscissa : float or None
+        Converged abscissa of the error system (None when unbounded below).
+    abscissa_converged : bool
+    abscissa_digits : float or None
+    noise : NoiseReport
+    pareto : bool
+        No other point has both a faster decay and a smaller error RMS.
+    """
+
+    gain: np.ndarray
+    scale: float | None
+    spectral_abscissa: float | None
+    abscissa_converged: bool
+    abscissa_digits: float | None
+    noise: NoiseReport
+    pareto: bool = False
+
+    @property
+    def decay_rate(self) -> float | None:
+        """−α, the exponential decay rate of the estimation error."""
+        return None if self.spectral_abscissa is None else -self.spectral_abscissa
+
+    @property
+    def rms(self) -> float | None:
+        """RMS of the first performance output's error (None unless converged)."""
+        return self.noise.rms()
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready row of the table."""
+        g = self.noise.l2_gain
+        return {
+            "gain": self.gain.tolist(),
+            "scale": self.scale,
+            "spectral_abscissa": finite_or_none(self.spectral_abscissa),
+            "abscissa_converged": self.abscissa_converged,
+            "abscissa_digits": finite_or_none(self.abscissa_digits),
+            "decay_rate": finite_or_none(self.decay_rate),
+            "rms": {
+                e.name: None if e.value is None else math.sqrt(e.value)
+                for e in self.noise.performance
+            },
+            "rms_converged": {e.name: e.converged for e in self.noise.performance},
+            "l2_gain": finite_or_none(g.value),
+            "l2_gain_converged": g.converged,
+            "error_energy_diverges": self.noise.error_energy.diverges,
+            "pareto": self.pareto,
+        }
+
+
+@dataclass(frozen=True)
+class Tradeoff:
+    """Result of :func:`tradeoff`: one row per gain, Pareto-optimal rows marked.
+
+    Attributes
+    ----------
+    model : str
+    sensors : ndarray
+    family : str
+        ``"ray"`` or ``"grid"``.
+    direction : ndarray or None
+        L₀ of a ray.
+    points : tuple of TradeoffPoint
+    performance : str
+        The performance output whose RMS is traded against the decay rate.
+    intensity : tuple of float
+    output_labels : tuple of str
+    """
+
+    model: str
+    sensors: np.ndarray
+    family: str
+    direction: np.ndarray | None
+    points: tuple[TradeoffPoint, ...]
+    performance: str
+    intensity: tuple[float, ...]
+    output_labels: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = field(default=())
+
+    @property
+    def pareto_points(self) -> tuple[TradeoffPoint, ...]:
+        """The Pareto-optimal points, by increasing RMS."""
+        best = [p for p in self.points if p.pareto]
+        return tuple(sorted(best, key=lambda p: p.rms if p.rms is not None else math.inf))
+
+    def _columns(self) -> list[str]:
+        q = self.sensors.shape[0]
+        gains = [f"l{i + 1}" for i in range(q)]
+        names = [e.name for e in self.points[0].noise.performance] if self.points else []
+        return [
+            *gains,
+            "scale",
+            "spectral_abscissa",
+            "abscissa_converged",
+            "decay_rate",
+            *[f"rms {n}" for n in names],
+            *[f"rms {n} converged" for n in names],
+            "l2_gain",
+            "l2_gain_converged",
+            "pareto",
+        ]
+
+    def _row(self, p: TradeoffPoint) -> list[Any]:
+        d = p.to_dict()
+        diag = np.diag(p.gain).tolist()
+        return [
+            *diag,
+            d["scale"],
+            d["spectral_abscissa"],
+            d["abscissa_converged"],
+            d["decay_rate"],
+            *d["rms"].values(),
+            *d["rms_converged"].values(),
+            d["l2_gain"],
+            d["l2_gain_converged"],
+            d["pareto"],
+        ]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary (``phdesign tradeoff --json``)."""
+        return {
+            "model": self.model,
+            "sensors": self.sensors.tolist(),
+            "family": self.family,
+            "direction": None if self.direction is None else self.direction.tolist(),
+            "performance": self.performance,
+            "intensity": list(self.intensity),
+            "points": [p.to_dict() for p in self.points],
+            "pareto": [i for i, p in enumerate(self.points) if p.pareto],
+            "warnings": list(self.warnings),
+        }
+
+    def to_csv(self) -> str:
+        """Return the table as CSV (empty cells: figures that did not converge)."""
+        buf = io.StringIO()
+        writer = csv.writer(buf, lineterminator="\n")
+        writer.writerow(self._columns())
+        for p in self.points:
+            writer.writerow(["" if v is None else v for v in self._row(p)])
+        return buf.getvalue()
+
+    def __str__(self) -> str:
+        sensors = describe_sensors(self.sensors, self.output_labels)
+        intensity = ", ".join(f"{s:g}" for s in self.intensity)
+        head = f"model: {self.model}   sensors: {sensors}   sensor noise intensity {intensity}"
+        lines = [
+            head,
+            f"decay rate -α against the error RMS of {self.performance} ({self.family}):",
+        ]
+        lines.append(f"  {'gain L':<28} {'-α':>10} {'rms':>12} {'L2-gain':>10}  Pareto")
+        for p in self.points:
+            rate = (
+                "—"
+                if p.decay_rate is None
+                else f"{p.decay_rate:.6g}" + ("" if p.abscissa_converged else "*")
+            )
+            rms = "—" if p.rms is None else f"{p.rms:.6g}"
+            gain = "—" if p.noise.l2_gain.value is None else f"{p.noise.l2_gain.value:.5g}"
+            mark = "  *" if p.pareto else ""
+            lines.append(f"  {describe_gain(p.gain):<28} {rate:>10} {rms:>12} {gain:>10}{mark}")
+        lines.append(
+            "(* after -α: the abscissa did not converge to 1e-10, e.g. at a coalescence; "
+            "— : the figure did not converge or diverges)"
+        )
+        lines += [f"warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        return (
+            f"Tradeoff(model={self.model!r}, {self.family} of {len(self.points)} gains, "
+            f"{len(self.pareto_points)} Pareto-optimal, performance={self.performance!r})"
+        )
+
+    def _repr_html_(self) -> str:
+        rows = [
+            (
+                describe_gain(p.gain),
+                "—" if p.decay_rate is None else f"{p.decay_rate:.6g}",
+                "—" if p.rms is None else f"{p.rms:.6g}",
+                "—" if p.noise.l2_gain.value is None else f"{p.noise.l2_gain.value:.5g}",
+                "yes" if p.pareto else "",
+            )
+            for p in self.points
+        ]
+        return html_table(
+            ("gain L", "decay rate −α", f"rms {self.performance}", "L2-gain", "Pareto"),
+            rows,
+            repr(self),
+        )
+
+    def plot(self, path: Any = None, *, force: bool = False, annotate: str = "pareto") -> Figure:
+        """Decay rate against error RMS, Pareto front drawn and gains annotated."""
+        from phdesign.plots.noise import plot_tradeoff
+
+        return plot_tradeoff(self, path, force=force, annotate=annotate)
+
+
+def pareto_mask(
+    decay: Sequence[float | None],
+    rms: Sequence[float | None],
+    decay_tol: float = 1e-8,
+    rms_tol: float = 1e-6,
+) -> list[bool]:
+    """Mark the points no other point beats in both (larger decay, smaller rms).
+
+    Values closer than the relative tolerances (the figures' own accuracy under
+    refinement) count as equal: a gain is not Pareto-optimal for a decay rate that beats
+    another's by round-off.  Points with a missing figure are never Pareto-optimal.
+
+    Examples
+    --------
+    >>> pareto_mask([1.0, 2.0, 1.5, None, 1.0 + 1e-12], [0.1, 0.3, 0.4, 0.0, 0.2])
+    [True, True, False, False, False]
+    """
+    pts = [(d, r) for d, r in zip(decay, rms, strict=True)]
+
+    def beats(a: tuple[float, float], b: tuple[float, float]) -> bool:
+        td = decay_tol * max(1.0, abs(b[0]))
+        tr = rms_tol * abs(b[1])
+        no_worse = a[0] >= b[0] - td and a[1] <= b[1] + tr
+        return no_worse and (a[0] > b[0] + td or a[1] < b[1] - tr)
+
+    known = [(d, r) for d, r in pts if d is not None and r is not None]
+    return [
+        d is not None and r is not None and not any(beats(o, (d, r)) for o in known)
+        for d, r in pts
+    ]
+
+
+def gain_family(
+    q: int,
+    *,
+    direction: Any = None,
+    scales: Sequence[float] | None = None,
+    grid: Sequence[Sequence[float]] | None = None,
+) -> tuple[list[np.ndarray], list[float | None], np.ndarray | None]:
+    """Return the gains of a ray ``s L_0`` or of a diagonal grid, their scales, and L₀."""
+    if grid is not None:
+        if direction is not None or scales is not None:
+            raise NumericError("give either a grid of gains or a ray (direction and scales)")
+        if isinstance(grid, str) or not isinstance(grid, Sequence | np.ndarray):
+            raise NumericError(f"grid: expected one sequence of gains per sensor; found {grid!r}")
+        axes = [np.atleast_1d(_floats(a, f"grid axis {i + 1}")) for i, a in enumerate(grid)]
+        if len(axes) != q:
+            raise NumericError(f"grid: expected {q} axes (one per sensor); found {len(axes)}")
+        for i, a in enumerate(axes):
+            if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a <= 0):
+                raise NumericError(
+                    f"grid axis {i + 1}: expected positive finite gains; found {a.tolist()}"
+                )
+        check_tradeoff_gains(math.prod(a.size for a in axes), "grid")  # before building them
+        gains = [np.diag(np.array(c)) for c in product(*axes)]
+        return gains, [None] * len(gains), None
+    L0 = np.eye(q) if direction is None else _floats(direction, "direction")
+    if L0.ndim == 1:
+        L0 = np.diag(np.broadcast_to(L0, (q,)) if L0.size == 1 else L0)
+    s = np.geomspace(0.1, 10.0, 12) if scales is None else _floats(scales, "scales").ravel()
+    check_tradeoff_gains(s.size, "scales")
+    if s.size == 0 or not np.all(np.isfinite(s)) or np.any(s <= 0):
+        raise NumericError(f"scales: expected positive finite numbers; found {s.tolist()}")
+    return [float(v) * L0 for v in s], [float(v) for v in s], L0
+
+
+def _floats(values: Any, name: str) -> np.ndarray:
+    """``values`` as a float array, or a :class:`NumericError` naming ``name``."""
+    try:
+        return np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise NumericError(f"{name}: expected numbers; found {values!r}") from None
+
+
+def tradeoff(
+    nm: NumericModel,
+    C_m: np.ndarray,
+    *,
+    direction: Any = None,
+    scales: Sequence[float] | None = None,
+    grid: Sequence[Sequence[float]] | None = None,
+    intensity: Any = None,
+    input_intensity: Any = None,
+    performance: Sequence[Functional | str] | None = None,
+    model: Any = None,
+    method: str = "galerkin",
+) -> Tradeoff:
+    """Decay rate and noise figures over a family of gains, Pareto-optimal gains marked.
+
+    Parameters
+    ----------
+    nm : NumericModel
+    C_m : ndarray (q, N n)
+    direction : array-like, optional
+        L₀ of the ray ``s L_0``: q diagonal entries or a q × q matrix (default identity).
+    scales : sequence of float, optional
+        The scales s (default 12 log-spaced values from 0.1 to 10).
+    grid : sequence of q sequences of float, optional
+        Per-sensor gain values; every combination is a diagonal gain (instead of a ray).
+    intensity, input_intensity, performance, model, method
+        As for :func:`phdesign.numeric.noise.figures.noise`; the first performance output is the
+        one traded against the decay rate.
+
+    Returns
+    -------
+    Tradeoff
+    """
+    C = sensor_rows(C_m, "a trade-off")
+    q = C.shape[0]
+    functionals = parse_functionals(performance, nm, model)
+    if not functionals:
+        raise NumericError(
+            f"the trade-off needs a performance output and the model {nm.name!r} defines no "
+            "displacement: give one (a point w(z) of a displacement, a trace like e1(1), or "
+            "an integral like 'x2: 1')"
+        )
+    gains, scale_list, L0 = gain_family(q, direction=direction, scales=scales, grid=grid)
+    for L in gains:
+        feedback_matrix(C, L, nm.n_ports)  # every gain valid before any work
+    cache: dict[int, DiscretePHS] = {}
+    rows = []
+    for L, s in zip(gains, scale_list, strict=True):
+        spec = spectrum(nm, C, L, method=method)
+        rep = noise(
+            nm,
+            C,
+            L,
+            intensity=intensity,
+            input_intensity=input_intensity,
+            performance=functionals,
+            method=method,
+            discretizations=cache,
+        )
+        rows.append((L, s, spec, rep))
+    decay = [None if r[2].spectral_abscissa is None else -r[2].spectral_abscissa for r in rows]
+    rms = [r[3].rms() for r in rows]
+    mask = pareto_mask(decay, rms)
+    points = tuple(
+        TradeoffPoint(
+            gain=L,
+            scale=s,
+            spectral_abscissa=spec.spectral_abscissa,
+            abscissa_converged=spec.converged,
+            abscissa_digits=spec.digits,
+            noise=rep,
+            pareto=m,
+        )
+        for (L, s, spec, rep), m in zip(rows, mask, strict=True)
+    )
+    warnings = []
+    missing = sum(1 for r in rms if r is None)
+    if missing:
+        warnings.append(
+            f"{missing} of {len(rows)} gains have no converged RMS of {functionals[0].name}: "
+            "they take no part in the Pareto comparison"
+        )
+    return Tradeoff(
+        model=nm.name,
+        sensors=C,
+        family="grid" if grid is not None else "ray",
+        direction=L0,
+        points=points,
+        performance=functionals[0].name,
+        intensity=rows[0][3].intensity,
+        output_labels=nm.output_labels,
+        warnings=tuple(warnings),
+    )

@@ -1,0 +1,1 @@
+"""The observer for a controller: samplers, exact period maps, order, verification."""

@@ -1,0 +1,241 @@
+r"""The verification of an exported observer: a high-resolution plant, sampled and continuous.
+
+:func:`verify_observer` runs the discrete observer and its continuous counterpart against a
+Galerkin plant of at least twice its order, both stepped exactly, the sampler applied to the
+plant's outputs, and reports the performance-output error over time and its floor
+(:class:`Verification`).  :func:`with_plant_gap` and :func:`with_target_check` add what the
+plant's own resolution says about those floors (:mod:`phdesign.numeric.sampled.plant_resolution`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from phdesign.core.limits import check_periods
+from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.sampled.order import OrderSelection, check_order
+from phdesign.numeric.sampled.samplers import (
+    ContinuousObserver,
+    check_sampling,
+    run_against_continuous,
+)
+
+__all__ = ["Verification", "plant_gap", "verify_observer", "with_plant_gap", "with_target_check"]
+
+
+def _fmt(value: float | None) -> str:
+    return "n/a" if value is None or not math.isfinite(value) else f"{value:.3g}"
+
+
+@dataclass(frozen=True)
+class Verification:
+    """The exported observer against a high-resolution plant, and the continuous one.
+
+    Attributes
+    ----------
+    plant_degree, plant_order : int
+        The plant: Galerkin degree and states (at least twice the observer's order).
+    dt : float
+    sampler : str
+    x0 : str
+        The plant's initial state (the observer starts from zero).
+    outputs : tuple of str
+        The performance outputs compared.
+    t : ndarray (nr,)
+        Record times (multiples of dt).
+    error, continuous_error : ndarray (nr, n_performance)
+        Plant minus observer for the sampled and for the continuous observer.
+    peak : float
+        Largest magnitude of the plant's performance outputs over the run.
+    floor, continuous_floor : float
+        Largest error over the last fifth of the run, absolute.
+    warnings : tuple of str
+    plant_gap : float or None
+        How far the plant's own performance outputs move over that window when its degree
+        is raised by half (:mod:`phdesign.numeric.sampled.plant_resolution`); None when unchecked.
+    """
+
+    plant_degree: int
+    plant_order: int
+    dt: float
+    sampler: str
+    x0: str
+    outputs: tuple[str, ...]
+    t: np.ndarray = field(repr=False)
+    error: np.ndarray = field(repr=False)
+    continuous_error: np.ndarray = field(repr=False)
+    peak: float
+    floor: float
+    continuous_floor: float
+    warnings: tuple[str, ...] = ()
+    plant_gap: float | None = None
+
+    @property
+    def ratio(self) -> float:
+        """Sampled floor over the continuous observer's (inf when that one is zero)."""
+        if self.continuous_floor > 0:
+            return self.floor / self.continuous_floor
+        return math.inf if self.floor > 0 else 1.0
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary (strict JSON)."""
+        ratio = self.ratio
+        return {
+            "plant_degree": self.plant_degree,
+            "plant_order": self.plant_order,
+            "dt": self.dt,
+            "sampler": self.sampler,
+            "x0": self.x0,
+            "outputs": list(self.outputs),
+            "t": self.t.tolist(),
+            "error": self.error.tolist(),
+            "continuous_error": self.continuous_error.tolist(),
+            "peak": self.peak,
+            "floor": self.floor,
+            "relative_floor": self.floor / self.peak if self.peak > 0 else None,
+            "continuous_floor": self.continuous_floor,
+            "ratio": ratio if math.isfinite(ratio) else None,
+            "plant_gap": self.plant_gap,
+            "warnings": list(self.warnings),
+        }
+
+    def __repr__(self) -> str:
+        return (
+            f"Verification(sampler={self.sampler!r}, dt={self.dt:g}, floor={self.floor:.3g}, "
+            f"continuous_floor={self.continuous_floor:.3g}, ratio={self.ratio:.3g})"
+        )
+
+    def __str__(self) -> str:
+        rel = self.floor / self.peak if self.peak > 0 else math.nan
+        lines = [
+            f"verification: plant of degree {self.plant_degree} ({self.plant_order} states) "
+            f"from {self.x0}, t = 0..{self.t[-1]:g}, outputs {', '.join(self.outputs)}",
+            f"error floor (max over the last fifth): {self.floor:.3g} ({_fmt(rel)} of the "
+            f"peak); continuous observer: {self.continuous_floor:.3g}; ratio {self.ratio:.3g}",
+        ]
+        lines += [f"warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        return (
+            "<table><tr><th>observer</th><th>error floor</th></tr>"
+            f"<tr><td>{self.sampler}, dt = {self.dt:g}</td><td>{self.floor:.3g}</td></tr>"
+            f"<tr><td>continuous</td><td>{self.continuous_floor:.3g}</td></tr></table>"
+        )
+
+    def plot(self, ax: Any = None) -> Any:
+        """Draw both errors over time (log scale); returns the axes."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(7, 3.5))
+        ax.semilogy(self.t, np.abs(self.continuous_error).max(axis=1), label="continuous")
+        ax.semilogy(
+            self.t, np.abs(self.error).max(axis=1), label=f"{self.sampler}, dt = {self.dt:g}"
+        )
+        ax.set_xlabel("t")
+        ax.set_ylabel("|" + ", ".join(self.outputs) + " error|")
+        ax.legend()
+        return ax
+
+
+def verify_observer(
+    plant: Any,
+    observer: ContinuousObserver,
+    C_m: np.ndarray,
+    *,
+    dt: float,
+    sampler: str,
+    x0: np.ndarray,
+    t_end: float,
+    samples: int = 501,
+    x0_text: str = "x0",
+) -> Verification:
+    """Run the sampled and the continuous observer against ``plant`` from ``x0``.
+
+    Both are stepped exactly (:func:`phdesign.numeric.sampled.samplers.run_loop`) over
+    round(t_end / dt) periods, the sampler applied to the plant's outputs, and recorded
+    on the same instants (every ``stride`` periods, about ``samples`` records).
+    """
+    dt = check_sampling(dt, sampler)
+    check_periods(dt, t_end)
+    check_order(observer.order, plant.dim, plant.resolution)
+    n_steps = max(1, round(t_end / dt))
+    stride = max(1, round(t_end / ((max(samples, 2) - 1) * dt)))
+    sampled, continuous, (floor, cont), warning = run_against_continuous(
+        plant, observer, C_m, sampler=sampler, x0=x0, dt=dt, n_steps=n_steps, stride=stride
+    )
+    errors = [r.performance_error(observer) for r in (sampled, continuous)]
+    peak = float(np.max(np.abs(sampled.target)))
+    return Verification(
+        plant_degree=plant.resolution,
+        plant_order=plant.dim,
+        dt=dt,
+        sampler=sampler,
+        x0=x0_text,
+        outputs=tuple(observer.outputs[i] for i in observer.performance),
+        t=sampled.t,
+        error=errors[0],
+        continuous_error=errors[1],
+        peak=peak,
+        floor=floor,
+        continuous_floor=cont,
+        warnings=() if warning is None else (warning,),
+    )
+
+
+def plant_gap(
+    nm: NumericModel, plant: Any, observer: ContinuousObserver, initial: Any, t: np.ndarray
+) -> tuple[float, int, float] | None:
+    """Return the plant's own resolution gap over ``t``, the finer degree and the peak.
+
+    :func:`~phdesign.numeric.sampled.plant_resolution.plant_resolution_gap` with this model's
+    largest Galerkin resolution; None when the plant is already there.
+    """
+    from phdesign.numeric.sampled.plant_resolution import plant_resolution_gap
+    from phdesign.numeric.spectrum.converged import default_resolutions
+
+    largest = default_resolutions(nm, "galerkin")[1]
+    return plant_resolution_gap(plant, observer, initial, t, largest)
+
+
+def with_plant_gap(
+    v: Verification, found: tuple[float, int, float] | None, plant_degree: int
+) -> Verification:
+    """Add the plant's own resolution gap ``found`` (:func:`plant_gap`) to the verification."""
+    from phdesign.numeric.sampled.plant_resolution import gap_warning
+
+    if found is None:
+        unchecked = (
+            f"the verification plant (degree {plant_degree}) is at this model's largest "
+            "Galerkin resolution: whether it resolves its own outputs from the initial "
+            "state is not checked"
+        )
+        return dataclasses.replace(v, warnings=(*v.warnings, unchecked))
+    gap, finer, _ = found
+    warning = gap_warning(gap, (plant_degree, finer), v.continuous_floor, v.peak, v.x0)
+    extra = () if warning is None else (warning,)
+    return dataclasses.replace(v, plant_gap=gap, warnings=v.warnings + extra)
+
+
+def with_target_check(
+    selection: OrderSelection,
+    found: tuple[float, int, float] | None,
+    plant_degree: int,
+    x0_text: str,
+) -> OrderSelection:
+    """Add the warning of :func:`~phdesign.numeric.sampled.plant_resolution.target_warning`."""
+    from phdesign.numeric.sampled.plant_resolution import target_warning
+
+    if found is None:
+        return selection
+    gap, finer, peak = found
+    warning = target_warning(gap, peak, (plant_degree, finer), selection.output_tol, x0_text)
+    if warning is None:
+        return selection
+    return dataclasses.replace(selection, warnings=(*selection.warnings, warning))

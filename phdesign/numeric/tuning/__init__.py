@@ -1,0 +1,1 @@
+"""Gain tuning on the converged abscissa, its result and its robustness figure."""

@@ -1,0 +1,184 @@
+"""Plots of the noise figures: the speed/noise trade-off and a noise report.
+
+A front end (matplotlib only, imported lazily): it draws what
+:mod:`phdesign.numeric.noise.tradeoff` and :mod:`phdesign.numeric.noise.figures` computed.  Figures
+come from :func:`phdesign.plots.new_figure` (Agg outside Jupyter, pyplot inside) and are
+written atomically when a path is given.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from phdesign.numeric.noise.report import describe_gain, describe_sensors
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from matplotlib.figure import Figure
+
+__all__ = ["plot_noise_report", "plot_tradeoff", "save_figure"]
+
+
+def save_figure(fig: Figure, path: str | os.PathLike[str], force: bool = False) -> None:
+    """Write ``fig`` to ``path`` atomically (format from the suffix; ``force`` to overwrite)."""
+    from phdesign.io import atomic_write
+    from phdesign.plots import check_plot_path
+
+    fmt = check_plot_path(path, force=force)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format=fmt, dpi=110)
+    atomic_write(path, buffer.getvalue(), force=force)
+
+
+def plot_tradeoff(
+    result: Any,
+    path: str | os.PathLike[str] | None = None,
+    *,
+    force: bool = False,
+    annotate: str = "pareto",
+) -> Figure:
+    """Decay rate −α against the error RMS; Pareto-optimal gains joined and annotated.
+
+    Parameters
+    ----------
+    result : Tradeoff
+    path : path-like, optional
+        Write the figure there (suffix picks the format).
+    force : bool
+        Overwrite an existing file.
+    annotate : {"pareto", "all", "none"}
+        Which points carry their gain as a label.
+    """
+    from phdesign.plots import check_plot_path, literal, new_figure
+
+    if path is not None:
+        check_plot_path(path, force=force)
+    fig, ax = new_figure(figsize=(7.5, 5.0))
+    pts = [p for p in result.points if p.rms is not None and p.decay_rate is not None]
+    others = [p for p in pts if not p.pareto]
+    front = sorted((p for p in pts if p.pareto), key=lambda p: p.rms)
+    if others:
+        ax.scatter(
+            [p.rms for p in others],
+            [p.decay_rate for p in others],
+            color="0.6",
+            label="dominated",
+            zorder=2,
+        )
+    if front:
+        ax.plot(
+            [p.rms for p in front],
+            [p.decay_rate for p in front],
+            "-o",
+            color="tab:red",
+            label="Pareto-optimal",
+            zorder=3,
+        )
+    loose = [p for p in pts if not p.abscissa_converged]
+    if loose:
+        ax.scatter(
+            [p.rms for p in loose],
+            [p.decay_rate for p in loose],
+            facecolors="none",
+            edgecolors="black",
+            s=120,
+            label="abscissa not converged (coalescence)",
+            zorder=4,
+        )
+    labelled = {"pareto": front, "all": pts, "none": []}.get(annotate, front)
+    for p in _spread(labelled):
+        ax.annotate(
+            describe_gain(p.gain),
+            (p.rms, p.decay_rate),
+            textcoords="offset points",
+            xytext=(6, 4),
+            fontsize=8,
+        )
+    ax.set_xscale("log")
+    ax.set(
+        xlabel=f"RMS of the estimation error of {result.performance}",
+        ylabel="decay rate −α [1/s]",
+        title=literal(
+            f"{result.model}, sensors {describe_sensors(result.sensors, result.output_labels)}: "
+            "speed against noise"
+        ),
+    )
+    ax.grid(True, which="both", alpha=0.3)
+    if pts:
+        ax.legend(loc="best")
+    if path is not None:
+        save_figure(fig, path, force=force)
+    return fig
+
+
+def _spread(points: list[Any], gap: float = 0.035) -> list[Any]:
+    """Drop labels that would overlap the previous one (log rms, linear decay, relative)."""
+    if not points:
+        return []
+    lx = np.log10([p.rms for p in points])
+    y = np.array([p.decay_rate for p in points])
+    sx, sy = max(float(np.ptp(lx)), 1e-12), max(float(np.ptp(y)), 1e-12)
+    kept = [0]
+    for i in range(1, len(points)):
+        j = kept[-1]
+        if abs(lx[i] - lx[j]) / sx > gap * 3 or abs(y[i] - y[j]) / sy > gap * 2:
+            kept.append(i)
+    return [points[i] for i in kept]
+
+
+def plot_noise_report(
+    report: Any, path: str | os.PathLike[str] | None = None, *, force: bool = False
+) -> Figure:
+    """Draw the frequency response per resolution, and every figure under refinement.
+
+    Left: the energy-norm gain from the noise to the error at each resolution, the
+    unresolved frequencies shaded and the peak γ starred.  Right: each figure divided by
+    its finest value against the resolution (flat when it converges, rising when it
+    diverges).
+    """
+    from phdesign.plots import check_plot_path, literal, new_figure
+
+    if path is not None:
+        check_plot_path(path, force=force)
+    fig, (left, right) = new_figure(1, 2, figsize=(11, 4.2))
+    if report.pencils:
+        omega = report.default_frequencies()
+        for res, values in report.frequency_response(omega).items():
+            left.loglog(omega, values, lw=1, label=f"resolution {res}")
+        band = report.l2_gain.band
+        if band:
+            left.axvspan(band, omega[-1], color="0.9", label="unresolved frequencies")
+        g = report.l2_gain
+        if g.value is not None and g.frequency:
+            left.plot(g.frequency, g.value, "k*", ms=12, label=f"γ = {g.value:.4g}")
+        disc = g.discrete
+        if disc is not None and disc.values and g.discrete_frequency:
+            # a sharp resonance of an unresolved mode falls between the plotted samples
+            left.plot(
+                g.discrete_frequency,
+                disc.values[-1],
+                "rx",
+                ms=9,
+                label=f"discretization's supremum {disc.values[-1]:.3g}",
+            )
+        left.legend(loc="lower left", fontsize=8)
+    left.set(
+        xlabel="frequency ω [rad/s]",
+        ylabel="gain noise → error (energy norm)",
+        title="frequency response",
+    )
+    figures = [*report.performance, report.error_energy]
+    for est in figures:
+        values = np.asarray(est.values, dtype=float)
+        if values.size and np.all(np.isfinite(values)) and values[-1] > 0:
+            label = f"{'Var ' if est is not report.error_energy else ''}{est.name}: {est.status()}"
+            right.plot(est.resolutions, values / values[-1], "-o", label=label)
+    right.set(xlabel="resolution", ylabel="value / finest value", title="figures under refinement")
+    right.legend(loc="best", fontsize=8)
+    fig.suptitle(literal(report.header()), fontsize=9)
+    if path is not None:
+        save_figure(fig, path, force=force)
+    return fig

@@ -1,0 +1,111 @@
+"""The L²-gain of the noise report where the PDE's peaks repeat forever, and settle's rule.
+
+A reviewer found ``phdesign noise wave-damper --sensors 1 --gain 2`` reporting the
+L²-gain as diverging ("grows like p^0.00") while its values at three resolutions agreed
+to 13 digits.  Two defects: :func:`~phdesign.numeric.noise.settle.settle` called round-off
+increments growth, and the gain compared the coarse member of a pair at the edge of what
+it resolves, where one of the infinitely many equal peaks happened to be found.
+
+Closed form (derived here, by characteristics).  ``wave-damper``: ρ = T = 1, so e = x,
+∂t x1 = ∂z e2, ∂t x2 = ∂z e1; α = ẽ1 + ẽ2 travels left (α_t = α_z), β = ẽ1 − ẽ2 right.
+
+- z = 1, the plant's damper e2 = −k e1 (copied by the observer): α = r1 β,
+  r1 = (1 − k)/(1 + k).
+- z = 0, sensor y1 = −e2(0) with gain l and noise ν: ũ1 = −l ỹ1 − l ν, i.e.
+  ẽ1(0) = l ẽ2(0) − l ν; with ẽ1 = (α + β)/2, ẽ2 = (α − β)/2:
+  β = ρ0 α − 2lν/(1 + l), ρ0 = (l − 1)/(l + 1).
+- At s = iω: β(z) = β0 e^{−sz}, α(z) = r1 β0 e^{−2s} e^{sz}, so
+  β0 = −(2l/(1 + l)) ν / (1 − ρ0 r1 e^{−2iω}).
+- ‖x̃‖² = ∫ ẽ1² + ẽ2² dz = ½ ∫ |α|² + |β|² dz = ½ |β0|² (1 + r1²).
+
+Hence the gain from ν (unit intensity) at ω and its supremum
+
+    g(ω) = √((1 + r1²)/2) · (2l/(1 + l)) / |1 − ρ0 r1 e^{−2iω}|,
+    γ = √((1 + r1²)/2) · (2l/(1 + l)) / (1 − |ρ0 r1|),
+
+attained at every ω with ρ0 r1 e^{−2iω} = |ρ0 r1|: for k = ½, l = 2, r1 = ρ0 = ⅓,
+ρ0 r1 = 1/9 > 0, the peaks are at ω = mπ, the first at 0, and γ = √(5/9)·(4/3)·(9/8) =
+√5/2 = 1.1180339887498949.
+
+``wave`` (sensor y2 = e1(1), gain k: the damper u_z(1) = −k u_t(1) with the noise in it):
+the peaks of k/√(k² sin²ω + cos²ω) (tests/numeric/noise/test_noise.py) are at cos ω = 0 for k < 1,
+the
+first at π/2, and at sin ω = 0 for k > 1, the first at 0.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from phdesign.models import load_builtin
+from phdesign.numeric.bridge import to_numeric
+from phdesign.numeric.noise.figures import noise
+from phdesign.numeric.noise.settle import settle
+
+K_DAMPER, L_SENSOR = 0.5, 2.0
+
+
+def wave_damper_gain(omega: np.ndarray, k: float = K_DAMPER, l: float = L_SENSOR) -> np.ndarray:  # noqa: E741
+    """g(ω) of the module docstring."""
+    r1, rho0 = (1 - k) / (1 + k), (l - 1) / (l + 1)
+    return (
+        math.sqrt((1 + r1**2) / 2)
+        * (2 * l / (1 + l))
+        / np.abs(1 - rho0 * r1 * np.exp(-2j * omega))
+    )
+
+
+def test_round_off_increments_are_not_divergence():
+    # the reviewer's minimal case: values equal to 14 digits, a pair that disagrees by 2e-6
+    est = settle("g", [1, 1 + 1e-14, 1 + 3e-14], [30, 45, 68], 1e-6, pair=(1, 1 + 2e-6))
+    assert not est.diverges
+    assert not est.converged
+    assert est.value is None
+    # growth that the tolerance can see is still divergence (linear in p, as E[H~])
+    assert settle("E", [2.0, 3.0, 4.5], [20, 30, 45], 1e-6).diverges
+    # one visible step after a round-off one is not yet a trend
+    assert not settle("f", [1.0, 1.0 + 1e-14, 2.0], [20, 30, 45], 1e-6).diverges
+
+
+def test_wave_damper_gain_is_the_characteristics_closed_form_at_its_first_peak():
+    # the reviewer's command: the performance output keeps the refinement going to p = 68,
+    # where the coarse member's edge peak (45 at ω ≈ 69) used to disagree by 1.6e-6
+    wave_damper = load_builtin("wave-damper")
+    rep = noise(
+        to_numeric(wave_damper),
+        np.array([[1.0]]),
+        np.array([[L_SENSOR]]),
+        intensity=1.0,
+        performance=["x2: 1"],
+        model=wave_damper,
+    )
+    assert rep.resolutions[-1] == 68
+    gain = rep.l2_gain
+    exact = math.sqrt(5) / 2  # module docstring, k = 1/2, l = 2
+    assert wave_damper_gain(np.array([0.0]))[0] == pytest.approx(exact, rel=1e-15)
+    assert not gain.diverges
+    assert gain.converged, gain.estimate
+    # spectral convergence: the pair agrees to ~13 digits; 1e-10 leaves room for round-off
+    assert gain.value == pytest.approx(exact, rel=1e-10)
+    assert gain.frequency == 0.0  # the first of the equal peaks at mπ, not one of the others
+    assert gain.to_dict()["frequency"] == 0.0
+    # the whole response, not only its peak, is the continuum's (finest resolution)
+    omega = np.array([0.3, 1.7, 5.0, 20.0])
+    finest = rep.frequency_response(omega)[rep.resolutions[-1]]
+    assert np.allclose(finest, wave_damper_gain(omega), rtol=1e-10)
+    assert "diverges" not in str(rep).split("L2-gain", 1)[1].split("\n", 1)[0]
+
+
+@pytest.mark.parametrize(("k", "first_peak"), [(0.5, math.pi / 2), (2.0, 0.0)])
+def test_wave_gain_reports_the_first_of_its_equal_peaks(k, first_peak):
+    rep = noise(
+        to_numeric(load_builtin("wave")), np.array([[0.0, 1.0]]), np.array([[k]]), performance=[]
+    )
+    gain = rep.l2_gain
+    assert gain.converged
+    assert gain.value == pytest.approx(max(1.0, k), rel=1e-10)  # tests/numeric/noise/test_noise.py
+    # Brent locates the peak to 1e-7 relative in ω (peak_gain's rtol)
+    assert gain.frequency == pytest.approx(first_peak, abs=1e-6)

@@ -1,0 +1,7 @@
+"""The repository's own folders, for tests at any depth of ``tests/``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]

@@ -1,0 +1,48 @@
+"""Strings and coupled strings shared by the spectrum tests, and the honesty of a digits claim."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from phdesign.symbolic.model import BCPHS
+
+SENSOR2 = np.array([[0.0, 1.0]])  # strings: y2 = e1(b), the velocity at the damper end
+
+
+def string(T: str, b: str = "1") -> BCPHS:
+    """rho u_tt = (T u_z)_z with rho = 1, fixed at 0 (u_t(0) = 0), force input at b."""
+    return BCPHS.define(
+        name="string",
+        interval=[0, b],
+        order=1,
+        P={1: [[0, 1], [1, 0]]},
+        H=[[1, 0], [0, T]],
+        inputs=["e1(0)", "e2(b)"],
+        outputs=["-e2(0)", "e1(b)"],
+    )
+
+
+# Two strings (speeds 1 and sqrt(2)) coupled by a zero-order skew term between the momentum
+# of the first and the strain of the second; the damper acts on the first string only.
+COUPLED_STRINGS = BCPHS.define(
+    name="two coupled strings",
+    interval=[0, 1],
+    order=1,
+    P={
+        0: [[0, 0, 0, -1], [0, 0, 0, 0], [0, 0, 0, 0], [1, 0, 0, 0]],
+        1: [[0, 1, 0, 0], [1, 0, 0, 0], [0, 0, 0, 1], [0, 0, 1, 0]],
+    },
+    H=[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 2]],
+    inputs=["e1(0)", "e3(0)", "e2(1)", "e4(1)"],
+    outputs=["-e2(0)", "-e4(0)", "e1(1)", "e3(1)"],
+)
+
+
+def honest(report, exact: float) -> bool:
+    """The report's digits claim holds against the exact abscissa.
+
+    Digits are relative to max(rate, |alpha|); reports without a rate measured against 1.
+    """
+    rate = getattr(report, "rate_scale", 1.0)
+    claim = 10.0 ** (-report.digits) * max(rate, abs(report.spectral_abscissa))
+    return abs(report.spectral_abscissa - exact) <= claim
