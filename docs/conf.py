@@ -21,8 +21,11 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
     "numpydoc",
+    "myst_parser",
     "phdesign_docs",
 ]
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+myst_heading_anchors = 3  # "model_files.md#boundary-feedback-dampers-in-the-plant" links work
 autosummary_generate = True
 autodoc_typehints = "none"  # numpydoc's Parameters sections state the types
 autodoc_default_options = {"members": True, "inherited-members": False}

@@ -1,4 +1,4 @@
-"""The README's block of the design object's noise, trade-off, export and loop methods runs.
+"""The getting-started block of the design object's noise, trade-off, export and loop runs.
 
 Expected values that do not come from the code under test: the error system's converged
 abscissa −2.9106562986 of the paper's design 2 (tests/numeric/spectrum/test_numeric_spectrum.py, 13
@@ -11,19 +11,14 @@ controlled plant's and the error system's.
 
 from __future__ import annotations
 
-import re
-
 import pytest
-from paths import ROOT
+from doc_blocks import DOCS, python_blocks
 
 import phdesign as phd
 
-README = ROOT / "README.md"
-
 
 def design_block() -> str:
-    blocks = re.findall(r"```python\n(.*?)```", README.read_text(encoding="utf-8"), flags=re.S)
-    (block,) = [b for b in blocks if "obs.noise()" in b]
+    (block,) = [b for b in python_blocks(DOCS / "getting_started.rst") if "obs.noise()" in b]
     return block
 
 
@@ -36,9 +31,9 @@ def test_readme_noise_tradeoff_export_loop_block_runs():
     (tip,) = report.performance
     assert tip.name == "w(1)"
     assert tip.converged
-    assert round(tip.value, 4) == 0.1347  # the README's 4-digit claim
+    assert round(tip.value, 4) == 0.1347  # the page's 4-digit claim
     assert report.error_energy.diverges
-    # design 2's converged abscissa (module docstring); 1e-8: the README's 10 digits
+    # design 2's converged abscissa (module docstring); 1e-8: the page's 10 digits
     decay = {p.scale: p.decay_rate for p in trade.points}
     assert decay[1.0] == pytest.approx(2.9106562986, abs=1e-8)
     assert max(decay, key=lambda s: decay[s]) == 1.0
