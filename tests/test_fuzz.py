@@ -20,7 +20,8 @@ from hypothesis import strategies as st
 from phdesign.core.errors import PhdesignError
 from phdesign.io import check_output_path, model_from_dict, model_from_toml
 from phdesign.models import builtin_names, builtin_toml
-from phdesign.symbolic.expressions import parse_scalar, parse_trace_expression
+from phdesign.symbolic.expressions import parse_scalar
+from phdesign.symbolic.traces import parse_trace_expression
 
 # Per-test budget: the profile's max_examples scaled up for these cheap targets in CI.
 BUDGET = 10_000 if os.environ.get("HYPOTHESIS_PROFILE") == "nightly" else 300
@@ -213,7 +214,7 @@ def _targets():
     import phdesign
     from phdesign.core import limits
     from phdesign.io import model_from_dict, model_to_toml
-    from phdesign.symbolic import expressions, printing
+    from phdesign.symbolic import expressions, printing, traces
     from phdesign.symbolic.definiteness import check_definite
 
     wave = phdesign.load_builtin("wave")
@@ -240,7 +241,7 @@ def _targets():
         ("format_expression", printing.format_expression, (Z_SYMBOL, (0, 1)), {}),
         ("exact_number", expressions.exact_number, ("0.5", "x"), {}),
         ("exact_matrix", expressions.exact_matrix, ([[1, 0]], "M"), {}),
-        ("Trace.label", expressions.Trace(1, 0, "a").label, ((0, 1),), {}),
+        ("Trace.label", traces.Trace(1, 0, "a").label, ((0, 1),), {}),
         ("check_definite", check_definite, (MATRIX, "H", (0, 1)), {}),
         ("check_sensor_outputs", limits.check_sensor_outputs, (2,), {}),
         ("check_output_path", check_output_path, ("out.csv",), {}),

@@ -23,15 +23,10 @@ from phdesign.core.errors import OutputFileError, PhdesignError
 from phdesign.core.files import OutputFiles
 from phdesign.io import model_from_toml, model_to_toml, read_model
 from phdesign.models import load_builtin
-from phdesign.symbolic.expressions import (
-    Trace,
-    Z,
-    parameter_symbol,
-    parse_scalar,
-    parse_trace_expression,
-)
+from phdesign.symbolic.expressions import Z, parameter_symbol, parse_scalar
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.printing import format_expression
+from phdesign.symbolic.traces import Trace, parse_trace_expression
 
 CANARY = "canary-of-test_hostile"
 

@@ -65,6 +65,7 @@ def trace_row(text: str, nm: NumericModel, model: Any = None) -> np.ndarray:
     import sympy
 
     from phdesign.symbolic import expressions as ex
+    from phdesign.symbolic import traces
 
     values = _parameter_values(model, None) if model is not None else {}
     if model is not None:  # exact endpoints, so that "e1(1)" names the endpoint 1
@@ -73,11 +74,11 @@ def trace_row(text: str, nm: NumericModel, model: Any = None) -> np.ndarray:
         )
     else:
         interval = tuple(sympy.Rational(repr(x)) for x in nm.interval)
-    expr = ex.parse_trace_expression(
+    expr = traces.parse_trace_expression(
         text, interval, nm.order, nm.size, parameters=[str(s) for s in values]
     )
     row = np.zeros(2 * nm.order * nm.size)  # the trace vector of the open plant
-    for trace, coefficient in ex.linear_coefficients(expr).items():
+    for trace, coefficient in traces.linear_coefficients(expr).items():
         value = coefficient.subs(values)
         if value.free_symbols:
             message = _free_symbols_message(f"trace expression {text!r}", value.free_symbols)

@@ -58,7 +58,6 @@ from phdesign.core.text import (
 )
 from phdesign.symbolic.assumption import AssumptionCheck, Partition, model_assumption
 from phdesign.symbolic.certificate import Certificate, certify
-from phdesign.symbolic.expressions import Trace
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import ErrorSystem, ObserverDesign
 from phdesign.symbolic.ports import trace_list
@@ -71,6 +70,7 @@ from phdesign.symbolic.propositions import (
     variant_cases,
     verdict_of,
 )
+from phdesign.symbolic.traces import Trace
 
 __all__ = ["VERDICTS", "Classification", "VariantResult", "classify", "verdict_of"]
 

@@ -36,7 +36,7 @@ that choice; the sign is fixed by :math:`W_C\Sigma W_B^\top = +I` (power
 
 Examples
 --------
->>> from phdesign.symbolic.expressions import parse_trace_expression
+>>> from phdesign.symbolic.traces import parse_trace_expression
 >>> from phdesign.symbolic.printing import format_expression
 >>> inputs = [parse_trace_expression(t, (0, 1), 1, 2) for t in ("e1(0)", "e2(1)")]
 >>> P = [sympy.zeros(2), sympy.Matrix([[0, 1], [1, 0]])]

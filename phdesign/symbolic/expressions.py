@@ -1,26 +1,19 @@
-r"""Safe parsing and printing of scalar expressions and boundary-trace expressions.
+r"""Safe parsing of scalar expressions, and the exact numbers and zero tests phdesign uses.
 
-Users write matrix entries (``"1/rho"``, ``"EI*(1 + z/10)"``) and boundary
-ports as trace expressions (``"-e2(0)"``, ``"(e1(0) - e2(0))/sqrt(2)"``,
-``"EI*e2'(b)"``).  A trace ``e<i><primes>(<point>)`` is the value at an
-endpoint of the ``k``-th :math:`z`-derivative (``k`` = number of primes) of the
-``i``-th effort component :math:`e = \mathcal{H} x`.
-
-The text is read by a small recursive-descent parser: user text is never
-evaluated as Python (no :func:`eval`, no :func:`sympy.sympify` on raw text).
-Printing (:mod:`phdesign.symbolic.printing`) goes through sympy's ``str`` with each trace
-symbol renamed to the user syntax, so ``parse(format(expr)) == expr`` holds exactly.
-
-The grammar and its limits live in :mod:`phdesign.symbolic.parser`.
+Users write matrix entries (``"1/rho"``, ``"EI*(1 + z/10)"``) in :math:`z` and named
+parameters.  The text is read by a small recursive-descent parser: user text is never
+evaluated as Python (no :func:`eval`, no :func:`sympy.sympify` on raw text); the grammar
+and its limits live in :mod:`phdesign.symbolic.parser`.  Numbers become exact
+(:func:`exact_number`: ``0.2`` is :math:`1/5`), and :func:`canonical` and :func:`vanishes`
+decide zero exactly.  Boundary-trace expressions (``"-e2(0)"``) are read on top of this, by
+:mod:`phdesign.symbolic.traces`, and printed back by :mod:`phdesign.symbolic.printing`.
 
 Examples
 --------
->>> from phdesign.symbolic.printing import format_expression
->>> expr = parse_trace_expression("(e1(0) - e2'(1))/sqrt(2)", interval=(0, 1), order=2, size=2)
->>> format_expression(expr, interval=(0, 1))
-"sqrt(2)*(e1(0) - e2'(1))/2"
 >>> parse_scalar("1/rho + z**2", parameters=["rho"])
 z**2 + 1/rho
+>>> exact_number(0.2, "d")
+1/5
 """
 
 from __future__ import annotations
@@ -30,33 +23,28 @@ import math
 import numbers
 import re
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
 from functools import lru_cache
-from typing import Literal
 
 import sympy
 
 from phdesign.core.checks import not_bytes
 from phdesign.core.errors import ExpressionError
 from phdesign.core.limits import MAX_NUMBER_OPERATIONS
-from phdesign.symbolic.parser import CONSTANTS, FUNCTIONS, Token, brief, check_text, parse
+from phdesign.symbolic.parser import CONSTANTS, FUNCTIONS, brief, check_text, parse
 
 __all__ = [
-    "Trace",
     "Z",
     "canonical",
+    "check_parameter_name",
     "exact_matrix",
     "exact_number",
-    "linear_coefficients",
+    "exactify",
+    "name_resolver",
     "parameter_symbol",
     "parse_scalar",
-    "parse_trace_expression",
-    "trace_of",
-    "trace_symbol",
     "vanishes",
 ]
 
-Side = Literal["a", "b"]
 
 #: The spatial variable of every model.
 Z = sympy.Symbol("z", real=True)
@@ -65,69 +53,6 @@ Z = sympy.Symbol("z", real=True)
 RESERVED_NAMES = frozenset({"z", "a", "b", *FUNCTIONS, *CONSTANTS})
 _TRACE_NAME = re.compile(r"e\d+\Z")
 _PARAMETER_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
-
-
-@dataclass(frozen=True)
-class Trace:
-    r"""The boundary trace :math:`\partial_z^k e_i` at one endpoint.
-
-    Parameters
-    ----------
-    component : int
-        1-based index ``i`` of the effort component.
-    derivative : int
-        Order ``k`` of the :math:`z`-derivative, ``0 <= k < N``.
-    side : {"a", "b"}
-        The endpoint.
-    """
-
-    component: int
-    derivative: int
-    side: Side
-
-    @property
-    def symbol(self) -> sympy.Symbol:
-        """The sympy symbol standing for this trace."""
-        return trace_symbol(self.component, self.derivative, self.side)
-
-    def label(self, interval: Sequence[object] | None = None, tilde: bool = False) -> str:
-        """Return the trace in user syntax, e.g. ``e2'(0)``, or ``ẽ2'(0)`` with ``tilde``.
-
-        ``interval`` gives the endpoints to print (numbers, or text read by the safe
-        parser); without it the point is written ``a`` or ``b``.
-        """
-        point = self.side if interval is None else _point_text(interval, self.side)
-        head = "ẽ" if tilde else "e"
-        return f"{head}{self.component}{chr(39) * self.derivative}({point})"
-
-
-@lru_cache(maxsize=4096)
-def trace_symbol(component: int, derivative: int, side: Side) -> sympy.Symbol:
-    r"""Return the symbol of trace :math:`\partial_z^k e_i(\text{side})`.
-
-    Examples
-    --------
-    >>> trace_symbol(2, 1, "b")
-    e2'(b)
-    """
-    return sympy.Symbol(f"e{component}{chr(39) * derivative}({side})", real=True)
-
-
-_SYMBOL_NAME = re.compile(r"e(\d+)('*)\((a|b)\)\Z")
-
-
-def trace_of(symbol: sympy.Basic) -> Trace | None:
-    """Return the :class:`Trace` a symbol stands for, or ``None`` for other symbols."""
-    if not isinstance(symbol, sympy.Symbol):
-        return None
-    match = _SYMBOL_NAME.match(symbol.name)
-    if match is None or symbol != trace_symbol(
-        int(match[1]),
-        len(match[2]),
-        match[3],  # type: ignore[arg-type]
-    ):
-        return None
-    return Trace(int(match[1]), len(match[2]), match[3])  # type: ignore[arg-type]
 
 
 @lru_cache(maxsize=1024)
@@ -336,9 +261,9 @@ def parse_scalar(
         The exact expression (decimals become rationals).
     """
     check_text(text, what)
-    names = _names(parameters)
+    resolve = name_resolver(parameters, allow_z)
     try:
-        return parse(text, _name_resolver(names, allow_z))
+        return parse(text, resolve)
     except ExpressionError as error:
         raise ExpressionError(f"{what}: {error}") from None
 
@@ -353,182 +278,29 @@ def _names(parameters: object) -> frozenset[str]:
     return frozenset(names)
 
 
-def _name_resolver(parameters: frozenset[str], allow_z: bool) -> Callable[[str, str], sympy.Expr]:
-    """Resolve ``z`` and parameter names; any other name is an error that lists the known ones."""
+def name_resolver(parameters: Iterable[str], allow_z: bool) -> Callable[[str, str], sympy.Expr]:
+    """Return the parser's name resolver for ``z`` and the named parameters.
+
+    Any other name is an error that lists the known ones.
+
+    Raises
+    ------
+    ExpressionError
+        If ``parameters`` is not a list of names.
+    """
+    known_names = _names(parameters)
 
     def resolve(name: str, text: str) -> sympy.Expr:
         if name == "z":
             if not allow_z:
                 raise ExpressionError(f"the spatial variable z is not allowed in {text!r}")
             return Z
-        if name in parameters:
+        if name in known_names:
             return parameter_symbol(name)
-        known = sorted(parameters)
+        known = sorted(known_names)
         raise ExpressionError(
             f"unknown symbol {name!r} in {text!r}; "
             f"known parameters: {', '.join(known) if known else 'none'}"
         )
 
     return resolve
-
-
-def _endpoints(interval: object) -> tuple[sympy.Expr, sympy.Expr]:
-    """Return the exact endpoints of a caller's interval (numbers, or text for the parser)."""
-    if isinstance(interval, str) or not isinstance(interval, Sequence) or len(interval) != 2:
-        raise ExpressionError(f"interval must be a pair (a, b); found {_brief(interval)}")
-    a, b = (exact_number(p, "interval endpoint") for p in interval)
-    return a, b
-
-
-def _point_text(interval: Sequence[object], side: Side) -> str:
-    try:  # a model prints every trace at its interval: read the endpoints once
-        return _cached_point_text(tuple(interval), side)
-    except TypeError:  # an unhashable endpoint
-        from phdesign.symbolic.printing import format_expression
-
-        return format_expression(_endpoints(interval)[0 if side == "a" else 1])
-
-
-#: Longest endpoint text a trace's point may hold (:func:`_side_of` reads no longer one).
-_POINT_TEXT_LIMIT = 40
-
-
-@lru_cache(maxsize=256)
-def _cached_point_text(interval: tuple[object, ...], side: Side) -> str:
-    from phdesign.symbolic.printing import format_expression  # printing reads traces here
-
-    text = format_expression(_endpoints(interval)[0 if side == "a" else 1])
-    # an endpoint too long to read back as a point (b = 1e300 has 301 digits) is its name
-    return text if len(text) <= _POINT_TEXT_LIMIT and _POINT_NUMBER.match(text) else side
-
-
-def parse_trace_expression(
-    text: str,
-    interval: Sequence[object],
-    order: int,
-    size: int,
-    parameters: Iterable[str] = (),
-    what: str = "trace expression",
-) -> sympy.Expr:
-    """Parse a linear combination of boundary traces.
-
-    Parameters
-    ----------
-    text : str
-        E.g. ``"-e2(0)"``, ``"(e1(0) - e2(0))/sqrt(2)"``, ``"EI*e2'(b)"``.
-    interval : (a, b)
-        The spatial interval; a point is written ``a``, ``b`` or as the endpoint's value.
-    order : int
-        The order ``N`` of the model: derivatives up to ``N - 1`` are traces.
-    size : int
-        The number ``n`` of components.
-    parameters : iterable of str
-        Parameter names allowed in coefficients.
-    what : str
-        How to name the expression in error messages.
-
-    Returns
-    -------
-    sympy.Expr
-        A linear form in the symbols of :func:`trace_symbol`, with no constant term.
-    """
-    check_text(text, what)
-    a, b = _endpoints(interval)
-    for name, value in (("order", order), ("size", size)):
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise ExpressionError(f"{name} must be a positive integer; found {value!r}")
-
-    def make_trace(token: Token) -> sympy.Expr:
-        component_text, primes, point = token.groups
-        component, derivative = int(str(component_text)), len(str(primes))
-        if not 1 <= component <= size:
-            raise ExpressionError(
-                f"component index in {token.text!r} is out of range; expected 1..{size}, "
-                f"found {component}"
-            )
-        if derivative >= order:
-            raise ExpressionError(
-                f"{token.text!r} has derivative order {derivative}; traces of an order-{order} "
-                f"model go up to order {order - 1}"
-            )
-        return trace_symbol(component, derivative, _side_of(str(point), a, b, token.text))
-
-    try:
-        expr = parse(text, _name_resolver(_names(parameters), False), make_trace)
-    except ExpressionError as error:
-        raise ExpressionError(f"{what} {text!r}: {error}") from None
-    linear_coefficients(expr, what=f"{what} {text!r}")
-    return expr
-
-
-_POINT_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?:/\d+)?\Z")
-
-
-def _side_of(point: str, a: object, b: object, trace_text: str) -> Side:
-    if point in ("a", "b"):
-        return point  # type: ignore[return-value]
-    if not _POINT_NUMBER.match(point) or len(point) > _POINT_TEXT_LIMIT:
-        raise ExpressionError(
-            f"point of {trace_text!r} must be a, b or an endpoint value; found {point!r}"
-        )
-    value = sympy.Rational(point)
-    if value == a:
-        return "a"
-    if value == b:
-        return "b"
-    raise ExpressionError(
-        f"{trace_text!r} is at an interior or outside point {point}; "
-        f"expected an endpoint, {a} or {b}"
-    )
-
-
-def linear_coefficients(expr: sympy.Expr, what: str = "expression") -> dict[Trace, sympy.Expr]:
-    """Split a trace expression into its coefficients, checking that it is linear.
-
-    Raises
-    ------
-    ExpressionError
-        If the expression has a constant term, a product or power of traces, a trace
-        inside a function, no trace at all, or a coefficient depending on ``z``.
-    """
-    if not isinstance(expr, sympy.Expr):
-        raise ExpressionError(
-            f"{what} must be a sympy expression; found {type(expr).__name__} {_brief(expr)}"
-        )
-    symbols = {s for s in expr.free_symbols if trace_of(s) is not None}
-    if not symbols:
-        raise ExpressionError(f"{what} contains no trace; expected a combination like e1(0)")
-    if expr.has(Z):
-        raise ExpressionError(f"{what} depends on z; coefficients must be constants")
-    sums: dict[sympy.Symbol, list[sympy.Expr]] = {}
-    # one pass over the terms of the expansion (far cheaper than a Poly in 2Nn symbols)
-    for term in sympy.Add.make_args(sympy.expand(expr)):
-        traces, rest = [], []
-        for factor in sympy.Mul.make_args(term):
-            if factor in symbols:
-                traces.append(factor)
-            elif factor.free_symbols & symbols:
-                if factor.is_Pow and factor.base in symbols and factor.exp.is_Integer:
-                    raise ExpressionError(
-                        f"{what} is not linear in the traces; found degree {factor.exp}"
-                    )
-                raise ExpressionError(
-                    f"{what} is not linear in the traces (a trace appears inside a function)"
-                )
-            else:
-                rest.append(factor)
-        if not traces:
-            raise ExpressionError(f"{what} has a constant term {term}; expected none")
-        if len(traces) > 1:
-            raise ExpressionError(
-                f"{what} is not linear in the traces; found degree {len(traces)}"
-            )
-        sums.setdefault(traces[0], []).append(sympy.Mul(*rest))
-    coefficients: dict[Trace, sympy.Expr] = {}
-    for symbol in sorted(sums, key=lambda s: s.name):
-        coefficient = sympy.Add(*sums[symbol])
-        if coefficient != 0:
-            coefficients[trace_of(symbol)] = coefficient  # type: ignore[index]
-    if not coefficients:
-        raise ExpressionError(f"{what} contains no trace; expected a combination like e1(0)")
-    return coefficients

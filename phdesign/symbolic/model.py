@@ -50,7 +50,6 @@ from phdesign.symbolic.expressions import (
     exactify,
     parameter_symbol,
     parse_scalar,
-    parse_trace_expression,
 )
 from phdesign.symbolic.feedback import (
     Feedback,
@@ -59,6 +58,7 @@ from phdesign.symbolic.feedback import (
 )
 from phdesign.symbolic.parser import check_expression
 from phdesign.symbolic.printing import format_expression
+from phdesign.symbolic.traces import parse_trace_expression
 from phdesign.symbolic.validation import validate
 
 if TYPE_CHECKING:  # pragma: no cover - typing only

@@ -35,6 +35,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy
+from sympy.printing.str import StrPrinter
 
 from phdesign.core.errors import ExpressionError
 from phdesign.core.limits import (
@@ -57,6 +58,7 @@ __all__ = [
     "degree_bound",
     "parse",
     "tokenize",
+    "unparse",
 ]
 
 #: The largest argument of exp, sinh and cosh whose value stays within MAX_MAGNITUDE.
@@ -407,6 +409,44 @@ def check_expression(expr: sympy.Expr, what: str) -> sympy.Expr:
             f"{MAX_DEGREE} (the budget phdesign.core.limits.MAX_DEGREE)"
         )
     return expr
+
+
+class _Printer(StrPrinter):
+    """sympy's printer, writing what sympy forms on its own in the grammar's syntax.
+
+    Euler's number is ``exp(1)`` (``E`` is an ordinary name); sympy turns ``sqrt(x**2)``
+    into ``Abs(x)`` and ``tan(pi/2 - x)`` into ``cot(x)`` (:data:`_FORMED`): both are
+    written back in the form that builds them again, so reading the text gives the same
+    expression.
+    """
+
+    def _print_Exp1(self, expr: sympy.Expr) -> str:
+        return "exp(1)"
+
+    def _print_Abs(self, expr: sympy.Expr) -> str:
+        return f"sqrt(({self._print(expr.args[0])})**2)"
+
+    def _print_cot(self, expr: sympy.Expr) -> str:
+        return f"tan(pi/2 - ({self._print(expr.args[0])}))"
+
+
+_PRINTER = _Printer()
+
+
+def unparse(expr: sympy.Basic) -> str:
+    """Write ``expr`` in the grammar's syntax, so that :func:`parse` builds it again.
+
+    Symbols are written by their names: a trace symbol is named in the user syntax at
+    the symbolic points ``a`` and ``b`` (:mod:`phdesign.symbolic.traces`);
+    :func:`phdesign.symbolic.printing.format_expression` writes traces at a model's
+    endpoints.
+
+    Examples
+    --------
+    >>> unparse(sympy.exp(1) * sympy.Abs(sympy.Symbol("x")))
+    'exp(1)*sqrt((x)**2)'
+    """
+    return str(_PRINTER.doprint(expr))
 
 
 def check_text(text: object, what: str) -> str:

@@ -57,15 +57,9 @@ from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.core.errors import PortError
 from phdesign.symbolic.display import PortsDisplay
-from phdesign.symbolic.expressions import (
-    Trace,
-    canonical,
-    exact_matrix,
-    linear_coefficients,
-    trace_symbol,
-    vanishes,
-)
+from phdesign.symbolic.expressions import canonical, exact_matrix, vanishes
 from phdesign.symbolic.model import require_model
+from phdesign.symbolic.traces import Trace, linear_coefficients, trace_symbol
 
 
 class PortedSystem(Protocol):

@@ -1,10 +1,10 @@
 r"""Printing expressions in the syntax the parser reads, so that reading gives them back.
 
-:func:`format_expression` writes sympy's ``str`` with each boundary-trace symbol renamed
-to the user syntax (``e2'(1)``) and the forms sympy builds on its own written back as the
-parser reads them, so ``parse(format_expression(expr)) == expr`` exactly
-(:mod:`phdesign.symbolic.expressions`); :func:`format_number` prints exact numbers short
-enough as they are and long ones in scientific notation.
+:func:`format_expression` writes an expression as the grammar reads it
+(:func:`phdesign.symbolic.parser.unparse`) with each boundary-trace symbol written at the
+model's endpoints (``e2'(1)``, :mod:`phdesign.symbolic.traces`), so
+``parse(format_expression(expr)) == expr`` exactly; :func:`format_number` prints exact
+numbers short enough as they are and long ones in scientific notation.
 """
 
 from __future__ import annotations
@@ -12,33 +12,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import sympy
-from sympy.printing.str import StrPrinter
 
 from phdesign.core.errors import ExpressionError
-from phdesign.symbolic.expressions import trace_of
+from phdesign.symbolic.parser import unparse
+from phdesign.symbolic.traces import trace_of
 
 __all__ = ["format_expression", "format_number"]
-
-
-class _Printer(StrPrinter):
-    """sympy's printer, writing what sympy forms on its own in the parser's syntax.
-
-    Euler's number is ``exp(1)`` (``E`` is an ordinary name); sympy turns ``sqrt(x**2)``
-    into ``Abs(x)`` and ``tan(pi/2 - x)`` into ``cot(x)``: both are written back in the
-    form that builds them again, so reading the text gives the same expression.
-    """
-
-    def _print_Exp1(self, expr: sympy.Expr) -> str:
-        return "exp(1)"
-
-    def _print_Abs(self, expr: sympy.Expr) -> str:
-        return f"sqrt(({self._print(expr.args[0])})**2)"
-
-    def _print_cot(self, expr: sympy.Expr) -> str:
-        return f"tan(pi/2 - ({self._print(expr.args[0])}))"
-
-
-_PRINTER = _Printer()
 
 
 def format_number(value: object, width: int = 28) -> str:
@@ -90,4 +69,4 @@ def format_expression(expr: sympy.Basic, interval: Sequence[object] | None = Non
         trace = trace_of(symbol)
         if trace is not None:
             replacements[symbol] = sympy.Symbol(trace.label(interval), real=True)
-    return str(_PRINTER.doprint(expr.xreplace(replacements)))
+    return unparse(expr.xreplace(replacements))

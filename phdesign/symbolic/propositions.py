@@ -59,8 +59,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
 from phdesign.core.errors import ObserverError
-from phdesign.symbolic.expressions import Trace
 from phdesign.symbolic.ports import trace_index
+from phdesign.symbolic.traces import Trace
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.assumption import AssumptionCheck, Partition

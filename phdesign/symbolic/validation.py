@@ -26,15 +26,10 @@ from phdesign.core.errors import (
 from phdesign.core.limits import check_model_dimensions, check_parameter_count
 from phdesign.symbolic.conjugate import conjugate_outputs
 from phdesign.symbolic.definiteness import check_definite
-from phdesign.symbolic.expressions import (
-    Z,
-    canonical,
-    linear_coefficients,
-    trace_of,
-    vanishes,
-)
+from phdesign.symbolic.expressions import Z, canonical, vanishes
 from phdesign.symbolic.feedback import check_feedback
 from phdesign.symbolic.parser import brief, check_expression
+from phdesign.symbolic.traces import linear_coefficients, trace_of
 from phdesign.symbolic.units import check_units
 
 if TYPE_CHECKING:  # pragma: no cover - typing only

@@ -10,18 +10,15 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from phdesign.core.errors import ExpressionError
-from phdesign.symbolic.expressions import (
+from phdesign.symbolic.expressions import Z, exact_number, parameter_symbol, parse_scalar
+from phdesign.symbolic.printing import format_expression
+from phdesign.symbolic.traces import (
     Trace,
-    Z,
-    exact_number,
     linear_coefficients,
-    parameter_symbol,
-    parse_scalar,
     parse_trace_expression,
     trace_of,
     trace_symbol,
 )
-from phdesign.symbolic.printing import format_expression
 
 INTERVAL = (0, 1)
 

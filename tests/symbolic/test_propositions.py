@@ -7,8 +7,9 @@ import sympy
 
 from phdesign.models import load_builtin
 from phdesign.symbolic.assumption import check_assumption
-from phdesign.symbolic.expressions import Trace, Z
+from phdesign.symbolic.expressions import Z
 from phdesign.symbolic.propositions import VARIANTS, applicable_variants
+from phdesign.symbolic.traces import Trace
 
 
 def labels(variant, order, size, partition=None):
