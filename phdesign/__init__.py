@@ -26,7 +26,7 @@ __version__ = "0.1.0"
 _EXPORTS: dict[str, str] = {
     # models
     "BCPHS": "phdesign.symbolic.model",
-    "Displacement": "phdesign.symbolic.model",
+    "Displacement": "phdesign.symbolic.definition",
     "load": "phdesign.models",
     "load_builtin": "phdesign.models",
     "builtin_names": "phdesign.models",
@@ -119,7 +119,8 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
     from phdesign.numeric.time.simulation import SimulationResult, simulate
     from phdesign.numeric.tuning.search import TuneResult, tune
     from phdesign.symbolic.classify import Classification, classify
-    from phdesign.symbolic.model import BCPHS, Displacement
+    from phdesign.symbolic.definition import Displacement
+    from phdesign.symbolic.model import BCPHS
     from phdesign.symbolic.observer import (
         gain_matrix,
         measurement_matrix,

@@ -52,7 +52,8 @@ from phdesign.core.checks import require_path
 from phdesign.core.errors import ModelFileError, PhdesignError
 from phdesign.core.files import atomic_write, check_output_path
 from phdesign.core.limits import MAX_MODEL_FILE_BYTES, check_file_size
-from phdesign.symbolic.model import BCPHS, Displacement
+from phdesign.symbolic.definition import Displacement
+from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.printing import format_expression
 
 __all__ = [

@@ -19,7 +19,8 @@ import sympy
 from phdesign.core.checks import DISCRETIZATION_METHODS, choice, positive_int
 from phdesign.core.errors import ArgumentError, ObserverError, ParameterError
 from phdesign.core.text import REPR_LIMIT, matrix_text, shorten
-from phdesign.symbolic.model import BCPHS, require_model
+from phdesign.symbolic.model import BCPHS
+from phdesign.symbolic.system import require_model
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     import numpy as np

@@ -294,7 +294,8 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         names them).
     """
     from phdesign.symbolic.expressions import exact_matrix, exact_number
-    from phdesign.symbolic.model import Z, require_model
+    from phdesign.symbolic.model import Z
+    from phdesign.symbolic.system import require_model
 
     require_model(model)
     if parameters is not None and not isinstance(parameters, Mapping):

@@ -52,53 +52,15 @@ import sympy
 
 from phdesign.core.errors import PortError
 from phdesign.symbolic.expressions import canonical, vanishes
-from phdesign.symbolic.printing import format_expression
+from phdesign.symbolic.ports import (
+    coefficient_matrix,
+    extended_matrices,
+    inadmissible_inputs_message,
+    sigma_matrix,
+    trace_vector,
+)
 
-__all__ = ["conjugate_outputs", "inadmissible_inputs_message"]
-
-
-def inadmissible_inputs_message(
-    residual: sympy.MatrixBase,
-    inputs: Sequence[sympy.Expr],
-    interval: Sequence[object],
-    defaults: Mapping[sympy.Symbol, sympy.Expr],
-) -> str:
-    r"""Explain why :math:`W_B \Sigma W_B^\top \ne 0`, naming the input rows.
-
-    Entry :math:`(i, j)` is twice the power that inputs ``i`` and ``j`` exchange: an
-    input pair such as a velocity and a force at the same end cannot both be imposed, and
-    a diagonal entry means input ``i`` carries power by itself (an impedance condition
-    such as ``e2(1) + c*e1(1)``: a feedback, which ``[feedback]`` expresses).
-    """
-    pairs = [
-        (i, j)
-        for i in range(residual.rows)
-        for j in range(i, residual.cols)
-        if not vanishes(residual[i, j])
-    ]
-
-    def name(i: int) -> str:
-        return f"inputs[{i + 1}] = {format_expression(inputs[i], interval)}"
-
-    parts = []
-    for i, j in pairs[:3]:
-        value = canonical(residual[i, j])
-        at = value.xreplace(dict(defaults))
-        shown = value if len(str(value)) < 30 else sympy.Float(at, 6)
-        if i == j:
-            parts.append(f"{name(i)} carries power by itself (entry ({i + 1}, {i + 1}) = {shown})")
-        else:
-            parts.append(
-                f"{name(i)} and {name(j)} exchange power (entry ({i + 1}, {j + 1}) = {shown})"
-            )
-    hint = (
-        "; an impedance or damper condition is a feedback: write the plain input in "
-        "[ports] and close it with [feedback]"
-        if any(i == j for i, j in pairs)
-        else "; impose only one of each power-conjugate pair"
-    )
-    more = f" (and {len(pairs) - 3} more)" if len(pairs) > 3 else ""
-    return "the inputs are not admissible: W_B Σ W_Bᵀ = 0 fails: " + "; ".join(parts) + more + hint
+__all__ = ["conjugate_outputs"]
 
 
 def conjugate_outputs(
@@ -134,13 +96,6 @@ def conjugate_outputs(
         If the inputs are linearly dependent or not admissible
         (:math:`W_B\Sigma W_B^\top \ne 0`); the message names the input rows.
     """
-    from phdesign.symbolic.ports import (
-        coefficient_matrix,
-        extended_matrices,
-        sigma_matrix,
-        trace_vector,
-    )
-
     n = P[order].shape[0]
     nn = order * n
     U = sympy.Matrix(coefficient_matrix(inputs, order, n, "inputs"))

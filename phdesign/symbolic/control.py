@@ -18,7 +18,7 @@ runs on the measured outputs, and the other inputs :math:`u_r` are free signals
     u_a = -K \hat y_a = -K y_a + K \tilde y_a ,
 
 so the plant is the **controlled plant** (the same PDE closed by :math:`u_a = -K y_a`,
-again a BC-PHS, with the dissipative boundary of :mod:`phdesign.symbolic.feedback`)
+again a BC-PHS, with the dissipative boundary of :mod:`phdesign.symbolic.closing`)
 driven at the actuated port by :math:`K\tilde y_a`.  The observer computes :math:`u`
 itself, so :math:`\tilde u = u - \hat u = -C_m^\top L C_m \tilde y` whatever :math:`u`
 is: the **error system** is autonomous.  In the coordinates :math:`(x, \tilde x)` the
@@ -91,9 +91,13 @@ import sympy
 
 from phdesign.core.errors import LoopError, ObserverError
 from phdesign.symbolic.classify import Classification, classify
+from phdesign.symbolic.closing import close_inputs
 from phdesign.symbolic.expressions import vanishes
+from phdesign.symbolic.feedback import external_indices
 from phdesign.symbolic.model import BCPHS
+from phdesign.symbolic.observer import ObserverDesign
 from phdesign.symbolic.printing import format_expression
+from phdesign.symbolic.propositions import VARIANTS
 from phdesign.symbolic.sensors import gain_matrix
 
 __all__ = [
@@ -256,17 +260,13 @@ def check_measured(actuate: Sequence[int], C_m: sympy.MatrixBase, model: BCPHS) 
 def controlled_plant(model: BCPHS, actuate: Sequence[int], K: sympy.MatrixBase) -> BCPHS:
     r"""Return the plant closed by :math:`u_a = -K y_a`, a BC-PHS with dissipative boundary.
 
-    Its external inputs are the others (:func:`~phdesign.symbolic.feedback.close_inputs`).
+    Its external inputs are the others (:func:`~phdesign.symbolic.closing.close_inputs`).
     """
-    from phdesign.symbolic.feedback import close_inputs
-
     return close_inputs(model, list(actuate), sympy.Matrix(K).tolist())
 
 
 # --------------------------------------------------------------------------- certificates
 def _variant_indices(result: Any, order: int, size: int) -> tuple[int, ...]:
-    from phdesign.symbolic.propositions import VARIANTS
-
     variant = next(
         v for v in VARIANTS if (v.proposition, v.variant) == (result.proposition, result.variant)
     )
@@ -284,9 +284,6 @@ def error_output_bounded(error: Classification, actuate: Sequence[int]) -> bool:
     algebra, gain-free: :math:`G n = 0` on :math:`\ker C_d`).  Then
     :math:`\int_s^\infty |\tilde y_a|^2 \le C \tilde H(s)` (module docstring).
     """
-    from phdesign.symbolic.feedback import external_indices
-    from phdesign.symbolic.observer import ObserverDesign
-
     model = error.model
     es = ObserverDesign(model, error.C_m, error.L).error_system()
     C_d, _ = es.dissipation

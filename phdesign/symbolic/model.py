@@ -1,22 +1,11 @@
-r"""The validated symbolic boundary-controlled port-Hamiltonian system (BC-PHS).
+"""The validated symbolic boundary-controlled port-Hamiltonian system, :class:`BCPHS`.
 
-.. math::
-
-    \partial_t x(z, t) = \sum_{k=0}^{N} P_k \partial_z^k\big(\mathcal H(z) x(z, t)\big),
-    \qquad z \in [a, b],
-
-with constant :math:`P_k^\top = (-1)^{k-1} P_k` for :math:`k \ge 1`,
-:math:`P_0(z) + P_0(z)^\top \preceq 0` on :math:`[a, b]`, :math:`P_N` invertible and
-:math:`\mathcal H(z) = \mathcal H(z)^\top \succeq m I > 0`.  Only :math:`P_0` and
-:math:`\mathcal H` may depend on :math:`z`: the boundary port variables (:math:`Q`,
-:math:`W_B`, :math:`W_C`) and the energy identity are derived for constant
-:math:`P_1, \dots, P_N`, while :math:`P_0` enters the energy balance only through
-:math:`\tfrac12\int e^\top (P_0 + P_0^\top) e\,dz \le 0`, pointwise in :math:`z`.
-Inputs and outputs are linear combinations of the boundary traces
-:math:`\partial_z^k e_i(a)`, :math:`\partial_z^k e_i(b)` of the effort :math:`e = \mathcal H x`
-(:mod:`phdesign.symbolic.expressions`), checked against the port identities of
-:mod:`phdesign.symbolic.ports` when the model is built (:mod:`phdesign.symbolic.validation`
-runs every check).
+The class states the equations and the conditions; building one checks them all
+(:mod:`phdesign.symbolic.validation`) and derives its boundary port variables
+(:mod:`phdesign.symbolic.ports`).  The parts of a definition are read by
+:mod:`phdesign.symbolic.definition`, the ``[feedback]`` by :mod:`phdesign.symbolic.feedback`
+and :mod:`phdesign.symbolic.closing`; a model prints itself through
+:mod:`phdesign.symbolic.display`.
 
 Examples
 --------
@@ -35,61 +24,89 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import sympy
 
-from phdesign.core.checks import found_text
-from phdesign.core.errors import ArgumentError, ExpressionError, ModelError, ParameterError
-from phdesign.core.limits import check_model_dimensions, check_parameter_count
-from phdesign.symbolic.display import ModelDisplay
-from phdesign.symbolic.expressions import (
-    Z,
-    check_parameter_name,
-    exact_number,
-    exactify,
-    parameter_symbol,
-    parse_scalar,
+from phdesign.core.errors import ExpressionError, ModelError, ParameterError
+from phdesign.symbolic import display
+from phdesign.symbolic.closing import ClosedPorts, closed_ports
+from phdesign.symbolic.definition import (
+    Displacement,
+    parse_interval,
+    parse_matrix,
+    parse_P,
+    parse_parameters,
+    parse_ports,
+    parse_units,
 )
-from phdesign.symbolic.feedback import (
-    Feedback,
-    external_indices,
-    feedback_from_mapping,
-)
-from phdesign.symbolic.parser import check_expression
-from phdesign.symbolic.printing import format_expression
-from phdesign.symbolic.traces import parse_trace_expression
+from phdesign.symbolic.expressions import Z, exact_number, parameter_symbol
+from phdesign.symbolic.feedback import Feedback, external_indices, feedback_from_mapping
+from phdesign.symbolic.ports import Ports, derive_ports
+from phdesign.symbolic.system import PortedSystem
 from phdesign.symbolic.validation import validate
 
-if TYPE_CHECKING:  # pragma: no cover - typing only
-    from phdesign.symbolic.ports import Ports
-
-__all__ = ["BCPHS", "Displacement", "Feedback", "Z", "parse_matrix", "require_model"]
-
-
-@dataclass(frozen=True)
-class Displacement:
-    r"""How to recover a physical displacement :math:`w(z, t)` from the state.
-
-    :math:`w` is ``integrations`` antiderivatives of state component ``component``
-    (1-based, of :math:`x`), each from :math:`z = a` with value zero there. For the
-    Euler-Bernoulli beam :math:`x_2 = \partial_z^2 w` and the beam is clamped at
-    :math:`a`, so ``Displacement(component=2, integrations=2)``.
-    """
-
-    component: int
-    integrations: int
+__all__ = ["BCPHS", "Z"]
 
 
 @dataclass(frozen=True, repr=False)
-class BCPHS(ModelDisplay):
-    r"""A validated symbolic BC-PHS (see the module docstring for the equations).
+class BCPHS(PortedSystem):
+    r"""A validated symbolic boundary-controlled port-Hamiltonian system (BC-PHS).
+
+    The state :math:`x(z, t) \in \mathbb R^n` on :math:`z \in [a, b]` and the effort
+    :math:`e = \mathcal H x` obey
+
+    .. math::
+
+        \partial_t x(z, t) = \sum_{k=0}^{N} P_k\, \partial_z^k \big(\mathcal H(z)\, x(z, t)\big),
+        \qquad
+        \mathcal E(t) = \tfrac12 \int_a^b x^\top \mathcal H x \, dz ,
+
+    with
+
+    .. math::
+
+        P_k = (-1)^{k+1} P_k^\top \ (k = 1, \dots, N) \text{ constant}, \qquad
+        P_N \text{ invertible}, \qquad
+        P_0(z) + P_0(z)^\top \preceq 0, \qquad
+        \mathcal H(z) = \mathcal H(z)^\top \succeq m I \succ 0 \ \text{on } [a, b].
+
+    The boundary traces :math:`\phi(z) = (e, \partial_z e, \dots, \partial_z^{N-1} e)(z)`
+    form :math:`v = (\phi(b); \phi(a)) \in \mathbb R^{2Nn}`; integration by parts gives the
+    boundary port variables and the energy balance
+
+    .. math::
+
+        \begin{pmatrix} f_\partial \\ e_\partial \end{pmatrix} = R_{ext} v, \quad
+        R_{ext} = \frac{1}{\sqrt 2}\begin{pmatrix} Q & -Q \\ I & I \end{pmatrix}, \quad
+        Q_{ij} = (-1)^{i-1} P_{i+j-1}, \qquad
+        \dot{\mathcal E} = \tfrac12 \int_a^b e^\top (P_0 + P_0^\top)\, e \, dz
+        + u^\top y ,
+
+    (:mod:`phdesign.symbolic.ports`; the paper's :math:`(-1)^{j-1}` has the wrong sign for
+    even :math:`k`).  The inputs and outputs are trace expressions, :math:`u = U v` and
+    :math:`y = Y v` (``N n`` each); with :math:`W_B = U R_{ext}^{-1}`,
+    :math:`W_C = Y R_{ext}^{-1}` of full rank :math:`Nn` and
+    :math:`\Sigma = \left(\begin{smallmatrix} 0 & I \\ I & 0 \end{smallmatrix}\right)`
+    of size :math:`2Nn`, they satisfy
+
+    .. math::
+
+        W_B \Sigma W_B^\top = 0, \qquad W_C \Sigma W_C^\top = 0, \qquad
+        W_C \Sigma W_B^\top = I .
+
+    Only :math:`P_0` and :math:`\mathcal H` may depend on :math:`z` (and all entries on
+    the parameters).  A ``[feedback]`` closes inputs with :math:`u_c = -K y_c`,
+    :math:`K + K^\top \succeq 0` (:mod:`phdesign.symbolic.feedback`); the others stay the
+    external ports.
 
     Build one with :meth:`define` (from strings and numbers) or from a model file
-    with :func:`phdesign.io.read_model`. Construction validates every condition and
-    raises :class:`~phdesign.core.errors.ModelError`,
+    with :func:`phdesign.io.read_model`. Construction validates every condition
+    (:mod:`phdesign.symbolic.validation`) and raises
+    :class:`~phdesign.core.errors.ModelError`,
     :class:`~phdesign.core.errors.ExpressionError`
-    or :class:`~phdesign.core.errors.PortError` naming what is wrong.
+    or :class:`~phdesign.core.errors.PortError` naming what is wrong; :attr:`checks`
+    says how each condition was verified.
 
     Attributes
     ----------
@@ -149,6 +166,18 @@ class BCPHS(ModelDisplay):
             object.__setattr__(self, "state_names", tuple(f"x{i + 1}" for i in range(self.size)))
         object.__setattr__(self, "checks", tuple(validate(self)))
 
+    # ------------------------------------------------------------------ printing
+    def __repr__(self) -> str:
+        """One line: name, order, size, interval and parameter defaults."""
+        return display.model_repr(self)
+
+    def __str__(self) -> str:
+        """Return the summary ``phdesign show`` prints (:mod:`phdesign.symbolic.display`)."""
+        return display.model_text(self)
+
+    def _repr_html_(self) -> str:
+        return display.model_html(self)
+
     # ------------------------------------------------------------------ construction
     @classmethod
     def define(
@@ -204,51 +233,12 @@ class BCPHS(ModelDisplay):
         """
         if not isinstance(order, int) or isinstance(order, bool) or order < 1:
             raise ModelError(f"order must be an integer N >= 1; found {order!r}")
-        if parameters is not None and not isinstance(parameters, Mapping):
-            raise ModelError(f"parameters must be a table of name = value; found {parameters!r}")
-        check_parameter_count(len(parameters or {}))
-        if isinstance(H, Sequence) and not isinstance(H, str):
-            check_model_dimensions(order, len(H))  # before any entry is parsed
-        names = list(parameters or {})
-        for parameter in names:
-            check_parameter_name(parameter)
-        defaults = tuple(
-            (parameter_symbol(p), exact_number(v, f"parameter {p}"))
-            for p, v in (parameters or {}).items()
-        )
-        endpoints = _interval(interval)
+        names, defaults = parse_parameters(parameters, order, H)
+        endpoints = parse_interval(interval)
         H_matrix = parse_matrix(H, "H", names, allow_z=True)
         size = H_matrix.shape[0]
-        if isinstance(P, str) or not isinstance(P, Mapping | Sequence):
-            raise ModelError(f"P must map k to P_k (or list P_0..P_N); found {P!r}")
-        P_by_order = dict(P) if isinstance(P, Mapping) else dict(enumerate(P))
-        for k in P_by_order:
-            if not isinstance(k, int) or not 0 <= k <= order:
-                raise ModelError(
-                    f"P{k} is not a matrix of an order-{order} model; expected P0..P{order}"
-                )
-        P_matrices = tuple(
-            parse_matrix(P_by_order[k], f"P{k}", names, allow_z=True)
-            if k in P_by_order
-            else sympy.ImmutableMatrix.zeros(size, size)
-            for k in range(order + 1)
-        )
-        derived = outputs is None or outputs == "conjugate"
-        ports = {}
-        for kind, texts in (("inputs", inputs), ("outputs", outputs)):
-            if kind == "outputs" and derived:
-                continue
-            if isinstance(texts, str) or not isinstance(texts, Sequence):
-                expected = ' or "conjugate"' if kind == "outputs" else ""
-                raise ModelError(
-                    f"{kind} must be a list of trace expressions{expected}; found {texts!r}"
-                )
-            ports[kind] = tuple(
-                _port(t, endpoints, order, size, names, what=f"{kind}[{i + 1}]")
-                for i, t in enumerate(texts)
-            )
-        if derived:  # derived in validation, once P_1..P_N are known to be valid
-            ports["outputs"] = ()
+        P_matrices = parse_P(P, order, size, names)
+        ins, outs, derived = parse_ports(inputs, outputs, endpoints, order, size, names)
         return cls(
             name=name,
             interval=endpoints,
@@ -257,13 +247,13 @@ class BCPHS(ModelDisplay):
             P=P_matrices,
             H=H_matrix,
             parameters=defaults,
-            inputs=ports["inputs"],
-            outputs=ports["outputs"],
+            inputs=ins,
+            outputs=outs,
             state_names=tuple(state_names),
             description=description,
             displacement=displacement,
             feedback=None if feedback is None else feedback_from_mapping(feedback, names),
-            units=_unit_pairs(units),
+            units=parse_units(units),
             derived_outputs=derived,
         )
 
@@ -271,9 +261,15 @@ class BCPHS(ModelDisplay):
     @cached_property
     def ports(self) -> Ports:
         """The boundary port structure (:func:`~phdesign.symbolic.ports.derive_ports`), cached."""
-        from phdesign.symbolic.ports import derive_ports
-
         return derive_ports(self)
+
+    @cached_property
+    def closed_ports(self) -> ClosedPorts | None:
+        """The ports closed by :attr:`feedback` (:func:`~phdesign.symbolic.closing.closed_ports`).
+
+        ``None`` for a model without feedback.
+        """
+        return None if self.feedback is None else closed_ports(self)
 
     @property
     def n_ports(self) -> int:
@@ -330,99 +326,3 @@ class BCPHS(ModelDisplay):
             except ExpressionError as error:
                 raise ParameterError(str(error)) from None
         return replace(self, parameters=tuple(updated.items()))
-
-
-# ---------------------------------------------------------------------- helpers
-
-
-def _port(
-    value: object,
-    interval: tuple[sympy.Expr, sympy.Expr],
-    order: int,
-    size: int,
-    parameters: Sequence[str],
-    what: str,
-) -> sympy.Expr:
-    if isinstance(value, str):
-        expr = parse_trace_expression(value, interval, order, size, parameters, what=what)
-    elif isinstance(value, sympy.Expr):
-        expr = check_expression(exactify(value), what)
-    else:
-        raise ExpressionError(
-            f'{what} must be a trace expression such as "e1(0)"; found {type(value).__name__} '
-            f"{value!r}"
-        )
-    # the form that reads back as itself (module docstring of phdesign.io: exact round trips)
-    text = format_expression(expr, interval)
-    return parse_trace_expression(text, interval, order, size, parameters, what=what)
-
-
-def _unit_pairs(units: object) -> tuple[tuple[Any, Any], ...]:
-    if units is None:
-        return ()
-    if not isinstance(units, Mapping):
-        raise ModelError(
-            f"units must be a mapping {{quantity: unit}} such as {{'t': 's'}}; found {units!r}"
-        )
-    return tuple(units.items())
-
-
-def _interval(interval: Sequence[object]) -> tuple[sympy.Expr, sympy.Expr]:
-    if isinstance(interval, str) or not isinstance(interval, Sequence) or len(interval) != 2:
-        raise ModelError(f"interval must be a pair [a, b]; found {interval!r}")
-    a, b = (exact_number(p, "interval endpoint") for p in interval)
-    if not a < b:
-        raise ModelError(f"interval must have a < b; found [{a}, {b}]")
-    return a, b
-
-
-def parse_matrix(
-    value: Any, name: str, parameters: Sequence[str], allow_z: bool = False
-) -> sympy.ImmutableMatrix:
-    """Read a square matrix of numbers or expression strings (rows of a list) exactly."""
-    if isinstance(value, sympy.MatrixBase):
-        rows = value.tolist()
-    elif isinstance(value, Sequence) and not isinstance(value, str):
-        rows = [
-            list(r) if isinstance(r, Sequence) and not isinstance(r, str) else r for r in value
-        ]
-    elif hasattr(value, "tolist"):  # numpy arrays, without importing numpy here
-        rows = value.tolist()
-    else:
-        raise ModelError(
-            f"{name} must be a square matrix given as a list of rows; found {value!r}"
-        )
-    if not rows or not all(isinstance(r, list) for r in rows):
-        raise ModelError(f"{name} must be a non-empty list of rows; found {value!r}")
-    width = len(rows[0])
-    for i, row in enumerate(rows):
-        if len(row) != width:
-            raise ModelError(f"{name} row {i + 1} has {len(row)} entries; expected {width}")
-    if len(rows) != width:
-        raise ModelError(f"{name} must be square; found {len(rows)} x {width}")
-    entries = [
-        [_entry(x, f"{name}[{i + 1},{j + 1}]", parameters, allow_z) for j, x in enumerate(row)]
-        for i, row in enumerate(rows)
-    ]
-    return sympy.ImmutableMatrix(entries)
-
-
-def _entry(value: object, what: str, parameters: Sequence[str], allow_z: bool) -> sympy.Expr:
-    if isinstance(value, str):
-        expr = parse_scalar(value, parameters, allow_z=allow_z, what=what)
-    elif isinstance(value, sympy.Expr):
-        expr = check_expression(exactify(value), what)
-    else:
-        return exact_number(value, what)
-    # sympy builds (z + d)/atan(1) as 4*(d + z)/pi, which reads back as (4*d + 4*z)/pi:
-    # keep the form that reads back as itself, so that written models read back exactly
-    return parse_scalar(format_expression(expr), parameters, allow_z=allow_z, what=what)
-
-
-def require_model(value: object, name: str = "model") -> None:
-    """Raise :class:`ArgumentError` unless ``value`` is a :class:`~phdesign.BCPHS`."""
-    if not isinstance(value, BCPHS):
-        hint = ""
-        if isinstance(value, str):
-            hint = f" (phdesign.load({value!r}) reads a built-in model or a TOML file)"
-        raise ArgumentError(f"{name}: expected a BCPHS model{hint}; found {found_text(value)}")

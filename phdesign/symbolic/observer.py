@@ -67,8 +67,8 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.core.errors import ObserverError
+from phdesign.symbolic.closing import error_dissipation, plant_feedback
 from phdesign.symbolic.expressions import vanishes
-from phdesign.symbolic.feedback import error_dissipation, plant_feedback
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.sensors import (
     caller_matrix,
@@ -80,6 +80,7 @@ from phdesign.symbolic.sensors import (
     sensor_matrix,
     sensors_and_gain,
 )
+from phdesign.symbolic.system import require_model
 
 __all__ = [
     "ErrorSystem",
@@ -133,8 +134,6 @@ def port_inverse(model: BCPHS) -> sympy.ImmutableMatrix:
     [1, 0,  0, 0],
     [0, 0, -1, 0]])
     """
-    from phdesign.symbolic.model import require_model
-
     require_model(model)
     return _inverse(sympy.ImmutableMatrix(sympy.Matrix.vstack(*port_matrices(model))))
 
@@ -174,7 +173,7 @@ class ErrorSystem:
     dissipation_C, dissipation_L : sympy.ImmutableMatrix or None
         The left-hand side of the propositions as
         :math:`\tfrac12 (C_d\tilde y)^\top (L_d + L_d^\top) (C_d\tilde y)`
-        (:func:`phdesign.symbolic.feedback.error_dissipation`); ``None`` means
+        (:func:`phdesign.symbolic.closing.error_dissipation`); ``None`` means
         :math:`C_d = C_m`, :math:`L_d = L` (no plant feedback).
     """
 
@@ -229,7 +228,7 @@ def error_system(
         Sensors over the external outputs and their gain, read by
         :func:`measurement_matrix` and :func:`gain_matrix`.
     feedback : (closed 0-based indices, K), optional
-        The plant's own boundary feedback (:func:`~phdesign.symbolic.feedback.plant_feedback`).
+        The plant's own boundary feedback (:func:`~phdesign.symbolic.closing.plant_feedback`).
 
     Raises
     ------
@@ -280,8 +279,6 @@ class ObserverDesign:
     L: sympy.ImmutableMatrix
 
     def __post_init__(self) -> None:
-        from phdesign.symbolic.model import require_model
-
         require_model(self.model)
         C_m, L = sensors_and_gain(self.C_m, self.L, self.model.n_ports)
         object.__setattr__(self, "C_m", C_m)

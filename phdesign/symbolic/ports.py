@@ -45,10 +45,10 @@ Matrix([
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Any, Protocol
+from typing import Any
 
 import sympy
 from sympy.polys.constructor import construct_domain
@@ -56,34 +56,11 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from phdesign.core.errors import PortError
-from phdesign.symbolic.display import PortsDisplay
+from phdesign.symbolic import display
 from phdesign.symbolic.expressions import canonical, exact_matrix, vanishes
-from phdesign.symbolic.model import require_model
+from phdesign.symbolic.printing import format_expression
+from phdesign.symbolic.system import PortedSystem, require_model
 from phdesign.symbolic.traces import Trace, linear_coefficients, trace_symbol
-
-
-class PortedSystem(Protocol):
-    """What the port derivation reads of a model (a :class:`~phdesign.symbolic.model.BCPHS`).
-
-    A protocol rather than an import keeps this module below the model module, which
-    calls :func:`derive_ports` to validate itself.
-    """
-
-    @property
-    def order(self) -> int: ...
-    @property
-    def size(self) -> int: ...
-    @property
-    def P(self) -> tuple[sympy.ImmutableMatrix, ...]: ...
-    @property
-    def inputs(self) -> tuple[sympy.Expr, ...]: ...
-    @property
-    def outputs(self) -> tuple[sympy.Expr, ...]: ...
-    @property
-    def parameter_defaults(self) -> dict[sympy.Symbol, sympy.Expr]: ...
-    @property
-    def interval(self) -> tuple[sympy.Expr, sympy.Expr]: ...
-
 
 __all__ = [
     "IDENTITY_NAMES",
@@ -91,7 +68,9 @@ __all__ = [
     "coefficient_matrix",
     "derive_ports",
     "extended_matrices",
+    "inadmissible_inputs_message",
     "q_matrix",
+    "sigma_matrix",
     "trace_index",
     "trace_list",
     "trace_vector",
@@ -187,7 +166,7 @@ def coefficient_matrix(
 
 
 @dataclass(frozen=True, repr=False)
-class Ports(PortsDisplay):
+class Ports:
     """The boundary port structure of a model (all matrices exact).
 
     Attributes
@@ -225,6 +204,21 @@ class Ports(PortsDisplay):
     def boundary_variables(self) -> sympy.ImmutableMatrix:
         r"""Return :math:`(f_\partial; e_\partial)` as expressions in the traces."""
         return self.R_ext * sympy.ImmutableMatrix(self.trace_vector)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Return the JSON of ``phdesign ports --json`` (matrices as rows of exact strings)."""
+        return display.ports_dict(self)
+
+    def __str__(self) -> str:
+        """Return what ``phdesign ports`` prints (:mod:`phdesign.symbolic.display`)."""
+        return display.ports_text(self)
+
+    def __repr__(self) -> str:
+        """Short form: the model, the trace vector and whether the identities are exact."""
+        return display.ports_repr(self)
+
+    def _repr_html_(self) -> str:
+        return display.ports_html(self)
 
 
 def sigma_matrix(dimension: int) -> sympy.ImmutableMatrix:
@@ -332,58 +326,9 @@ def derive_ports(model: PortedSystem) -> Ports:
     # over the rationals, clear the denominators: integer products are far cheaper, and
     # each residual below is the true one times a positive constant (same zero test)
     s_Q, Qi = _integral(Q_inv)
-    s_U, Ui = _integral(dU)
-    s_Y, Yi = _integral(dY)
-    U_b, U_a, Y_b, Y_a = Ui[:, :nn], Ui[:, nn:], Yi[:, :nn], Yi[:, nn:]
-    UQ_b, UQ_a, YQ_b, YQ_a = (M * Qi for M in (U_b, U_a, Y_b, Y_a))
-    residuals = {
-        "WB_Sigma_WBt": UQ_b * U_b.transpose() - UQ_a * U_a.transpose(),
-        "WC_Sigma_WCt": YQ_b * Y_b.transpose() - YQ_a * Y_a.transpose(),
-        "WC_Sigma_WBt_minus_I": YQ_b * U_b.transpose()
-        - YQ_a * U_a.transpose()
-        - _identity(nn, Qi) * (s_Y * s_U * s_Q),
-    }
-    scales = {
-        "WB_Sigma_WBt": s_U * s_U * s_Q,
-        "WC_Sigma_WCt": s_Y * s_Y * s_Q,
-        "WC_Sigma_WBt_minus_I": s_Y * s_U * s_Q,
-    }
-    statements = {
-        "WB_Sigma_WBt": "W_B Σ W_Bᵀ = 0",
-        "WC_Sigma_WCt": "W_C Σ W_Cᵀ = 0",
-        "WC_Sigma_WBt_minus_I": "W_C Σ W_Bᵀ = I",
-    }
-    identities: dict[str, sympy.Expr] = {}
-    for key in IDENTITY_NAMES:
-        if _exact_zero(residuals[key]):
-            identities[key] = sympy.Integer(0)
-            continue
-        scale = Qi.domain.to_sympy(scales[key])
-        residual = residuals[key].to_Matrix().applyfunc(lambda x, c=scale: canonical(x / c))
-        largest = _max_abs(residual, defaults)
-        if key == "WB_Sigma_WBt":  # the inputs alone are wrong: say so, naming them
-            from phdesign.symbolic.conjugate import inadmissible_inputs_message
-
-            raise PortError(
-                inadmissible_inputs_message(residual, model.inputs, model.interval, defaults)
-            )
-        at = " at the parameter defaults" if residual.free_symbols else ""
-        raise PortError(
-            f"port identity {statements[key]} fails: largest residual |entry| = "
-            f"{_short(largest)}{at}; the outputs must be the power conjugates of the inputs"
-        )
+    u, y = _Halves.of(dU, Qi, nn), _Halves.of(dY, Qi, nn)
+    identities = _identities(u, y, Qi, s_Q, model)
     half = sympy.sqrt(2) / 2
-
-    def port_map(
-        b_half: DomainMatrix, a_half: DomainMatrix, bq: DomainMatrix, aq: DomainMatrix, s: Any
-    ) -> sympy.ImmutableMatrix:
-        # W = (1/sqrt 2) ((M_b - M_a) Q^-1, M_b + M_a) with M = (b_half, a_half) / s
-        c_left = half / Qi.domain.to_sympy(s * s_Q)
-        c_right = half / Qi.domain.to_sympy(s)
-        left = (bq - aq).to_Matrix().applyfunc(lambda x: c_left * x)
-        right = (b_half + a_half).to_Matrix().applyfunc(lambda x: c_right * x)
-        return sympy.ImmutableMatrix(sympy.Matrix.hstack(left, right))
-
     eye = sympy.eye(nn)
     R_ext = sympy.ImmutableMatrix(
         sympy.Matrix.vstack(sympy.Matrix.hstack(Q, -Q), sympy.Matrix.hstack(eye, eye)).applyfunc(
@@ -396,12 +341,136 @@ def derive_ports(model: PortedSystem) -> Ports:
         R_ext=R_ext,
         U=U,
         Y=Y,
-        W_B=port_map(U_b, U_a, UQ_b, UQ_a, s_U),
-        W_C=port_map(Y_b, Y_a, YQ_b, YQ_a, s_Y),
+        W_B=u.port_map(Qi, s_Q),
+        W_C=y.port_map(Qi, s_Q),
         Sigma=sigma_matrix(nn),
         identities=identities,
         model=model,
     )
+
+
+@dataclass(frozen=True)
+class _Halves:
+    r"""A port matrix :math:`M = (M_b\ M_a)/s` over an exact domain, split by the halves of ``v``.
+
+    ``b``, ``a`` are the halves of :math:`sM` (integers over the rationals), ``bq``, ``aq``
+    the halves times the cleared :math:`s_Q Q^{-1}`.
+    """
+
+    b: DomainMatrix
+    a: DomainMatrix
+    bq: DomainMatrix
+    aq: DomainMatrix
+    scale: Any
+
+    @classmethod
+    def of(cls, M: DomainMatrix, Qi: DomainMatrix, nn: int) -> _Halves:
+        scale, Mi = _integral(M)
+        b, a = Mi[:, :nn], Mi[:, nn:]
+        return cls(b, a, b * Qi, a * Qi, scale)
+
+    def form(self, other: _Halves) -> DomainMatrix:
+        r"""Return :math:`M_b Q^{-1} N_b^\top - M_a Q^{-1} N_a^\top`.
+
+        That is :math:`W_M \Sigma W_N^\top` times the positive scales cleared by
+        :func:`_integral` (:func:`derive_ports`).
+        """
+        return self.bq * other.b.transpose() - self.aq * other.a.transpose()
+
+    def port_map(self, Qi: DomainMatrix, s_Q: Any) -> sympy.ImmutableMatrix:
+        r"""Return :math:`W = (1/\sqrt 2)((M_b - M_a) Q^{-1}, M_b + M_a)`, exact."""
+        half = sympy.sqrt(2) / 2
+        c_left = half / Qi.domain.to_sympy(self.scale * s_Q)
+        c_right = half / Qi.domain.to_sympy(self.scale)
+        left = (self.bq - self.aq).to_Matrix().applyfunc(lambda x: c_left * x)
+        right = (self.b + self.a).to_Matrix().applyfunc(lambda x: c_right * x)
+        return sympy.ImmutableMatrix(sympy.Matrix.hstack(left, right))
+
+
+def _identities(
+    u: _Halves, y: _Halves, Qi: DomainMatrix, s_Q: Any, model: PortedSystem
+) -> dict[str, sympy.Expr]:
+    r"""Check the three identities exactly; return their residuals (all zero) by name.
+
+    Raises
+    ------
+    PortError
+        Naming the identity that fails (the input rows, when :math:`W_B\Sigma W_B^\top \ne 0`).
+    """
+    nn = u.b.shape[0]
+    residuals = {
+        "WB_Sigma_WBt": (u.form(u), u.scale * u.scale * s_Q),
+        "WC_Sigma_WCt": (y.form(y), y.scale * y.scale * s_Q),
+        "WC_Sigma_WBt_minus_I": (
+            y.form(u) - _identity(nn, Qi) * (y.scale * u.scale * s_Q),
+            y.scale * u.scale * s_Q,
+        ),
+    }
+    defaults = model.parameter_defaults
+    identities: dict[str, sympy.Expr] = {}
+    for key in IDENTITY_NAMES:
+        exact, cleared = residuals[key]
+        if _exact_zero(exact):
+            identities[key] = sympy.Integer(0)
+            continue
+        scale = Qi.domain.to_sympy(cleared)
+        residual = exact.to_Matrix().applyfunc(lambda x, c=scale: canonical(x / c))
+        largest = _max_abs(residual, defaults)
+        if key == "WB_Sigma_WBt":  # the inputs alone are wrong: say so, naming them
+            raise PortError(
+                inadmissible_inputs_message(residual, model.inputs, model.interval, defaults)
+            )
+        at = " at the parameter defaults" if residual.free_symbols else ""
+        raise PortError(
+            f"port identity {display.IDENTITY_STATEMENTS[key]} fails: largest residual "
+            f"|entry| = {_short(largest)}{at}; the outputs must be the "
+            "power conjugates of the inputs"
+        )
+    return identities
+
+
+def inadmissible_inputs_message(
+    residual: sympy.MatrixBase,
+    inputs: Sequence[sympy.Expr],
+    interval: Sequence[object],
+    defaults: Mapping[sympy.Symbol, sympy.Expr],
+) -> str:
+    r"""Explain why :math:`W_B \Sigma W_B^\top \ne 0`, naming the input rows.
+
+    Entry :math:`(i, j)` is twice the power that inputs ``i`` and ``j`` exchange: an
+    input pair such as a velocity and a force at the same end cannot both be imposed, and
+    a diagonal entry means input ``i`` carries power by itself (an impedance condition
+    such as ``e2(1) + c*e1(1)``: a feedback, which ``[feedback]`` expresses).
+    """
+    pairs = [
+        (i, j)
+        for i in range(residual.rows)
+        for j in range(i, residual.cols)
+        if not vanishes(residual[i, j])
+    ]
+
+    def name(i: int) -> str:
+        return f"inputs[{i + 1}] = {format_expression(inputs[i], interval)}"
+
+    parts = []
+    for i, j in pairs[:3]:
+        value = canonical(residual[i, j])
+        at = value.xreplace(dict(defaults))
+        shown = value if len(str(value)) < 30 else sympy.Float(at, 6)
+        if i == j:
+            parts.append(f"{name(i)} carries power by itself (entry ({i + 1}, {i + 1}) = {shown})")
+        else:
+            parts.append(
+                f"{name(i)} and {name(j)} exchange power (entry ({i + 1}, {j + 1}) = {shown})"
+            )
+    hint = (
+        "; an impedance or damper condition is a feedback: write the plain input in "
+        "[ports] and close it with [feedback]"
+        if any(i == j for i, j in pairs)
+        else "; impose only one of each power-conjugate pair"
+    )
+    more = f" (and {len(pairs) - 3} more)" if len(pairs) > 3 else ""
+    return "the inputs are not admissible: W_B Σ W_Bᵀ = 0 fails: " + "; ".join(parts) + more + hint
 
 
 def _max_abs(matrix: sympy.MatrixBase, defaults: dict[sympy.Symbol, sympy.Expr]) -> sympy.Expr:

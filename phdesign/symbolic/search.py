@@ -66,11 +66,13 @@ from phdesign.core.text import (
     shorten,
 )
 from phdesign.symbolic.assumption import Partition, model_assumption
+from phdesign.symbolic.closing import plant_feedback
 from phdesign.symbolic.expressions import vanishes
-from phdesign.symbolic.feedback import external_indices, plant_feedback
-from phdesign.symbolic.model import BCPHS, require_model
+from phdesign.symbolic.feedback import external_indices
+from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import gain_matrix, port_inverse
 from phdesign.symbolic.propositions import VERDICTS, Case, strength, variant_cases, verdict_of
+from phdesign.symbolic.system import require_model
 
 __all__ = ["Candidate", "SensorSearch", "SubsetResult", "candidates", "search_sensors"]
 

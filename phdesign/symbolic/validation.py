@@ -24,10 +24,12 @@ from phdesign.core.errors import (
     check_shape,
 )
 from phdesign.core.limits import check_model_dimensions, check_parameter_count
+from phdesign.symbolic.closing import closed_ports
 from phdesign.symbolic.conjugate import conjugate_outputs
 from phdesign.symbolic.definiteness import check_definite
+from phdesign.symbolic.definition import Displacement
 from phdesign.symbolic.expressions import Z, canonical, vanishes
-from phdesign.symbolic.feedback import check_feedback
+from phdesign.symbolic.feedback import check_feedback_indices
 from phdesign.symbolic.parser import brief, check_expression
 from phdesign.symbolic.traces import linear_coefficients, trace_of
 from phdesign.symbolic.units import check_units
@@ -35,30 +37,29 @@ from phdesign.symbolic.units import check_units
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.model import BCPHS
 
-__all__ = ["check_finite", "check_symbols", "validate"]
-
-
-def _check_displacement(d: object, n: int) -> None:
-    """Refuse a displacement that is not a Displacement of a component in 1..n."""
-    from phdesign.symbolic.model import Displacement  # model imports this module
-
-    if not isinstance(d, Displacement) or not all(
-        type(v) is int for v in (d.component, d.integrations)
-    ):
-        raise ArgumentError(
-            "displacement must be a Displacement(component=i, integrations=k) of two "
-            f"integers; found {type(d).__name__} {brief(d, 60)}"
-        )
-    if not (1 <= d.component <= n) or d.integrations < 0:
-        raise ModelError(
-            f"displacement must name a component in 1..{n} and integrations >= 0; "
-            f"found component {d.component}, integrations {d.integrations}"
-        )
+__all__ = ["check_feedback", "check_finite", "check_symbols", "validate"]
 
 
 def validate(model: BCPHS) -> list[str]:
     """Check every structural condition; return how each one was verified."""
-    checks: list[str] = []
+    _check_sizes(model)
+    symbols = {s for s, _ in model.parameters}
+    defaults = model.parameter_defaults
+    _check_entries(model, symbols, defaults)
+    checks = _check_matrices(model, defaults)
+    if model.displacement is not None:
+        _check_displacement(model.displacement, model.size)
+    object.__setattr__(
+        model, "units", check_units(model.units, model.parameter_names, model.state_names)
+    )
+    checks += _check_all_ports(model, symbols, defaults)
+    if model.feedback is not None:
+        checks += check_feedback(model, symbols, defaults)
+    return checks
+
+
+def _check_sizes(model: BCPHS) -> None:
+    """Check the name, N, n, the interval, the shapes of P_k and H, budgets and labels."""
     if not isinstance(model.name, str) or not model.name.strip():
         raise ModelError(f"name must be non-empty text; found {model.name!r}")
     if not isinstance(model.order, int) or isinstance(model.order, bool) or model.order < 1:
@@ -78,7 +79,11 @@ def validate(model: BCPHS) -> list[str]:
     check_parameter_count(len(model.parameters))
     _check_state_names(model.state_names, n)
 
-    symbols = {s for s, _ in model.parameters}
+
+def _check_entries(
+    model: BCPHS, symbols: set[sympy.Symbol], defaults: Mapping[sympy.Symbol, sympy.Expr]
+) -> None:
+    """Numeric defaults; z only in P_0 and H; known symbols; entries the parser could build."""
     for s, value in model.parameters:
         if not value.is_number:
             raise ParameterError(f"default of parameter {s} must be a number; found {value}")
@@ -89,11 +94,18 @@ def validate(model: BCPHS) -> list[str]:
     for matrix, label in ((model.H, "H"), *((P_k, f"P{k}") for k, P_k in enumerate(model.P))):
         for (i, j), entry in sympy.ImmutableMatrix(matrix).todok().items():
             check_expression(entry, f"{label}[{i + 1},{j + 1}]")
-
-    defaults = model.parameter_defaults
     for k, P_k in enumerate(model.P):
         check_finite(P_k, f"P{k}", defaults)
     check_finite(model.H, "H", defaults)
+
+
+def _check_matrices(model: BCPHS, defaults: Mapping[sympy.Symbol, sympy.Expr]) -> list[str]:
+    r"""Check the conditions on the matrices; return how each one was verified.
+
+    :math:`P_k^\top = (-1)^{k-1} P_k`, :math:`P_0 + P_0^\top \preceq 0`, :math:`P_N`
+    invertible, :math:`\mathcal H = \mathcal H^\top \succ 0`.
+    """
+    N = model.order
     for k in range(1, N + 1):
         sign = (-1) ** (k - 1)
         residual = (model.P[k].T - sign * model.P[k]).applyfunc(canonical)
@@ -103,7 +115,7 @@ def validate(model: BCPHS) -> list[str]:
                 f"P{k} must satisfy {relation} (k = {k}); found P{k}^T - ({sign})*P{k} = "
                 f"{residual.tolist()}"
             )
-    checks.append("P_k symmetry: exact")
+    checks = ["P_k symmetry: exact"]
     P0_sym = model.P[0] + model.P[0].T
     checks.append(
         check_definite(P0_sym, "P0 + P0^T", model.interval, defaults, sign=-1, strict=False)
@@ -113,22 +125,62 @@ def validate(model: BCPHS) -> list[str]:
     if not all(vanishes(x) for x in residual):
         raise ModelError(f"H must be symmetric; found H - H^T = {residual.tolist()}")
     checks.append(check_definite(model.H, "H", model.interval, defaults))
-    if model.displacement is not None:
-        _check_displacement(model.displacement, n)
-    object.__setattr__(
-        model, "units", check_units(model.units, model.parameter_names, model.state_names)
-    )
+    return checks
+
+
+def _check_all_ports(
+    model: BCPHS, symbols: set[sympy.Symbol], defaults: Mapping[sympy.Symbol, sympy.Expr]
+) -> list[str]:
+    """Check the inputs, the outputs (derived when asked) and the port identities."""
+    checks = []
     _check_ports(model, symbols, ("inputs",))
     if model.derived_outputs and not model.outputs:
-        outputs = conjugate_outputs(model.P, N, model.inputs, model.interval, defaults)
+        outputs = conjugate_outputs(model.P, model.order, model.inputs, model.interval, defaults)
         object.__setattr__(model, "outputs", outputs)
         checks.append("outputs: derived, the least-norm power conjugates of the inputs")
     _check_ports(model, symbols, ("outputs",))
     model.ports  # noqa: B018 - derives the ports (checking the identities) and caches them
     checks.append("port identities: exact")
-    if model.feedback is not None:
-        checks += check_feedback(model, symbols, defaults)
     return checks
+
+
+def check_feedback(
+    model: BCPHS, symbols: set[sympy.Symbol], defaults: Mapping[sympy.Symbol, sympy.Expr]
+) -> list[str]:
+    r"""Validate the model's feedback: indices, gain, :math:`K + K^\top \succeq 0`, identities.
+
+    Returns how each condition was checked (nothing without a feedback).
+    """
+    feedback = model.feedback
+    if feedback is None:
+        return []
+    check_feedback_indices(feedback, model.order * model.size)
+    K = feedback.gain
+    if Z in K.free_symbols:
+        raise ModelError("feedback gain K must not depend on z; it acts at the boundary")
+    check_symbols(K, "feedback gain K", symbols)
+    check_finite(K, "feedback gain K", defaults)
+    dissipative = check_definite(
+        K + K.T, "K + K^T", model.interval, defaults, sign=1, strict=False
+    )
+    closed_ports(model)
+    return [f"feedback {dissipative}", "closed-plant identities: exact"]
+
+
+def _check_displacement(d: object, n: int) -> None:
+    """Refuse a displacement that is not a Displacement of a component in 1..n."""
+    if not isinstance(d, Displacement) or not all(
+        type(v) is int for v in (d.component, d.integrations)
+    ):
+        raise ArgumentError(
+            "displacement must be a Displacement(component=i, integrations=k) of two "
+            f"integers; found {type(d).__name__} {brief(d, 60)}"
+        )
+    if not (1 <= d.component <= n) or d.integrations < 0:
+        raise ModelError(
+            f"displacement must name a component in 1..{n} and integrations >= 0; "
+            f"found component {d.component}, integrations {d.integrations}"
+        )
 
 
 #: Characters a state label may not hold: they separate the items of an initial state.

@@ -25,7 +25,7 @@ from phdesign.numeric.spectrum.converged import spectrum
 from phdesign.numeric.statespace import plant_statespace
 from phdesign.numeric.time.simulation import simulate
 from phdesign.symbolic.classify import classify
-from phdesign.symbolic.feedback import close_inputs, closed_ports
+from phdesign.symbolic.closing import close_inputs, closed_ports
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 from phdesign.symbolic.ports import derive_ports, q_matrix

@@ -16,6 +16,7 @@ from phdesign.core.errors import LoopError, ObserverError
 from phdesign.design.loop import Loop
 from phdesign.models import load_builtin
 from phdesign.symbolic.classify import classify
+from phdesign.symbolic.closing import close_inputs
 from phdesign.symbolic.control import (
     classify_loop,
     controlled_plant,
@@ -23,7 +24,6 @@ from phdesign.symbolic.control import (
     feedback_gain,
     loop_verdict,
 )
-from phdesign.symbolic.feedback import close_inputs
 from phdesign.symbolic.observer import gain_matrix, sensor_matrix
 
 BEAM = load_builtin("euler-bernoulli")

@@ -14,7 +14,7 @@ closed system is again port-Hamiltonian, exactly:
 
 so its energy balance :math:`\dot H_d = -\hat e^\top R \hat e - y_c^\top
 \operatorname{sym}(K) y_c + u_r^\top y_r` carries the damper's dissipation in :math:`R`.
-This is the discrete counterpart of :mod:`phdesign.symbolic.feedback`;
+This is the discrete counterpart of :mod:`phdesign.symbolic.closing`;
 :func:`close_plant_feedback` applies a model's own ``[feedback]`` to its discretization,
 and :func:`close_ports` is the reusable step (a controller's :math:`u = -K y` as well).
 

@@ -29,7 +29,7 @@ from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.time.simulation import simulate
-from phdesign.symbolic.feedback import close_inputs
+from phdesign.symbolic.closing import close_inputs
 
 BEAM = load_builtin("euler-bernoulli")
 

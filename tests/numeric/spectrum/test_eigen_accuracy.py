@@ -29,7 +29,7 @@ from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.scales import problem_scales
 from phdesign.numeric.spectrum.converged import eigen, spectrum
 from phdesign.numeric.spectrum.refinement import choose_pair, refine
-from phdesign.symbolic.feedback import close_inputs
+from phdesign.symbolic.closing import close_inputs
 
 BEAM = load_builtin("euler-bernoulli")
 
