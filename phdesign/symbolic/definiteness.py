@@ -26,32 +26,11 @@ minor is :math:`\ge 0`: no factor of odd multiplicity has a root inside :math:`(
 and :math:`p > 0` at a point where it does not vanish.
 
 *Otherwise* (transcendental entries, algebraic coefficients, or over budget, which the
-returned line says): for :math:`\succ 0`, the smallest eigenvalue on a grid of
-:data:`POSITIVITY_GRID_POINTS` points, then a proof on every cell :math:`[z_i, z_{i+1}]`:
-
-.. math::
-
-    \lambda_{\min}(S(z)) \ge \lambda_{\min}(S(m)) - \|R\|_F, \qquad
-    R_{jk} = \max_{z \in [z_i, z_{i+1}]} |S_{jk}(z) - S_{jk}(m)|,
-
-(Weyl's inequality, :math:`m` the midpoint, :math:`R` bounded by interval arithmetic,
-:mod:`phdesign.symbolic.evaluation`); a cell that this does not prove positive is halved,
-so a sharp dip between grid points is found (and refused with its location) instead of
-being stepped over.  Gershgorin's discs of the enclosed entries,
-:math:`\lambda_{\min} \ge \min_i (\underline{S_{ii}} - \sum_{j \ne i} \max |S_{ij}|)`, give
-a second bound, and each cell keeps the better of the two.
-
-For :math:`\succeq 0` the same proof runs with the threshold :math:`-\tau` instead of 0,
-:math:`\tau = 10^{-12}` times the matrix's scale: floating point cannot prove an
-eigenvalue that touches 0 non-negative, so what is proved is
-:math:`\lambda_{\min}(S(z)) \ge -\tau` for every :math:`z \in [a, b]` (cells near a
-touching point shrink until their bound meets :math:`-\tau`).  A constant kernel of
-:math:`S` (a damping on some components only, or on a fixed combination of them) is set
-aside first, exactly (``_without_constant_kernel``): it adds the eigenvalue 0 and
-nothing else, and would otherwise keep every bound below 0.  A cell the budget cannot
-close is refused with its location, never accepted on the strength of samples; so is
-any sample below :math:`-\tau`, which is how a narrow violation between grid points (a
-bump of width :math:`10^{-5}`) is found.
+returned line says): the smallest eigenvalue on a grid, then a proof on every cell
+between its points by interval bounds (Weyl's inequality and Gershgorin's discs), for
+:math:`\succeq 0` to a tolerance :math:`\tau` that counts as 0
+(:mod:`phdesign.symbolic.grid_proof`).  A cell that cannot be closed is refused with its
+location, never accepted on the strength of samples.
 
 Examples
 --------
@@ -71,24 +50,17 @@ from typing import Any
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
-from phdesign.core.errors import ExpressionError, ModelError
+from phdesign.core.errors import ModelError
 from phdesign.core.limits import (
     EXACT_DEFINITENESS_BITS,
     EXACT_DEFINITENESS_DEGREE,
     EXACT_DEFINITENESS_SIZE,
 )
 from phdesign.symbolic.expressions import Z, exact_matrix, exact_number
+from phdesign.symbolic.grid_proof import Question, on_grid
 from phdesign.symbolic.parser import brief
 
-__all__ = ["POSITIVITY_GRID_POINTS", "check_definite"]
-
-#: Points of the first grid of the numeric check (cells between them are then proved).
-POSITIVITY_GRID_POINTS = 2001
-#: Halvings of a cell the numeric proof may make, and cells it may examine in all.
-_MAX_HALVINGS = 40
-_MAX_CELLS = 400_000
-#: Relative size under which an eigenvalue counts as zero in the semidefinite check.
-_SEMIDEFINITE_TOLERANCE = 1e-12
+__all__ = ["check_definite"]
 
 _KINDS = {
     (1, True): ("positive definite", ">"),
@@ -148,7 +120,7 @@ def check_definite(
         raise ModelError(f"{name}: the interval must have a < b; found [{a}, {b}]")
     if defaults is not None and not isinstance(defaults, Mapping):
         raise ModelError(f"{name}: defaults must map parameters to values; found {defaults!r}")
-    check = _Check(name, kind, sign, bool(strict), (a, b))
+    check = _Check(name, kind, sign, bool(strict), a, b)
     M = exact_matrix(matrix, name, symbols=True)
     if M.rows != M.cols:
         raise ModelError(f"{name} must be square; found {M.rows} x {M.cols}")
@@ -162,13 +134,8 @@ def check_definite(
     return f"{name} {relation} 0: " + check.run(M, at)
 
 
-class _Check:
-    """One definiteness question: the matrix's name, the relation and the interval."""
-
-    def __init__(self, name: str, kind: str, sign: int, strict: bool, interval: Any) -> None:
-        self.name, self.kind, self.sign, self.strict = name, kind, sign, strict
-        self.a, self.b = interval
-        self.where = f"[{self.a}, {self.b}]"
+class _Check(Question):
+    """A definiteness question with its two paths: exact (here) and on a grid."""
 
     # ------------------------------------------------------------------ dispatch
     def run(self, M: sympy.ImmutableMatrix, at: str) -> str:
@@ -178,7 +145,7 @@ class _Check:
         exact, reason = self.exactly(M, S)
         if exact is not None:
             return exact
-        how = self.numerically(M, S)
+        how = on_grid(self, S)
         return how if reason is None else f"{how}; exact check skipped: {reason}"
 
     def constant(self, M: sympy.MatrixBase, S: sympy.MatrixBase, at: str) -> str:
@@ -187,7 +154,7 @@ class _Check:
         if decided:
             return how
         if decided is None:  # sympy cannot decide these constants exactly: evaluate them
-            return self.numerically(M, S)
+            return on_grid(self, S)
         raise ModelError(
             f"{self.name} must be {self.kind} ({how}); found eigenvalues {_eigenvalues(M)}"
         )
@@ -295,208 +262,8 @@ class _Check:
             "(parameter defaults)"
         )
 
-    # ------------------------------------------------------------------ numeric path
-    def numerically(self, M: sympy.MatrixBase, S: sympy.MatrixBase) -> str:
-        """Decide on a grid, then prove every cell between its points by interval bounds.
-
-        Strict: every cell must have a bound > 0.  Semidefinite: rows and columns that
-        are identically zero are set aside first (a zero row of a symmetric matrix adds
-        the eigenvalue 0 and nothing else), and every cell of the rest must have a bound
-        of at least ``-tolerance`` (:data:`_SEMIDEFINITE_TOLERANCE` times the matrix's
-        scale), the eigenvalue that "counts as 0": where an eigenvalue touches 0 the cells
-        shrink until the bound meets it.  A cell that cannot be closed within the budget
-        is refused, never accepted on the strength of its samples.
-        """
-        import numpy as np  # the numeric check only (the symbolic layer stays light)
-
-        from phdesign.symbolic.evaluation import enclose, evaluate
-
-        a, b = float(self.a), float(self.b)
-        kernel: sympy.MatrixBase | None = None
-        if not self.strict:
-            kernel, S = _without_constant_kernel(S, a, b, self.name)
-            if S.rows == 0:
-                return "identically zero on [a, b]"
-        n = S.rows
-        entries = [(i, j) for i in range(n) for j in range(i, n)]
-
-        def values(z: np.ndarray) -> np.ndarray:
-            out = np.empty((z.size, n, n))
-            for i, j in entries:
-                out[:, i, j] = out[:, j, i] = _evaluate(evaluate, S[i, j], z, self.name)
-            return out
-
-        def smallest(z: np.ndarray) -> np.ndarray:
-            V = values(z)
-            if not np.all(np.isfinite(V)):
-                bad = z[~np.all(np.isfinite(V), axis=(1, 2))][0]
-                raise ModelError(
-                    f"{self.name} must be bounded on {self.where}; found a non-finite entry "
-                    f"at z = {bad:g}"
-                )
-            return np.linalg.eigvalsh(V)[:, 0]
-
-        grid = np.linspace(a, b, POSITIVITY_GRID_POINTS)
-        lam = smallest(grid)
-        scale = max(1.0, float(np.max(np.abs(values(grid)))))
-        tolerance = 0.0 if self.strict else _SEMIDEFINITE_TOLERANCE * scale
-
-        def violated(value: float) -> bool:
-            return value <= 0 if self.strict else value < -tolerance
-
-        worst = int(np.argmin(lam))
-        if violated(lam[worst]):
-            self.fail_point(lam[worst], grid[worst])
-        lo, hi = grid[:-1], grid[1:]
-        examined, lowest = 0, (float(lam[worst]), float(grid[worst]))
-        for _ in range(_MAX_HALVINGS):
-            mid = 0.5 * (lo + hi)
-            lam_mid = smallest(mid)
-            k = int(np.argmin(lam_mid))
-            if lam_mid[k] < lowest[0]:
-                lowest = (float(lam_mid[k]), float(mid[k]))
-            if violated(lam_mid[k]):
-                self.fail_point(lam_mid[k], mid[k])
-            radius = np.zeros((lo.size, n, n))
-            reach = np.zeros((lo.size, n, n))  # |S_ij| <= reach_ij off the diagonal
-            floor = np.zeros((lo.size, n))  # S_ii >= floor_i
-            centre = values(mid)
-            for i, j in entries:
-                low, high = enclose(S[i, j], lo, hi)
-                r = np.maximum(high - centre[:, i, j], centre[:, i, j] - low)
-                radius[:, i, j] = radius[:, j, i] = r
-                if i == j:
-                    floor[:, i] = low
-                else:
-                    reach[:, i, j] = reach[:, j, i] = np.maximum(np.abs(low), np.abs(high))
-            # two lower bounds of the smallest eigenvalue on the cell, the better one kept:
-            # Weyl about the midpoint, and Gershgorin's discs of the interval matrix (sharp
-            # where an entry touches 0 while the others stay away: diag(sin(2 pi z)^2, e^z))
-            # each less round-off in its own magnitudes (the cell's, the row's): one from the
-            # largest entry left diag(exp(30 z), 1) unproved (1e-13 e³⁰ > 1 = λ_min)
-            cell = np.max(np.abs(centre) + radius, axis=(1, 2))
-            weyl = lam_mid - np.sqrt(np.sum(radius**2, axis=(1, 2))) - _allowance(cell, n)
-            row = np.abs(floor) + np.sum(reach, axis=2)
-            gershgorin = np.min(floor - np.sum(reach, axis=2) - _allowance(row, n), axis=1)
-            bound = np.maximum(weyl, gershgorin)
-            open_cells = ~(bound > 0) if self.strict else ~(bound >= -tolerance)
-            examined += lo.size
-            if not np.any(open_cells):
-                return self.proved(lowest, tolerance, kernel)
-            lo, hi, mid = lo[open_cells], hi[open_cells], mid[open_cells]
-            if examined + 2 * lo.size > _MAX_CELLS:
-                break
-            lo, hi = np.concatenate([lo, mid]), np.concatenate([mid, hi])
-        which, shown = self.extreme(lowest[0])
-        if self.strict:
-            raise ModelError(
-                f"{self.name} must be {self.kind} on {self.where}; it could not be proved "
-                f"near z = {lo[0]:g} ({which} eigenvalue found {shown:.6g} at z = "
-                f"{lowest[1]:g}; interval bounds of the entries do not separate it from 0) "
-                "(parameter defaults)"
-            )
-        raise ModelError(
-            f"{self.name} must be {self.kind} on {self.where}; it could not be decided near "
-            f"z = {lo[0]:g} within the budget of {_MAX_CELLS} cells: an eigenvalue stays "
-            f"within {tolerance:.3g} of 0 there ({which} eigenvalue sampled {shown:.6g} at "
-            f"z = {lowest[1]:g}) and interval bounds of the entries do not bound it away "
-            "from the wrong side; write the entries as rational functions of z (decided "
-            "exactly) (parameter defaults)"
-        )
-
-    def extreme(self, value: float) -> tuple[str, float]:
-        """Name and value of the eigenvalue of M that ``value`` (of S = ±M) stands for."""
-        return ("smallest", value + 0.0) if self.sign == 1 else ("largest", 0.0 - value)
-
-    def proved(
-        self, lowest: tuple[float, float], tolerance: float, kernel: sympy.MatrixBase | None
-    ) -> str:
-        """Return the line that says what the interval proof established."""
-        which, shown = self.extreme(lowest[0])
-        how = (
-            f"on a grid of {POSITIVITY_GRID_POINTS} points at the parameter defaults, proved "
-            "between the points by interval bounds"
-        )
-        if self.strict:
-            return f"{how} ({which} eigenvalue {shown:.6g} at z = {lowest[1]:g})"
-        aside = ""
-        if kernel is not None:
-            vectors = ", ".join(
-                "(" + ", ".join(str(x) for x in kernel[:, j]) + ")" for j in range(kernel.cols)
-            )
-            aside = f"; its constant kernel {vectors} set aside"
-        return (
-            f"{how} to {tolerance:.3g} (eigenvalues within {tolerance:.3g} of 0 count as 0; "
-            f"{which} eigenvalue {shown:.6g} at z = {lowest[1]:g}{aside})"
-        )
-
-    def fail_point(self, value: float, z: float) -> None:
-        which, shown = self.extreme(value)
-        raise ModelError(
-            f"{self.name} must be {self.kind} on {self.where}; found "
-            f"{which} eigenvalue {shown:.6g} at z = {z:g} (parameter defaults)"
-        )
-
 
 # ---------------------------------------------------------------------- helpers
-def _allowance(magnitude: Any, n: int) -> Any:
-    """Round-off of a bound from outward-rounded entries of this magnitude (relative)."""
-    import numpy as np
-
-    return 1e-13 * n * np.maximum(magnitude, 1e-300)  # the floor: entries that underflow
-
-
-def _without_constant_kernel(
-    S: sympy.MatrixBase, a: float, b: float, name: str
-) -> tuple[sympy.MatrixBase | None, sympy.MatrixBase]:
-    r"""Return ``(N, B^T S B)``: the constant kernel of S set aside, exactly; or ``(None, S)``.
-
-    If :math:`S(z) N = 0` for every z with a constant N of full column rank, then in the
-    basis :math:`(B\ N)`, B a basis of :math:`N^\perp`, :math:`S` is
-    :math:`\mathrm{diag}(B^\top S B, 0)` (congruence keeps the inertia), so
-    :math:`S \succeq 0` iff :math:`B^\top S B \succeq 0`.  Without this, a kernel that
-    persists (a damping on some components only, or on a combination of them) keeps the
-    smallest eigenvalue at 0 on every cell while the entries vary, and no interval bound
-    could close a cell.  The candidate N is read from samples (their common null space),
-    rounded to rationals and then *verified exactly*, :math:`S N = 0` symbolically; a
-    candidate that fails the verification is not used.
-    """
-    import numpy as np
-
-    from phdesign.symbolic.evaluation import evaluate
-
-    n = S.rows
-    points = a + (b - a) * np.array([0.0, 0.1234, 0.3571, 0.5, 0.7071, 0.9123, 1.0])
-    samples = np.empty((points.size, n, n))
-    for i in range(n):
-        for j in range(n):
-            samples[:, i, j] = _evaluate(evaluate, S[i, j], points, name)
-    if not np.all(np.isfinite(samples)):
-        return None, S  # the grid reports the unbounded entry with its point
-    stacked = samples.reshape(-1, n)
-    _, sigma, vt = np.linalg.svd(stacked)
-    rank = int(np.sum(sigma > 1e-9 * max(1.0, float(sigma[0]) if sigma.size else 1.0)))
-    if rank == n:
-        return None, S
-    # a rational basis of the numeric null space: reduce it to echelon form first, so that
-    # a kernel such as (1, -1) comes out with small integer entries
-    null = sympy.Matrix(vt[rank:]).applyfunc(lambda x: sympy.nsimplify(x, tolerance=1e-12))
-    try:
-        echelon = null.rref(pivots=False)
-        rows = echelon.applyfunc(lambda x: sympy.nsimplify(x, rational=True, tolerance=1e-9))
-    except (TypeError, ValueError, ZeroDivisionError):  # pragma: no cover - defensive
-        return None, S
-    N = rows.T
-    # distributing products only: expanding exp(-c (z - m)**2) would overflow its factors
-    if N.rank() != n - rank or any(sympy.expand_mul(x) != 0 for x in S * N):
-        return None, S
-    complement = N.T.nullspace()
-    if not complement:
-        return N, sympy.zeros(0, 0)
-    B = sympy.Matrix.hstack(*complement)
-    return N, B.T * S * B
-
-
 def _fraction(entry: sympy.Expr) -> tuple[sympy.Poly, sympy.Poly] | None:
     """``(p, q)`` with entry = p/q, polynomials in z over the rationals, or ``None``."""
     if not entry.is_rational_function(Z):
@@ -556,13 +323,6 @@ def _eigenvalues(M: sympy.MatrixBase) -> str:
 
     values = np.linalg.eigvalsh(np.array(M.evalf(17).tolist(), dtype=float))
     return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
-
-
-def _evaluate(evaluate: Any, entry: sympy.Expr, z: Any, name: str) -> Any:
-    try:
-        return evaluate(entry, z)
-    except ExpressionError as error:
-        raise ModelError(f"{name}: {error}") from None
 
 
 def _brief(value: object) -> str:
