@@ -44,7 +44,7 @@ _EXPORTS: dict[str, str] = {
     "classify": "phdesign.symbolic.classify",
     "Classification": "phdesign.symbolic.classify",
     "search_sensors": "phdesign.symbolic.search",
-    "SensorSearch": "phdesign.symbolic.search",
+    "SensorSearch": "phdesign.symbolic.search_result",
     # the design objects
     "Observer": "phdesign.design.observer",
     "Plant": "phdesign.design.plant",
@@ -128,7 +128,8 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
         sensor_matrix,
     )
     from phdesign.symbolic.ports import Ports, derive_ports
-    from phdesign.symbolic.search import SensorSearch, search_sensors
+    from phdesign.symbolic.search import search_sensors
+    from phdesign.symbolic.search_result import SensorSearch
 
 
 #: Subpackages and modules reachable as attributes (``phd.plots``), imported on first use.

@@ -186,12 +186,12 @@ def test_progress_callback_on_long_search():
 
 
 def test_pure_python_and_numpy_kappa_paths_agree(beam, monkeypatch):
-    import phdesign.symbolic.search as search
+    from phdesign.symbolic import search_kappa
 
     gain = [0.5, 2, 1, 3]
-    pure = search.search_sensors(beam, gain=gain)
-    monkeypatch.setattr(search, "PURE_PYTHON_JOBS", 0)  # force the batched numpy path
-    batched = search.search_sensors(beam, gain=gain)
+    pure = search_sensors(beam, gain=gain)
+    monkeypatch.setattr(search_kappa, "PURE_PYTHON_JOBS", 0)  # force the batched numpy path
+    batched = search_sensors(beam, gain=gain)
     for a, b in zip(pure.subsets, batched.subsets, strict=True):
         assert (a.sensors, a.verdict, a.best, a.unbounded) == (
             b.sensors,
