@@ -156,61 +156,16 @@ def check_assumption(
         return AssumptionCheck(
             False, (), f"partition search not attempted for n = {n} > {MAX_SIZE}"
         )
-    h = n // 2
-    p1 = [[sympy.sympify(P1[i, j], strict=True) for j in range(n)] for i in range(n)]
-    p2 = [[sympy.sympify(P2[i, j], strict=True) for j in range(n)] for i in range(n)]
-    hh = [[sympy.sympify(H[i, j], strict=True) for j in range(n)] for i in range(n)]
-    zero_cache: dict[sympy.Expr, bool] = {}
-
-    def zero(expr: sympy.Expr) -> bool:
-        if expr not in zero_cache:
-            zero_cache[expr] = _is_zero(expr)
-        return zero_cache[expr]
-
-    def equal(x: sympy.Expr, y: sympy.Expr) -> bool:
-        return zero(x - y)
-
+    blocks = _Blocks(P1, P2, H, values)
     found: list[Partition] = []
     reasons: list[str] = []
-    for first in combinations(range(n), h):
+    for first in combinations(range(n), n // 2):
         second = tuple(i for i in range(n) if i not in first)
-        diagonal_zero = all(
-            zero(m[i][j])
-            for m in (p1, p2)
-            for block in (first, second)
-            for i in block
-            for j in block
-        )
-        if not diagonal_zero:
-            reasons.append("diagonal blocks of P1/P2")
-            continue
-        if not all(zero(hh[i][j]) for i in first for j in second):
-            reasons.append("H not block diagonal")
-            continue
-        pairing = _pair(first, second, p1, p2, equal)
-        if pairing is None:
-            reasons.append("Q1/Q2 not symmetric for any pairing")
-            continue
-        Q1 = sympy.ImmutableMatrix([[p1[r][c] for c in second] for r in pairing])
-        Q2 = sympy.ImmutableMatrix([[p2[r][c] for c in pairing] for r in second])
-        # The lower-left block of P1 must be Q1 and the upper-right block of P2 must be
-        # -Q2 exactly (automatic for a validated model, checked for direct callers).
-        lower_ok = all(
-            equal(p1[second[r]][pairing[c]], Q1[r, c])
-            and equal(p2[pairing[r]][second[c]], -Q2[r, c])
-            for r in range(h)
-            for c in range(h)
-        )
-        if not lower_ok:
-            reasons.append("Q1/Q2 not symmetric for any pairing")
-            continue
-        det = Q2.det()
-        if _is_zero(det) or (det.free_symbols and _is_zero(det.subs(values))):
-            reasons.append("Q2 singular")
-            continue
-        found.append(
-            Partition(tuple(i + 1 for i in pairing), tuple(i + 1 for i in second), Q1, Q2)
-        )
+        partition = blocks.partition(first, second)
+        if isinstance(partition, str):
+            reasons.append(partition)
+        else:
+            found.append(partition)
     if found:
         found.sort(key=lambda p: sorted(p.x1))
         return AssumptionCheck(True, tuple(found), f"{len(found)} admissible partition(s)")
@@ -223,6 +178,67 @@ def check_assumption(
     ]
     worst = next((r for r in order if r in reasons), "no split")
     return AssumptionCheck(False, (), f"no split of the state satisfies it ({worst})")
+
+
+class _Blocks:
+    r"""The entries of :math:`P_1`, :math:`P_2`, :math:`\mathcal H`, with a cached zero test."""
+
+    def __init__(
+        self,
+        P1: sympy.MatrixBase,
+        P2: sympy.MatrixBase,
+        H: sympy.MatrixBase,
+        values: dict[sympy.Symbol, sympy.Expr],
+    ) -> None:
+        n = P1.shape[0]
+        self.p1 = [[sympy.sympify(P1[i, j], strict=True) for j in range(n)] for i in range(n)]
+        self.p2 = [[sympy.sympify(P2[i, j], strict=True) for j in range(n)] for i in range(n)]
+        self.hh = [[sympy.sympify(H[i, j], strict=True) for j in range(n)] for i in range(n)]
+        self.values = values
+        self._zero: dict[sympy.Expr, bool] = {}
+
+    def zero(self, expr: sympy.Expr) -> bool:
+        if expr not in self._zero:
+            self._zero[expr] = _is_zero(expr)
+        return self._zero[expr]
+
+    def equal(self, x: sympy.Expr, y: sympy.Expr) -> bool:
+        return self.zero(x - y)
+
+    def partition(self, first: tuple[int, ...], second: tuple[int, ...]) -> Partition | str:
+        """Return the partition of the split ``(first, second)``, or the condition it fails."""
+        p1, p2, zero, equal = self.p1, self.p2, self.zero, self.equal
+        diagonal_zero = all(
+            zero(m[i][j])
+            for m in (p1, p2)
+            for block in (first, second)
+            for i in block
+            for j in block
+        )
+        if not diagonal_zero:
+            return "diagonal blocks of P1/P2"
+        if not all(zero(self.hh[i][j]) for i in first for j in second):
+            return "H not block diagonal"
+        pairing = _pair(first, second, p1, p2, equal)
+        if pairing is None:
+            return "Q1/Q2 not symmetric for any pairing"
+        h = len(first)
+        Q1 = sympy.ImmutableMatrix([[p1[r][c] for c in second] for r in pairing])
+        Q2 = sympy.ImmutableMatrix([[p2[r][c] for c in pairing] for r in second])
+        # The lower-left block of P1 must be Q1 and the upper-right block of P2 must be
+        # -Q2 exactly (automatic for a validated model, checked for direct callers).
+        lower_ok = all(
+            equal(p1[second[r]][pairing[c]], Q1[r, c])
+            and equal(p2[pairing[r]][second[c]], -Q2[r, c])
+            for r in range(h)
+            for c in range(h)
+        )
+        if not lower_ok:
+            return "Q1/Q2 not symmetric for any pairing"
+        det = Q2.det()
+        if _is_zero(det) or (det.free_symbols and _is_zero(det.subs(self.values))):
+            return "Q2 singular"
+        return Partition(tuple(i + 1 for i in pairing), tuple(i + 1 for i in second), Q1, Q2)
 
 
 def _pair(

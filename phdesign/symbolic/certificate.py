@@ -150,14 +150,9 @@ def certify(
     rows = list(selected)
     # LHS = ½ zᵀ(L + Lᵀ)z, z = C ỹ: the observer's sensors, and the plant's own dampers
     C_m, L = es.dissipation
-    # ---- decision (exact, independent of L)
-    for n_c in _nullspace(C_m):
-        v = es.K * n_c  # the admissible trace with error output n_c (= T⁻¹(0; n_c) when G n_c = 0)
-        zero = [vanishes(v[i]) for i in rows]
-        if not all(zero):
-            free = tuple(i for i, z in zip(rows, zero, strict=True) if not z)
-            witness = tuple(sympy.S.Zero if vanishes(x) else sympy.expand(x) for x in v)
-            return Certificate(False, None, None, False, witness, free, "exact")
+    failed = _counter_example(es, C_m, rows)  # the decision: exact, independent of L
+    if failed is not None:
+        return failed
     # ---- constant
     right_inverse = C_m.T * (C_m * C_m.T).inv()
     K_m = sympy.ImmutableMatrix(es.K * right_inverse)
@@ -173,6 +168,33 @@ def certify(
     if symbolic:
         kappa, conditions = _symbolic_kappa(A_r, B_r)
         return Certificate(True, kappa, None, False, None, (), "symbolic", conditions, pencil)
+    return _numeric_kappa(pencil, method)
+
+
+def _counter_example(
+    es: ErrorSystem, C_m: sympy.MatrixBase, rows: list[int]
+) -> Certificate | None:
+    r"""Return the failed certificate with its witness, or ``None`` when the variant holds.
+
+    It fails iff an error output in :math:`\ker C_m` (neither measured nor damped) gives an
+    admissible trace that does not vanish on the selected rows.
+    """
+    for n_c in _nullspace(C_m):
+        v = es.K * n_c  # the admissible trace with error output n_c (= T⁻¹(0; n_c) when G n_c = 0)
+        zero = [vanishes(v[i]) for i in rows]
+        if not all(zero):
+            free = tuple(i for i, z in zip(rows, zero, strict=True) if not z)
+            witness = tuple(sympy.S.Zero if vanishes(x) else sympy.expand(x) for x in v)
+            return Certificate(False, None, None, False, witness, free, "exact")
+    return None
+
+
+def _numeric_kappa(
+    pencil: tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix, sympy.ImmutableMatrix],
+    method: str,
+) -> Certificate:
+    """κ* of a numeric pencil: exact when affordable (``auto``, ``exact``), else in float."""
+    A_r, B_r, _ = pencil
     affordable = _operations(A_r, B_r) <= EXACT_KAPPA_OPERATIONS
     if method == "exact" and not affordable:
         raise ObserverError(
