@@ -85,6 +85,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from html import escape
 from typing import Any
 
 import sympy
@@ -431,8 +432,6 @@ class LoopClassification:
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        from html import escape
-
         rows = "".join(
             f"<tr><td>{escape(k)}</td><td>{escape(str(v))}</td></tr>"
             for k, v in (

@@ -33,6 +33,7 @@ import sympy
 
 from phdesign.core.checks import not_bytes
 from phdesign.core.errors import ExpressionError, ObserverError, check_shape
+from phdesign.core.limits import MAX_PORTS
 from phdesign.symbolic.expressions import exact_matrix, exact_number
 
 __all__ = [
@@ -302,8 +303,6 @@ def _check_gain(L: sympy.MatrixBase, q: int, symbol: str = "L") -> sympy.Immutab
 # --------------------------------------------------------------------------- entries
 def _check_count(value: object, what: str) -> None:
     """Refuse a count that is not a positive integer, or more ports than any model has."""
-    from phdesign.core.limits import MAX_PORTS
-
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise ObserverError(f"{what} must be a positive integer; found {value!r}")
     if value > MAX_PORTS:  # before any q x q or q x n_outputs matrix is allocated
