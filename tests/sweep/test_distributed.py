@@ -84,7 +84,6 @@ def _characteristic_roots(count: int) -> list[complex]:
     perturbation of the undamped modes sin(ω z), ω = (m + 1/2) π:
     Re λ ≈ -½ ∫ d sin² / ∫ sin² = -d0/4 + d0/(4 ω²), Im λ ≈ ω.
     """
-    mpmath.mp.dps = 50
 
     def F(lam):
         alpha, beta = lam**2 + D0 * lam, -D0 * lam
@@ -98,10 +97,11 @@ def _characteristic_roots(count: int) -> list[complex]:
                 return total
 
     roots = []
-    for m in range(count):
-        omega = (m + 0.5) * np.pi
-        guess = mpmath.mpc(-D0 / 4 + D0 / (4 * omega**2), omega)
-        roots.append(complex(mpmath.findroot(F, guess)))
+    with mpmath.workdps(50):
+        for m in range(count):
+            omega = (m + 0.5) * np.pi
+            guess = mpmath.mpc(-D0 / 4 + D0 / (4 * omega**2), omega)
+            roots.append(complex(mpmath.findroot(F, guess)))
     return roots
 
 

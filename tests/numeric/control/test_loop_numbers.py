@@ -36,14 +36,14 @@ BEAM = load_builtin("euler-bernoulli")
 
 def _roots_from_the_undamped_cantilever(**gains):
     """Follow each undamped cantilever mode iω, ω = β², to a root of the damped determinant."""
-    mpmath.mp.dps = 30
     betas = (1.8751040687, 4.6940911330, 7.8547574382, 10.9955407349, 14.1371683910)
     roots = []
-    for b in betas:
-        f = lambda x: beam_determinant(x, **gains)  # noqa: E731
-        root = mpmath.findroot(f, 1j * b * b - 0.3, tol=1e-40, verify=False)
-        assert abs(f(root)) < 1e-20  # a root, to far below double precision
-        roots.append(complex(root))
+    with mpmath.workdps(30):
+        for b in betas:
+            f = lambda x: beam_determinant(x, **gains)  # noqa: E731
+            root = mpmath.findroot(f, 1j * b * b - 0.3, tol=1e-40, verify=False)
+            assert abs(f(root)) < 1e-20  # a root, to far below double precision
+            roots.append(complex(root))
     return roots
 
 
@@ -115,12 +115,12 @@ def test_assembled_spectrum_is_the_union_of_the_two_blocks_on_the_beam():
     assert report.digits > 12
     _assert_union(report, 8)
     # the abscissa against the determinant with damping: mu^4 = -(lambda^2 + d lambda)
-    mpmath.mp.dps = 30
-    guess = mpmath.mpc(report.spectral_abscissa, abs(report.rightmost[0].imag))
-    root = mpmath.findroot(
-        lambda x: beam_determinant(x, torque=0.5, damping=0.2), guess, tol=1e-40, verify=False
-    )
-    assert abs(beam_determinant(root, torque=0.5, damping=0.2)) < 1e-20
+    with mpmath.workdps(30):
+        guess = mpmath.mpc(report.spectral_abscissa, abs(report.rightmost[0].imag))
+        root = mpmath.findroot(
+            lambda x: beam_determinant(x, torque=0.5, damping=0.2), guess, tol=1e-40, verify=False
+        )
+        assert abs(beam_determinant(root, torque=0.5, damping=0.2)) < 1e-20
     assert abs(report.spectral_abscissa - float(root.real)) < 1e-12
     assert abs(report.plant_abscissa - float(root.real)) < EIGEN_ROUNDOFF
 

@@ -128,9 +128,9 @@ def test_beam_error_energy_reproduces_the_independent_galerkin_values():
     assert f"{tips[1]:.9g}" == f"{tips[2]:.9g}" == "0.134708572"
 
 
+@mp.workdps(30)
 def _beam_continuum_gain(omega: float, l1: float, l2: float, d: float = 0.2) -> float:
     """Largest energy-norm gain of the beam's error response to (ν1, ν2) at ω (docstring)."""
-    mp.mp.dps = 30
     om = mp.mpf(omega)
     s = 1j * om
     mus = [mp.root(om**2 - 1j * om * d, 4, j) for j in range(4)]

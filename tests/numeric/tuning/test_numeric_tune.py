@@ -44,9 +44,9 @@ def beam_characteristic(lam, l1, l2, d="0.2"):
     return (a11 * a22 - a12 * a21) / mu
 
 
+@mp.workdps(40)
 def triple_root():
     """(lam*, l1*, l2*) with F = F' = F'' = 0: three real eigenvalues coalesce."""
-    mp.mp.dps = 40
 
     def equations(lam, l1, l2):
         f = lambda x: beam_characteristic(x, l1, l2)  # noqa: E731
@@ -55,10 +55,10 @@ def triple_root():
     return mp.findroot(equations, (mp.mpf("-5.83"), mp.mpf("0.1755"), mp.mpf("1.0257")))
 
 
+@mp.workdps(50)
 def true_abscissa_near(l1, l2, centre, m=3, radius=0.05):
     """max Re over the m roots of the characteristic function nearest ``centre`` (mpmath,
     Muller's method with deflation by the roots already found)."""
-    mp.mp.dps = 50
     l1, l2 = mp.mpf(l1), mp.mpf(l2)
     roots = []
     for k in range(m):
@@ -172,10 +172,11 @@ def test_evaluator_closes_the_loop_through_the_feedthrough():
     ev = AbscissaEvaluator(nm, np.eye(2), 70, method="fd")
     pair = ev.pair(np.diag([k1, k2]))
     assert np.any(discretize(nm, "fd", 70).D)
-    mp.mp.dps = 30
     for m in (0, 1):
-        guess = mp.mpc(-0.96, 2 * math.pi * m)
-        root = complex(mp.findroot(lambda x: wave_feedthrough_characteristic(x, k1, k2), guess))
+        with mp.workdps(30):
+            guess = mp.mpc(-0.96, 2 * math.pi * m)
+            f = lambda x: wave_feedthrough_characteristic(x, k1, k2)  # noqa: E731
+            root = complex(mp.findroot(f, guess))
         distance = np.abs(pair.eigenvalues - root)
         nearest = int(np.argmin(distance))
         assert distance[nearest] < 1e-2, (root, pair.eigenvalues[nearest])
@@ -206,10 +207,10 @@ def test_tune_says_no_optimum_where_the_abscissa_falls_without_bound():
     # gives -6.2, converged). Now its restarts keep improving and it says so.
     k1, k2 = 0.5, 2.0
     E = np.roots(_feedthrough_quadratic(k1, k2))
-    mp.mp.dps = 30
-    for root in E:  # the hand derivation against the determinant of the boundary conditions
-        lam = mp.log(mp.mpc(complex(root)))
-        assert abs(wave_feedthrough_characteristic(lam, k1, k2)) < 1e-12
+    with mp.workdps(30):
+        for root in E:  # the hand derivation against the determinant of the boundary conditions
+            lam = mp.log(mp.mpc(complex(root)))
+            assert abs(wave_feedthrough_characteristic(lam, k1, k2)) < 1e-12
     result = tune(to_numeric(FEEDTHROUGH), np.eye(2))
     # the restarts crawl down the valley until, at diag(0.008, 1.008), the search's low
     # resolution resolves no eigenvalue, which the verification refutes (-5.52, finite)
@@ -298,13 +299,13 @@ def test_tune_on_a_model_with_its_own_boundary_feedback():
     assert result.status == "optimum"
     assert result.converged
     (tuned_gain,) = np.diag(result.gain)
-    mp.mp.dps = 30
 
     def polished_abscissa(gain):
         z = complex(spectrum(nm, C, np.array([[gain]])).rightmost[0])
         f = lambda x: beam_determinant(x, torque=gain, shear=1.0)  # noqa: E731
-        root = mp.findroot(f, mp.mpc(z), tol=1e-40, verify=False)
-        assert abs(f(root)) < 1e-25
+        with mp.workdps(30):
+            root = mp.findroot(f, mp.mpc(z), tol=1e-40, verify=False)
+            assert abs(f(root)) < 1e-25
         assert abs(complex(root) - z) < 1e-10
         return complex(root).real
 
