@@ -84,8 +84,9 @@ class BCPHS(PortedSystem):
         + u^\top y ,
 
     (:mod:`phdesign.symbolic.ports`; the paper's :math:`(-1)^{j-1}` has the wrong sign for
-    even :math:`k`).  The inputs and outputs are trace expressions, :math:`u = U v` and
-    :math:`y = Y v` (``N n`` each); with :math:`W_B = U R_{ext}^{-1}`,
+    even :math:`k`).  The inputs and outputs are trace expressions (``N n`` each),
+    :math:`u = U v = W_B (f_\partial; e_\partial)` and
+    :math:`y = Y v = W_C (f_\partial; e_\partial)`; with :math:`W_B = U R_{ext}^{-1}`,
     :math:`W_C = Y R_{ext}^{-1}` of full rank :math:`Nn` and
     :math:`\Sigma = \left(\begin{smallmatrix} 0 & I \\ I & 0 \end{smallmatrix}\right)`
     of size :math:`2Nn`, they satisfy
