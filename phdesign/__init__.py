@@ -53,7 +53,7 @@ _EXPORTS: dict[str, str] = {
     "to_numeric": "phdesign.numeric.bridge",
     "discretize": "phdesign.numeric.discretization.registry",
     "spectrum": "phdesign.numeric.spectrum.converged",
-    "SpectrumReport": "phdesign.numeric.spectrum.converged",
+    "SpectrumReport": "phdesign.numeric.spectrum.report",
     "simulate": "phdesign.numeric.time.simulation",
     "SimulationResult": "phdesign.numeric.time.simulation",
     "tune": "phdesign.numeric.tuning.search",
@@ -115,7 +115,8 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
     from phdesign.numeric.noise.report import NoiseReport
     from phdesign.numeric.noise.tradeoff import Tradeoff
     from phdesign.numeric.sampled.export import SampledObserver
-    from phdesign.numeric.spectrum.converged import SpectrumReport, spectrum
+    from phdesign.numeric.spectrum.converged import spectrum
+    from phdesign.numeric.spectrum.report import SpectrumReport
     from phdesign.numeric.time.simulation import SimulationResult, simulate
     from phdesign.numeric.tuning.search import TuneResult, tune
     from phdesign.symbolic.classify import Classification, classify

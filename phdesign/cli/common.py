@@ -8,6 +8,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
+from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError, ParameterError
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
@@ -15,6 +16,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 __all__ = [
     "add_json_argument",
+    "add_method_argument",
     "add_model_argument",
     "check_finite_series",
     "emit",
@@ -39,6 +41,18 @@ def add_model_argument(parser: argparse.ArgumentParser) -> None:
         default=[],
         metavar="NAME=VALUE",
         help="override a parameter's default value (repeatable)",
+    )
+
+
+def add_method_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--method``: the registered discretizations (the table of defaults in force)."""
+    table = current()
+    methods = "; ".join(f"{m.name}: {m.summary}" for m in table.methods.values())
+    parser.add_argument(
+        "--method",
+        choices=table.method_names,
+        default=table.method,
+        help=f"discretization ({methods}); default: %(default)s",
     )
 
 

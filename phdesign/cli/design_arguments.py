@@ -117,7 +117,7 @@ def observer_from_args(
     *,
     default_gain: Any = None,
     command: str = "",
-    method: str = "galerkin",
+    method: str | None = None,
     resolution: int | None = None,
 ) -> Any:
     """Return the :class:`phdesign.Observer` of ``--sensors``/``--cm`` and ``--gain``.

@@ -24,7 +24,7 @@ from phdesign.cli.common import (
     load_model,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
-from phdesign.core.defaults import EXPORT
+from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError, ObserverError, OutputFileError
 
 __all__ = ["add_sampling_arguments", "register", "sampled_simulation"]
@@ -42,11 +42,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     add_model_argument(ex)
     add_observer_arguments(ex)
+    export = current().export
     ex.add_argument("--dt", type=float, required=True, metavar="DT", help="sampling period (s)")
     ex.add_argument(
         "--sampler",
         choices=SAMPLER_CHOICES,
-        default=EXPORT.sampler,
+        default=export.sampler,
         help="the controller's front end: mean of the outputs over each period (default) "
         "or point samples",
     )
@@ -63,13 +64,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     ex.add_argument(
         "--tol",
         type=float,
-        default=EXPORT.tol,
+        default=export.tol,
         help="relative accuracy of the rightmost error eigenvalues (default %(default)g)",
     )
     ex.add_argument(
         "--output-tol",
         type=float,
-        default=EXPORT.output_tol,
+        default=export.output_tol,
         help="error floor of the performance outputs, relative to their peak (default "
         "%(default)g)",
     )
@@ -99,7 +100,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     ex.add_argument(
         "--t-end",
         type=float,
-        default=EXPORT.t_end,
+        default=export.t_end,
         metavar="T",
         help="verification time (default %(default)g)",
     )
@@ -107,7 +108,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "--plant-resolution",
         type=int,
         metavar="Q",
-        help="Galerkin degree of the verification plant (default 48, at least twice the order)",
+        help=f"Galerkin degree of the verification plant (default {export.plant_degree}, at "
+        "least twice the order)",
     )
     ex.add_argument(
         "--at",

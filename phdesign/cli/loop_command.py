@@ -13,6 +13,7 @@ from typing import Any
 
 from phdesign.cli.common import (
     add_json_argument,
+    add_method_argument,
     add_model_argument,
     check_finite_series,
     check_positive,
@@ -23,6 +24,7 @@ from phdesign.cli.common import (
     warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
+from phdesign.core.defaults import current
 from phdesign.core.errors import LoopError, NumericError
 
 __all__ = ["register"]
@@ -84,7 +86,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     _loop_arguments(sp)
     _numeric_arguments(sp)
     sp.add_argument("--tol", type=float, help="required agreement of the abscissa")
-    sp.add_argument("--count", type=int, default=6, help="rightmost eigenvalues to report")
+    sp.add_argument(
+        "--count",
+        type=int,
+        default=current().spectrum.count,
+        help="rightmost eigenvalues to report",
+    )
     add_json_argument(sp)
     sp.set_defaults(handler=_spectrum)
 
@@ -96,9 +103,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument(
         "--u", metavar="EXPRS", help="signals on the inputs not actuated, e.g. 'u4: sin(t)'"
     )
-    sim.add_argument("--t-end", type=float, default=5.0, metavar="T", help="final time")
-    sim.add_argument("--samples", type=int, default=501, help="output samples on [0, T]")
-    sim.add_argument("--scheme", choices=("expm", "midpoint"), default="expm")
+    run = current().simulation
+    sim.add_argument("--t-end", type=float, default=run.t_end, metavar="T", help="final time")
+    sim.add_argument("--samples", type=int, default=run.samples, help="output samples on [0, T]")
+    sim.add_argument("--scheme", choices=("expm", "midpoint"), default=run.scheme)
     fmt = sim.add_mutually_exclusive_group()
     fmt.add_argument("--csv", action="store_true", help="CSV output (the default)")
     fmt.add_argument("--json", action="store_true", help="JSON output")
@@ -123,7 +131,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
 
 
 def _numeric_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--method", choices=("galerkin", "fd"), default="galerkin")
+    add_method_argument(parser)
     parser.add_argument("--resolution", type=int, metavar="N", help="degree / nodes per group")
 
 
@@ -145,7 +153,7 @@ def _loop(args: argparse.Namespace, numeric: bool = True) -> Any:
         feedback=parse_gain_text(args.feedback or "1", "--feedback"),
         feedback_source=args.feedback_source,
         feedback_outputs=None if outputs is None else parse_indices(outputs, "--feedback-outputs"),
-        method=args.method if numeric else "galerkin",
+        method=args.method if numeric else None,
         resolution=getattr(args, "resolution", None),
     )
 

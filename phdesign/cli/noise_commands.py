@@ -27,6 +27,7 @@ from typing import Any
 
 from phdesign.cli.common import (
     add_json_argument,
+    add_method_argument,
     add_model_argument,
     check_positive,
     emit_result,
@@ -125,9 +126,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "--scales", metavar="LO:HI:N", help="scales s of the ray, log-spaced (default 0.1:10:12)"
     )
     add_noise_arguments(tr)
-    tr.add_argument(
-        "--method", choices=("galerkin", "fd"), default="galerkin", help="discretization"
-    )
+    add_method_argument(tr)
     fmt = tr.add_mutually_exclusive_group()
     fmt.add_argument("--csv", action="store_true", help="CSV table")
     fmt.add_argument("--json", action="store_true", help="JSON output")

@@ -19,6 +19,7 @@ from typing import Any
 
 from phdesign.cli.common import (
     add_json_argument,
+    add_method_argument,
     add_model_argument,
     check_finite_series,
     check_positive,
@@ -37,6 +38,7 @@ from phdesign.cli.noise_commands import (
     noise_tuning,
     stochastic_simulation,
 )
+from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
 
 __all__ = ["register"]
@@ -46,13 +48,7 @@ TUNE_STARTS = 2
 
 
 def _add_discretization(parser: argparse.ArgumentParser, default_hint: str) -> None:
-    parser.add_argument(
-        "--method",
-        choices=("galerkin", "fd"),
-        default="galerkin",
-        help="discretization: Legendre-Galerkin (spectral) or staggered finite "
-        "differences (the paper's setting); default: %(default)s",
-    )
+    add_method_argument(parser)
     parser.add_argument(
         "--resolution", type=int, metavar="N", help=f"degree / nodes per group ({default_hint})"
     )
@@ -66,23 +62,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     add_model_argument(sp)
     add_observer_arguments(sp, required=True)
+    table = current()
     _add_discretization(sp, "default: the first of the refinement pairs")
     sp.add_argument(
         "--max-resolution",
         type=int,
         metavar="N",
-        help="largest resolution the refinement may reach (default: 100-110 for Galerkin)",
+        help="largest resolution the refinement may reach (default: "
+        f"{table.describe('spectrum_max')})",
     )
     sp.add_argument(
         "--tol",
         type=float,
         help="required accuracy of the abscissa, relative to the problem's rate "
-        "(default 1e-10 Galerkin, 1e-3 FD)",
+        f"(default: {table.describe('abscissa_tol')})",
     )
     sp.add_argument(
         "--count",
         type=int,
-        default=6,
+        default=table.spectrum.count,
         help="rightmost eigenvalues to report; default: %(default)s",
     )
     add_json_argument(sp)
@@ -93,7 +91,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     add_model_argument(sim)
     add_observer_arguments(sim)
-    _add_discretization(sim, "default: Galerkin 40 (16 for N >= 3), FD 70")
+    _add_discretization(sim, f"default: {table.describe('resolution')}")
     sim.add_argument(
         "--x0",
         metavar="EXPRS",
@@ -101,16 +99,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "series is zero: a warning says so)",
     )
     sim.add_argument("--xhat0", metavar="EXPRS", help="observer initial state; default zero")
+    run = table.simulation
     sim.add_argument(
-        "--t-end", type=float, default=5.0, metavar="T", help="final time; default: %(default)s"
+        "--t-end",
+        type=float,
+        default=run.t_end,
+        metavar="T",
+        help="final time; default: %(default)s",
     )
     sim.add_argument(
-        "--samples", type=int, default=501, help="output samples on [0, T]; default: %(default)s"
+        "--samples",
+        type=int,
+        default=run.samples,
+        help="output samples on [0, T]; default: %(default)s",
     )
     sim.add_argument(
         "--scheme",
         choices=("expm", "midpoint"),
-        default="expm",
+        default=run.scheme,
         help="time stepping: exact matrix exponential or implicit midpoint; default: %(default)s",
     )
     sim.add_argument(
@@ -119,7 +125,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument(
         "--tol",
         type=float,
-        default=1e-6,
+        default=run.tol,
         help="midpoint: largest estimated error of the states, relative to their largest "
         "energy norm; the substeps are chosen to meet it; default: %(default)s",
     )

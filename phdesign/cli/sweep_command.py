@@ -86,7 +86,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         flag = "--" + name.replace("_", "-")
         kwargs: dict[str, Any] = {"help": f"{option.help} (job {job})"}
         if option.kind == "choice":
-            kwargs["choices"] = option.choices
+            kwargs["choices"] = option.allowed
         else:
             kwargs["type"] = _TYPES[option.kind]
             kwargs["metavar"] = "N" if option.kind == "int" else "X"

@@ -25,7 +25,6 @@ from collections.abc import Sequence
 from phdesign.core.errors import ArgumentError, NumericError, PhdesignError
 
 __all__ = [
-    "DISCRETIZATION_METHODS",
     "choice",
     "found_text",
     "not_bytes",
@@ -33,13 +32,6 @@ __all__ = [
     "positive_number",
     "require_path",
 ]
-
-
-#: The values of a ``method`` argument: Legendre-Galerkin and staggered finite differences
-#: (:func:`phdesign.numeric.discretization.registry.discretize`).  Here, so that a design object
-# checks
-#: its method without loading the numeric layer.
-DISCRETIZATION_METHODS = ("galerkin", "fd")
 
 
 def found_text(value: object) -> str:

@@ -40,6 +40,8 @@ from typing import TYPE_CHECKING, Any
 
 import sympy
 
+from phdesign.core.checks import choice
+from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import LoopError
 from phdesign.symbolic.control import (
     FEEDBACK_SOURCES,
@@ -100,7 +102,8 @@ class Loop:
         The outputs fed back; they must be the collocated ones (the default).
     parameters : mapping, optional
         Parameter overrides (applied to the model).
-    method : {"galerkin", "fd"}
+    method : str, optional
+        A registered discretization; default: the table's (:mod:`phdesign.core.defaults`).
     resolution : int, optional
         Discretization used by :meth:`simulate`, :meth:`statespace`, :meth:`assemble`, and
         the first resolution of :meth:`spectrum`'s refinement (unless it is given one).
@@ -127,7 +130,7 @@ class Loop:
         feedback_source: str = "estimate",
         feedback_outputs: int | Sequence[int] | None = None,
         parameters: Mapping[str, Any] | None = None,
-        method: str = "galerkin",
+        method: str | None = None,
         resolution: int | None = None,
     ) -> None:
         from phdesign.design.observer import Observer
@@ -152,8 +155,7 @@ class Loop:
             raise LoopError(
                 f"feedback_source must be one of {FEEDBACK_SOURCES}; found {feedback_source!r}"
             )
-        if method not in ("galerkin", "fd"):
-            raise LoopError(f"method must be 'galerkin' or 'fd'; found {method!r}")
+        method = choice(method_or_default(method), "method", current().method_names, LoopError)
         C = _sensors(model, sensors, C_m)
         design = ObserverDesign(model, C, gain_matrix(gain, C.rows))  # checks C_m and L
         if feedback_source == "measured":
@@ -182,7 +184,7 @@ class Loop:
         feedback_source: str = "estimate",
         feedback_outputs: int | Sequence[int] | None = None,
         parameters: Mapping[str, Any] | None = None,
-        method: str = "galerkin",
+        method: str | None = None,
         resolution: int | None = None,
     ) -> Loop:
         """Build a loop from what an observer design holds: model, C_m, L, parameters."""
@@ -259,7 +261,7 @@ class Loop:
         self,
         *,
         tol: float | None = None,
-        count: int = 6,
+        count: int | None = None,
         resolution: int | None = None,
         max_resolution: int | None = None,
     ) -> LoopSpectrum:
@@ -286,9 +288,9 @@ class Loop:
         x0: str | Callable[[Any], Any] | None = None,
         xhat0: str | Callable[[Any], Any] | None = None,
         u: str | Callable[[float], Any] | None = None,
-        t_end: float = 5.0,
-        samples: int = 501,
-        scheme: str = "expm",
+        t_end: float | None = None,
+        samples: int | None = None,
+        scheme: str | None = None,
     ) -> LoopSimulation:
         """Simulate the loop (:func:`~phdesign.numeric.control.simulation.simulate_loop`).
 

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any
 import sympy
 
 from phdesign.core.checks import choice
-from phdesign.core.defaults import EXPORT
+from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, ObserverError
 from phdesign.core.text import REPR_LIMIT, html_table, matrix_text, sensors_text, shorten
 from phdesign.design.plant import Plant, numeric_matrix
@@ -49,7 +49,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.numeric.noise.report import NoiseReport
     from phdesign.numeric.noise.tradeoff import Tradeoff
     from phdesign.numeric.sampled.export import SampledObserver
-    from phdesign.numeric.spectrum.converged import SpectrumReport
+    from phdesign.numeric.spectrum.report import SpectrumReport
     from phdesign.numeric.time.simulation import SimulationResult
     from phdesign.numeric.tuning.search import TuneResult
     from phdesign.symbolic.classify import Classification
@@ -123,13 +123,13 @@ class Observer:
         C_m: Any = None,
         gain: Any = None,
         parameters: Mapping[str, Any] | None = None,
-        method: str = "galerkin",
+        method: str | None = None,
         resolution: int | None = None,
         tuning: TuneResult | None = None,
     ) -> None:
         if not isinstance(model, Plant):
             plant = Plant(model, dict(parameters or {}), method, resolution)
-        elif parameters or method != "galerkin" or resolution is not None:
+        elif parameters or method not in (None, current().method) or resolution is not None:
             raise ArgumentError("give parameters, method and resolution to the Plant, not twice")
         else:
             plant = model
@@ -198,7 +198,11 @@ class Observer:
         return classify(self.plant.design_model, self.C_m, self._gain("classify"), method)
 
     def spectrum(
-        self, *, max_resolution: int | None = None, tol: float | None = None, count: int = 6
+        self,
+        *,
+        max_resolution: int | None = None,
+        tol: float | None = None,
+        count: int | None = None,
     ) -> SpectrumReport:
         r"""Return the converged spectrum of the error system.
 
@@ -217,12 +221,12 @@ class Observer:
         x0: str | Callable[[Any], Any] | None = None,
         *,
         xhat0: str | Callable[[Any], Any] | None = None,
-        t_end: float = 5.0,
-        samples: int = 501,
+        t_end: float | None = None,
+        samples: int | None = None,
         u: Callable[[float], Any] | None = None,
-        scheme: str = "expm",
+        scheme: str | None = None,
         z_w: Any = None,
-        tol: float = 1e-6,
+        tol: float | None = None,
     ) -> SimulationResult:
         """Simulate plant and observer together.
 
@@ -234,7 +238,7 @@ class Observer:
             function ``f(z) -> (len(z), n)``.  Both default to zero: without ``x0`` and
             ``u`` every series is zero.
         t_end, samples, u, scheme, z_w, tol
-            See :func:`phdesign.numeric.time.simulation.simulate`.
+            See :func:`phdesign.numeric.time.simulation.simulate` (and its defaults).
         """
         C, L = self.numeric_gain("simulate")
         return self.plant.run(
@@ -438,14 +442,14 @@ class Observer:
         self,
         *,
         dt: float,
-        sampler: str = EXPORT.sampler,
+        sampler: str | None = None,
         order: int | None = None,
         reduction: str = "none",
-        tol: float = EXPORT.tol,
-        output_tol: float = EXPORT.output_tol,
+        tol: float | None = None,
+        output_tol: float | None = None,
         verify: bool = False,
         x0: str | Callable[[Any], Any] | None = None,
-        t_end: float = EXPORT.t_end,
+        t_end: float | None = None,
         plant_resolution: int | None = None,
         points: float | Sequence[float] | None = None,
     ) -> SampledObserver:
@@ -467,7 +471,9 @@ class Observer:
         ----------
         dt : float
             Sampling period (s).
-        sampler : {"average", "point"}
+        sampler : {"average", "point"}, optional
+            Default ``"average"``; this and every default are the export's
+            (:mod:`phdesign.core.defaults`).
         order : int, optional
             Observer states (default: the smallest that meets the targets).
         reduction : {"none", "modal", "balanced"}
@@ -571,7 +577,7 @@ class Observer:
             ["model", self.model.name],
             ["sensors", labels["sensors"]],
             ["gain L", labels["gain"]],
-            ["discretization", self.plant.method],
+            ["discretization", str(self.plant.method)],
         ]
         if self.tuning is not None:
             rows.append(["tuned abscissa", str(self.tuning.spectral_abscissa)])

@@ -16,7 +16,8 @@ from typing import TYPE_CHECKING, Any
 
 import sympy
 
-from phdesign.core.checks import DISCRETIZATION_METHODS, choice, positive_int
+from phdesign.core.checks import choice, positive_int
+from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, ObserverError, ParameterError
 from phdesign.core.text import REPR_LIMIT, matrix_text, shorten
 from phdesign.symbolic.model import BCPHS
@@ -27,7 +28,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
     from phdesign.numeric.bridge import NumericModel
     from phdesign.numeric.discretization.phs import DiscretePHS
-    from phdesign.numeric.spectrum.converged import SpectrumReport
+    from phdesign.numeric.spectrum.report import SpectrumReport
     from phdesign.numeric.time.simulation import SimulationResult
 
 __all__ = ["Plant", "numeric_matrix"]
@@ -68,8 +69,10 @@ class Plant:
     parameters : mapping of str to number, optional
         Overrides of the model's parameter defaults (``{"d": 0.5}``), used by the
         classification and by the numbers alike.
-    method : {"galerkin", "fd"}
-        Discretization (:func:`phdesign.numeric.discretization.registry.discretize`).
+    method : str, optional
+        A registered discretization (``"galerkin"``, ``"fd"``,
+        :func:`phdesign.numeric.discretization.registry.discretize`); default: the table's
+        (:mod:`phdesign.core.defaults`), remembered by the plant.
     resolution : int, optional
         Degree or nodes per group; for spectra, the first resolution of the refinement.
 
@@ -85,7 +88,7 @@ class Plant:
 
     model: BCPHS
     parameters: Mapping[str, Any] = field(default_factory=dict, hash=False)
-    method: str = "galerkin"
+    method: str | None = None
     resolution: int | None = None
 
     def __post_init__(self) -> None:
@@ -95,7 +98,9 @@ class Plant:
                 "parameters must be a mapping of names to values such as {'d': 0.5}; found "
                 f"{type(self.parameters).__name__}"
             )
-        choice(self.method, "method", DISCRETIZATION_METHODS)
+        table = current()  # None: the default method, remembered by the plant
+        method = table.method if self.method is None else self.method
+        object.__setattr__(self, "method", choice(method, "method", table.method_names))
         if self.resolution is not None:
             positive_int(self.resolution, "resolution")
         object.__setattr__(self, "parameters", dict(self.parameters))
@@ -133,7 +138,11 @@ class Plant:
         return initial_state_function(x0, self.numeric)
 
     def spectrum(
-        self, *, max_resolution: int | None = None, tol: float | None = None, count: int = 6
+        self,
+        *,
+        max_resolution: int | None = None,
+        tol: float | None = None,
+        count: int | None = None,
     ) -> SpectrumReport:
         """Return the converged spectrum of the plant with u = 0."""
         return self.closed_spectrum(
@@ -147,7 +156,7 @@ class Plant:
         *,
         max_resolution: int | None = None,
         tol: float | None = None,
-        count: int = 6,
+        count: int | None = None,
     ) -> SpectrumReport:
         r"""Return the converged spectrum with :math:`u = -C_m^\top L C_m y` (u = 0 without)."""
         from phdesign.numeric.spectrum.converged import spectrum
@@ -167,16 +176,16 @@ class Plant:
         self,
         x0: str | Callable[[Any], Any] | None = None,
         *,
-        t_end: float = 5.0,
-        samples: int = 501,
+        t_end: float | None = None,
+        samples: int | None = None,
         u: Callable[[float], Any] | None = None,
-        scheme: str = "expm",
-        tol: float = 1e-6,
+        scheme: str | None = None,
+        tol: float | None = None,
     ) -> SimulationResult:
         """Simulate the plant alone from ``x0`` (text or a function of z; zero by default).
 
         ``tol`` bounds the error of ``scheme="midpoint"`` (its substeps are chosen to meet
-        it; :func:`phdesign.numeric.time.simulation.simulate`).
+        it; :func:`phdesign.numeric.time.simulation.simulate`, whose defaults apply).
         """
         return self.run(None, None, x0, t_end=t_end, samples=samples, u=u, scheme=scheme, tol=tol)
 

@@ -30,8 +30,10 @@ import numpy as np
 
 from phdesign.core import limits
 from phdesign.core.checks import choice, positive_int, positive_number
+from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError, ObserverError
 from phdesign.numeric.bridge import require_numeric_model
+from phdesign.numeric.discretization.registry import check_basis
 
 __all__ = [
     "check_initial_state",
@@ -40,12 +42,6 @@ __all__ = [
     "check_spectrum_arguments",
     "check_tune_arguments",
 ]
-
-
-def _methods() -> tuple[str, ...]:
-    from phdesign.numeric.discretization.registry import METHODS
-
-    return tuple(METHODS)
 
 
 def check_sensors_and_gain(
@@ -111,7 +107,7 @@ def _common(
     nm: Any, method: str, resolution: Any, tol: Any = None, max_resolution: Any = None
 ) -> None:
     require_numeric_model(nm)
-    choice(method, "method", _methods())
+    choice(method, "method", current().method_names)
     if resolution is not None:
         positive_int(resolution, "resolution")
     if max_resolution is not None:
@@ -131,9 +127,11 @@ def check_spectrum_arguments(
     tol: Any,
     rtol_resolved: Any,
     count: Any,
+    basis: Any = None,
 ) -> None:
     """Check the arguments of the spectrum (:mod:`phdesign.numeric.spectrum.converged`)."""
     _common(nm, method, resolution, tol, max_resolution)
+    check_basis(current().entry(method), basis)
     if rtol_resolved is not None:
         positive_number(rtol_resolved, "rtol_resolved")
     positive_int(count, "count")
@@ -190,7 +188,7 @@ def check_tune_arguments(
     log_range: Any,
     resolution: Any,
     maxiter: Any,
-    method: str = "galerkin",
+    method: str,
 ) -> None:
     """Check the arguments of :func:`~phdesign.numeric.tuning.search.tune` and its budget."""
     _common(nm, method, resolution)

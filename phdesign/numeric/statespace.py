@@ -61,20 +61,16 @@ MODES = ("all", "resolved")
 
 
 def state_labels(d: DiscretePHS, prefix: str = "") -> list[str]:
-    """Names of the discrete states: ``<prefix>e<i>[<j>]`` (effort i, basis index/node j)."""
-    n = d.model.size
-    if d.method == "galerkin":
-        coords = d.info.get("coordinates")
-        if coords is None:
-            per = d.dim // n
-            coords = [(i, j) for i in range(n) for j in range(per)]
-        return [f"{prefix}e{i + 1}[{j}]" for i, j in coords]
-    per = d.dim // n
-    p, q = d.info["groups"]
-    r = len(p)
-    labels = [f"{prefix}e{p[c] + 1}[{j}]" for j in range(per) for c in range(r)]
-    labels += [f"{prefix}e{q[c] + 1}[{j}]" for j in range(per) for c in range(r)]
-    return labels
+    """Names of the discrete states: ``<prefix>e<i>[<j>]`` (effort i, basis index/node j).
+
+    The pairs (component, index) are the discretization's ``info["coordinates"]``, which
+    every registered method gives; a system without them is read as n equal blocks.
+    """
+    coords = d.info.get("coordinates")
+    if coords is None:
+        per = d.dim // d.model.size
+        coords = [(i, j) for i in range(d.model.size) for j in range(per)]
+    return [f"{prefix}e{i + 1}[{j}]" for i, j in coords]
 
 
 def control_signal_name(label: str) -> str:

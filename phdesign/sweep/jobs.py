@@ -39,6 +39,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from phdesign.core.defaults import current
 from phdesign.core.errors import SweepError
 
 __all__ = ["JOBS", "Figure", "Job", "Option", "get_job"]
@@ -90,17 +91,28 @@ class Option:
     name : str
     kind : {"int", "float", "choice"}
         Positive integer, positive finite float, or one of ``choices``.
-    default : object
-        ``None`` leaves the choice to the library (its documented default).
+    default : object or callable
+        ``None`` leaves the choice to the library (its documented default); a function
+        without arguments is asked at each use (the table of defaults in force).
     help : str
-    choices : tuple of str
+    choices : tuple of str, or a function without arguments returning them
     """
 
     name: str
     kind: str
     default: Any
     help: str
-    choices: tuple[str, ...] = ()
+    choices: tuple[str, ...] | Callable[[], tuple[str, ...]] = ()
+
+    @property
+    def allowed(self) -> tuple[str, ...]:
+        """The choices now (those of the table in force, for the discretization method)."""
+        return self.choices() if callable(self.choices) else self.choices
+
+    @property
+    def default_value(self) -> Any:
+        """The default now (``None``: the library's)."""
+        return self.default() if callable(self.default) else self.default
 
     def check(self, value: Any) -> Any:
         """Return ``value`` validated (``None`` stays ``None``).
@@ -113,9 +125,9 @@ class Option:
         if value is None:
             return None
         if self.kind == "choice":
-            if value not in self.choices:
+            if value not in self.allowed:
                 raise SweepError(
-                    f"option {self.name}: expected one of {', '.join(self.choices)}; "
+                    f"option {self.name}: expected one of {', '.join(self.allowed)}; "
                     f"found {value!r}"
                 )
             return value
@@ -186,7 +198,7 @@ class Job:
                 raise SweepError(
                     f"job {self.name} has no option {name!r}; its options: {expected}"
                 )
-        return {o.name: o.check(given.get(o.name, o.default)) for o in self.options}
+        return {o.name: o.check(given.get(o.name, o.default_value)) for o in self.options}
 
     def check_options(self, model: Any, options: Mapping[str, Any]) -> None:
         """Refuse, before the sweep, options that every point would refuse (see ``check``)."""
@@ -205,12 +217,17 @@ def _load(target: str) -> Any:
     return getattr(importlib.import_module(module), function)
 
 
+def _default_method() -> str:
+    return current().method
+
+
+def _method_names() -> tuple[str, ...]:
+    return current().method_names
+
+
+# the registered discretizations and the default one, read from the table when used
 _METHOD = Option(
-    "method",
-    "choice",
-    "galerkin",
-    "discretization: galerkin (default) or fd",
-    ("galerkin", "fd"),
+    "method", "choice", _default_method, "discretization (default: the table's)", _method_names
 )
 
 JOBS: dict[str, Job] = {

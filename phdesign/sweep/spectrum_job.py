@@ -24,9 +24,11 @@ from typing import Any
 
 import numpy as np
 
+from phdesign.core.defaults import method_or_default
 from phdesign.numeric.bridge import NumericModel, to_numeric
-from phdesign.numeric.spectrum.converged import SpectrumReport, spectrum
+from phdesign.numeric.spectrum.converged import spectrum
 from phdesign.numeric.spectrum.refinement import Discretizations
+from phdesign.numeric.spectrum.report import SpectrumReport
 
 __all__ = ["ChunkSpectrum", "abscissa_evaluator", "check_options", "figures_of_report", "prepare"]
 
@@ -51,7 +53,8 @@ class ChunkSpectrum:
     nm : NumericModel
     C_m : ndarray or None
         Sensor matrix (``None``: the plant with u = 0, gains ignored).
-    method : {"galerkin", "fd"}
+    method : str, optional
+        A registered discretization; default: the table's (:mod:`phdesign.core.defaults`).
     resolution, max_resolution : int, optional
         As for :func:`~phdesign.numeric.spectrum.converged.spectrum`.
     tol : float, optional
@@ -74,11 +77,12 @@ class ChunkSpectrum:
         nm: NumericModel,
         C_m: np.ndarray | None,
         *,
-        method: str = "galerkin",
+        method: str | None = None,
         resolution: int | None = None,
         max_resolution: int | None = None,
         tol: float | None = None,
     ) -> None:
+        method = method_or_default(method)
         self.nm, self.C_m, self.method = nm, C_m, method
         self.resolution, self.max_resolution, self.tol = resolution, max_resolution, tol
         self.discretizations = Discretizations(nm, method)
@@ -108,7 +112,7 @@ def abscissa_evaluator(
     return ChunkSpectrum(
         nm,
         C_m,
-        method=options.get("method") or "galerkin",
+        method=options.get("method"),
         resolution=options.get("resolution"),
         max_resolution=options.get("max_resolution"),
         tol=options.get("tol"),
@@ -123,7 +127,7 @@ def check_options(model: Any, options: Mapping[str, Any]) -> None:
     """
     from phdesign.core.limits import check_discretization
 
-    method = options.get("method") or "galerkin"
+    method = method_or_default(options.get("method"))
     check_discretization(model, method, options.get("resolution"), options.get("max_resolution"))
 
 

@@ -182,25 +182,30 @@ def test_import_stays_light_and_the_new_names_load_on_first_use():
 
 
 def test_the_library_the_design_object_and_the_cli_share_the_export_defaults():
-    # one row of defaults (phdesign.core.defaults.EXPORT) serves the three entry points:
-    # a change of policy there reaches every one of them
+    # one row of defaults (phdesign.core.defaults, its export row) serves the three entry
+    # points: the signatures say None ("the registered default") and the command line
+    # reads the row, so a change of policy there reaches every one of them
     import inspect
+    from dataclasses import replace
 
     from phdesign.cli import build_parser
-    from phdesign.core.defaults import EXPORT
+    from phdesign.core.defaults import DEFAULTS, current, using
     from phdesign.numeric.sampled.order import select_order
 
     expected = {"sampler": "average", "tol": 1e-6, "output_tol": 1e-3, "t_end": 5.0}
-    assert vars(EXPORT) == expected
+    assert {k: getattr(current().export, k) for k in expected} == expected
     for function in (export_observer, phd.Observer.export):
         parameters = inspect.signature(function).parameters
-        assert {k: parameters[k].default for k in expected} == expected, function
+        assert {k: parameters[k].default for k in expected} == dict.fromkeys(expected), function
     parameters = inspect.signature(select_order).parameters
-    assert (parameters["tol"].default, parameters["output_tol"].default) == (1e-6, 1e-3)
-    args = build_parser().parse_args(
-        ["export", "wave", "--sensors", "2", "--dt", "0.01", "--format", "json", "-o", "x.json"]
-    )
+    assert (parameters["tol"].default, parameters["output_tol"].default) == (None, None)
+    argv = ["export", "wave", "--sensors", "2", "--dt", "0.01", "--format", "json", "-o", "x.json"]
+    args = build_parser().parse_args(argv)
     assert {k: getattr(args, k) for k in expected} == expected
+    changed = {"sampler": "point", "tol": 1e-4, "output_tol": 1e-2, "t_end": 2.0}
+    with using(replace(DEFAULTS, export=replace(DEFAULTS.export, **changed))):
+        args = build_parser().parse_args(argv)
+    assert {k: getattr(args, k) for k in expected} == changed
 
 
 def test_the_symbolic_commands_never_load_the_numeric_layer():

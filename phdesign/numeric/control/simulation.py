@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from phdesign.core.defaults import current
 from phdesign.core.errors import LoopError, NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import NumericLoop, assemble
@@ -128,12 +129,12 @@ def simulate_loop(
     *,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     xhat0: Callable[[np.ndarray], np.ndarray] | None = None,
-    t_end: float = 5.0,
-    samples: int = 501,
-    method: str = "galerkin",
+    t_end: float | None = None,
+    samples: int | None = None,
+    method: str | None = None,
     resolution: int | None = None,
     u: Callable[[float], np.ndarray] | None = None,
-    scheme: str = "expm",
+    scheme: str | None = None,
     z_w: np.ndarray | None = None,
 ) -> LoopSimulation:
     """Simulate plant, observer and feedback together (module docstring).
@@ -145,7 +146,8 @@ def simulate_loop(
     x0, xhat0 : callable, optional
         Initial plant and observer states ``f(z) -> (m, n)``; default zero.
     t_end, samples, method, resolution, scheme, z_w
-        As for :func:`phdesign.numeric.time.simulation.simulate`.
+        As for :func:`phdesign.numeric.time.simulation.simulate` (defaults: the table's,
+        :mod:`phdesign.core.defaults`).
     u : callable, optional
         ``u(t) -> (n_ports,)``: signals on the inputs that are *not* actuated (the
         actuated entries must be zero; the controller sets them).
@@ -172,6 +174,7 @@ def simulate_loop(
     >>> bool(run.H[-1] < run.H[0]), run.warnings
     (True, ())
     """
+    t_end, samples, scheme, _ = current().simulation.fill(t_end, samples, scheme)
     if not (np.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a positive number; found {t_end}")
     if int(samples) < 2:

@@ -30,28 +30,26 @@ from typing import Any
 
 import numpy as np
 
+from phdesign.core.defaults import current, method_or_default
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import LoopSystem, NumericLoop, assemble
-from phdesign.numeric.discretization.defaults import band_resolution
 from phdesign.numeric.discretization.registry import discretize, feedback_matrix
 from phdesign.numeric.scales import dimensionless_model
 from phdesign.numeric.spectrum.branches import Branches, merged_branches
 from phdesign.numeric.spectrum.converged import (
-    SpectrumReport,
+    RefinementPlan,
     abscissa_digits,
-    default_resolutions,
     rightmost_indices,
     spectrum,
 )
 from phdesign.numeric.spectrum.eigen import SHIFT, rescaled, shift_invert
-from phdesign.numeric.spectrum.evaluator import default_tolerances
 from phdesign.numeric.spectrum.refinement import (
     Discretizations,
     PairResult,
     choose_pair,
     extinct_twice,
-    refine,
 )
+from phdesign.numeric.spectrum.report import SpectrumReport
 from phdesign.numeric.spectrum.warnings import report_warnings, reported_value
 from phdesign.numeric.threads import small_dense_threads
 
@@ -307,12 +305,12 @@ def loop_spectrum(
     nm: NumericModel,
     loop: NumericLoop,
     *,
-    method: str = "galerkin",
+    method: str | None = None,
     resolution: int | None = None,
     max_resolution: int | None = None,
     tol: float | None = None,
     rtol_resolved: float | None = None,
-    count: int = 6,
+    count: int | None = None,
     design: str = "",
 ) -> LoopSpectrum:
     r"""Converged spectrum of the assembled loop, and of the controlled plant and error system.
@@ -336,6 +334,8 @@ def loop_spectrum(
     -------
     LoopSpectrum
     """
+    method = method_or_default(method)
+    count = current().spectrum.count if count is None else count
     m = nm.n_ports
     loop.check(m)
     S_a = loop.selection(m)
@@ -351,30 +351,26 @@ def loop_spectrum(
         system="controlled plant (u_a = -K y_a)",
     )
     error = spectrum(nm, loop.C_m, loop.L, resolution=resolution, **options)
-    default_tol, default_rtol = default_tolerances(method)
-    tol = default_tol if tol is None else float(tol)
-    rtol_resolved = default_rtol if rtol_resolved is None else float(rtol_resolved)
-    p0, pmax = default_resolutions(nm, method)
+    start = None
     if resolution is None:  # where both blocks converged: usually one pair suffices
-        p0 = max(plant.resolutions[0], error.resolutions[0])
-    p = int(resolution) if resolution is not None else p0
-    pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
+        start = max(plant.resolutions[0], error.resolutions[0])
+    plan = RefinementPlan.of(
+        nm,
+        method,
+        resolution=resolution,
+        max_resolution=max_resolution,
+        tol=tol,
+        rtol_resolved=rtol_resolved,
+        start=start,
+    )
     solver = AssembledLoopSolver(nm, loop, method=method)
     with small_dense_threads():
-        band_stop = pmax if max_resolution is not None else band_resolution(nm.order, method)
-        trail = refine(
-            solver,
-            start=p,
-            stop=pmax,
-            tol=tol,
-            rtol_resolved=rtol_resolved,
-            band_stop=band_stop,
-        )
+        trail = plan.refine(solver)
         chosen, notes = choose_pair(trail)
         blocks = solver.blocks(chosen.pair.resolutions[1])
     triangular = max(solver.systems[r].triangular_residual for r in chosen.pair.resolutions)
     return _report(
-        nm, trail, chosen, notes, blocks, plant, error, tol, count, method, triangular, design
+        nm, trail, chosen, notes, blocks, plant, error, plan.tol, count, method, triangular, design
     )
 
 

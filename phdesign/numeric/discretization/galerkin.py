@@ -98,9 +98,10 @@ from typing import Any
 import numpy as np
 from numpy.polynomial import legendre as leg
 
+from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel, trace_index
-from phdesign.numeric.discretization.defaults import defaults_for
+from phdesign.numeric.discretization.base import Method
 from phdesign.numeric.discretization.distributed import galerkin_p0
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.spurious import (
@@ -110,7 +111,7 @@ from phdesign.numeric.discretization.spurious import (
 )
 
 __all__ = [
-    "BASES",
+    "Galerkin",
     "galerkin",
     "gauss_rule",
     "legendre_basis",
@@ -118,14 +119,20 @@ __all__ = [
     "trace_scaling",
 ]
 
-BASES = ("scaled", "legendre")
+
+class Galerkin(Method, name="galerkin"):
+    """The registered method ``"galerkin"``: :func:`galerkin` at degree ``resolution``."""
+
+    @classmethod
+    def build(cls, nm: NumericModel, resolution: int, basis: str | None) -> DiscretePHS:
+        """Return :func:`galerkin` of ``nm`` at degree ``resolution`` in ``basis``."""
+        return galerkin(nm, resolution, basis)
 
 
 def resolve_basis(basis: str | None, order: int) -> str:
     """Return the basis :func:`galerkin` uses for a model of order ``order``.
 
-    ``None`` means the registry's choice
-    (:data:`phdesign.numeric.discretization.defaults.GALERKIN`).
+    ``None`` means the table's choice (:mod:`phdesign.core.defaults`).
 
     Examples
     --------
@@ -134,7 +141,7 @@ def resolve_basis(basis: str | None, order: int) -> str:
     """
     if basis is not None:
         return basis
-    chosen = defaults_for("galerkin", order).basis
+    chosen = current().discretization(Galerkin.name, order).basis
     assert chosen is not None  # every Galerkin row names its basis
     return chosen
 
@@ -293,8 +300,9 @@ def galerkin(
     if p < N + 1:
         raise NumericError(f"Galerkin degree must be at least N + 1 = {N + 1}; found {p}")
     basis = resolve_basis(basis, nm.order)
-    if basis not in BASES:
-        raise NumericError(f"unknown Galerkin basis {basis!r}; expected one of {BASES}")
+    bases = current().entry(Galerkin.name).bases
+    if basis not in bases:
+        raise NumericError(f"unknown Galerkin basis {basis!r}; expected one of {bases}")
     iv, nb = nm.interval, p + 1
     s = trace_scaling(p, N, iv) if basis == "scaled" else np.ones(nb)
     # Exact Gauss rule for the polynomial products psi_j psi_l^(k) (degree <= 2p).
@@ -359,7 +367,7 @@ def galerkin(
     space = _TrialSpace(nm, p, s, W, M)
     return DiscretePHS(
         model=nm,
-        method="galerkin",
+        method=Galerkin.name,
         resolution=p,
         E=M,
         J=J,

@@ -1,4 +1,4 @@
-r"""Structure-preserving discretizations of a BC-PHS: the common result type and dispatch.
+r"""Structure-preserving discretizations of a BC-PHS: the registered methods and dispatch.
 
 Every method returns a :class:`DiscretePHS` in *effort coordinates* ê (the discrete
 efforts, e ≈ e(ê)), in descriptor port-Hamiltonian form
@@ -20,6 +20,11 @@ The energy-state form of the contract, :math:`\dot x_d = (J - R) Q x_d + B u`, i
 
 Methods
 -------
+A method is one module with a :class:`~phdesign.numeric.discretization.base.Method`
+subclass (registered by its name) and one entry of the table of defaults
+(:mod:`phdesign.core.defaults`: resolutions, basis, caps and tolerances by order); this
+module imports the built-in ones and checks that the two agree.
+
 ``"galerkin"`` (default, :mod:`phdesign.numeric.discretization.galerkin`)
     Legendre-Galerkin with weakly imposed, power-conjugate boundary inputs: spectrally
     accurate for smooth data, any order N, any size n, H varying in z, any admissible
@@ -35,21 +40,39 @@ Methods
 from __future__ import annotations
 
 from phdesign.core import limits
-from phdesign.core.checks import DISCRETIZATION_METHODS
+from phdesign.core.defaults import MethodDefaults, current
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.discretization.defaults import defaults_for
+from phdesign.numeric.discretization import galerkin, staggered
+from phdesign.numeric.discretization.base import Method, check_registered
 from phdesign.numeric.discretization.feedback import close_plant_feedback
 from phdesign.numeric.discretization.phs import ClosedLoop, DiscretePHS, feedback_matrix
 
-__all__ = ["METHODS", "ClosedLoop", "DiscretePHS", "discretize", "feedback_matrix"]
+__all__ = ["ClosedLoop", "DiscretePHS", "check_basis", "discretize", "feedback_matrix"]
 
-METHODS = DISCRETIZATION_METHODS
+#: The built-in methods (their modules register them as they load).
+_BUILT_IN = (galerkin.Galerkin, staggered.StaggeredFD)
+check_registered()
+
+
+def check_basis(entry: MethodDefaults, basis: object) -> None:
+    """Refuse a ``basis`` that the method of ``entry`` does not accept (None always passes)."""
+    if basis is None or basis in entry.bases:
+        return
+    if not entry.bases:
+        raise NumericError(
+            f"basis: method {entry.name!r} has no bases; found basis={basis!r} (methods with "
+            f"bases: {', '.join(repr(m.name) for m in current().methods.values() if m.bases)})"
+        )
+    raise NumericError(
+        f"basis must be one of {', '.join(map(repr, entry.bases))} for method {entry.name!r}; "
+        f"found {basis!r}"
+    )
 
 
 def discretize(
     nm: NumericModel,
-    method: str = "galerkin",
+    method: str | None = None,
     resolution: int | None = None,
     *,
     basis: str | None = None,
@@ -59,29 +82,32 @@ def discretize(
     Parameters
     ----------
     nm : NumericModel
-    method : {"galerkin", "fd"}
+    method : str, optional
+        A registered method (``"galerkin"``, ``"fd"``); default: the table's
+        (:mod:`phdesign.core.defaults`).
     resolution : int, optional
-        Degree (Galerkin) or nodes per state group (FD); default from the registry
-        :mod:`phdesign.numeric.discretization.defaults` (Galerkin 40, or 16 for N >= 3; FD 70: the
-        paper's 140 states for the beam).
-    basis : {"scaled", "legendre"}, optional
-        Galerkin basis (default: the registry's); not accepted by ``"fd"``.
+        Degree (Galerkin) or nodes per group (FD); default: the method's row of the table
+        (Galerkin 40, or 16 for N >= 3; FD 70: the paper's 140 states for the beam).
+    basis : str, optional
+        The basis of a method that has several (Galerkin: ``"scaled"`` or
+        ``"legendre"``); default: the row's.
 
     Returns
     -------
     DiscretePHS
     """
+    table = current()
+    method = table.method if method is None else method
+    entry = table.entry(method)
     limits.check_discretization(nm, method, resolution)
-    if method not in METHODS:
-        raise NumericError(f"unknown discretization method {method!r}; expected one of {METHODS}")
-    res = defaults_for(method, nm.order).resolution if resolution is None else int(resolution)
+    check_basis(entry, basis)
+    row = entry.at(nm.order)
+    res = row.resolution if resolution is None else int(resolution)
+    discrete = Method.from_name(method).build(nm, res, row.basis if basis is None else basis)
+    if discrete.method != method:
+        raise NumericError(
+            f"the method {method!r} built a discretization that says method="
+            f"{discrete.method!r}; expected its own name"
+        )
     # the model's own [feedback] closes the open discretization (numeric.feedback)
-    if method == "galerkin":
-        from phdesign.numeric.discretization.galerkin import galerkin
-
-        return close_plant_feedback(galerkin(nm, res, basis))
-    if basis is not None:
-        raise NumericError(f"basis applies to method='galerkin' only; found basis={basis!r}")
-    from phdesign.numeric.discretization.staggered import staggered_fd
-
-    return close_plant_feedback(staggered_fd(nm, res))
+    return close_plant_feedback(discrete)

@@ -35,10 +35,20 @@ import numpy as np
 
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel, trace_index
+from phdesign.numeric.discretization.base import Method
 from phdesign.numeric.discretization.distributed import staggered_p0
 from phdesign.numeric.discretization.phs import DiscretePHS
 
-__all__ = ["staggered_fd"]
+__all__ = ["StaggeredFD", "staggered_fd"]
+
+
+class StaggeredFD(Method, name="fd"):
+    """The registered method ``"fd"``: :func:`staggered_fd` with ``resolution`` nodes per group."""
+
+    @classmethod
+    def build(cls, nm: NumericModel, resolution: int, basis: str | None) -> DiscretePHS:
+        """Return :func:`staggered_fd` of ``nm`` (finite differences have no ``basis``)."""
+        return staggered_fd(nm, resolution)
 
 
 def _groups(nm: NumericModel) -> tuple[list[int], list[int]]:
@@ -222,7 +232,7 @@ def staggered_fd(nm: NumericModel, m: int) -> DiscretePHS:
         disp = _fd_displacement(nm, p, q, zp, zq, Hp, Hq, r, m, dim)
     return DiscretePHS(
         model=nm,
-        method="fd",
+        method=StaggeredFD.name,
         resolution=m,
         E=E,
         J=0.5 * (J - J.T),
@@ -232,7 +242,12 @@ def staggered_fd(nm: NumericModel, m: int) -> DiscretePHS:
         effort_basis=effort_basis,
         project=project,
         displacement_basis=disp,
-        info={"h": h, "groups": (p, q)},
+        info={
+            "h": h,
+            "groups": (p, q),
+            # (component, node) of each state: node-major within the p block, then the q block
+            "coordinates": tuple((g[c], j) for g in (p, q) for j in range(m) for c in range(r)),
+        },
     )
 
 

@@ -68,6 +68,7 @@ from scipy.optimize import minimize_scalar
 
 from phdesign.core import limits
 from phdesign.core.checks import positive_int, positive_number
+from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import NumericError, ObserverError
 from phdesign.core.limits import check_noise_intensity
 from phdesign.numeric.bridge import NumericModel
@@ -76,7 +77,8 @@ from phdesign.numeric.discretization.registry import DiscretePHS, discretize, fe
 from phdesign.numeric.noise.lyapunov import TriangularPencil, triangularize
 from phdesign.numeric.noise.report import GainEstimate, NoiseReport
 from phdesign.numeric.noise.settle import Estimate, settle
-from phdesign.numeric.spectrum.converged import default_resolutions, match_resolved
+from phdesign.numeric.spectrum.converged import default_resolutions
+from phdesign.numeric.spectrum.drift import match_resolved
 
 __all__ = [
     "ErrorStatistics",
@@ -91,10 +93,6 @@ __all__ = [
     "sensor_rows",
 ]
 
-#: Default relative agreement of a noise figure between two resolutions.
-DEFAULT_TOL = {"galerkin": 1e-6, "fd": 1e-3}
-#: Relative drift under which an eigenvalue is resolved (the spectrum's defaults).
-RESOLVED_RTOL = {"galerkin": 1e-6, "fd": 1e-2}
 #: Grid maxima this far (relative) below the largest peak are not refined as its ties.
 _TIE_SCREEN = 1e-2
 
@@ -343,7 +341,7 @@ def noise(
     input_intensity: Any = None,
     performance: Sequence[Functional | str] | None = None,
     model: Any = None,
-    method: str = "galerkin",
+    method: str | None = None,
     resolution: int | None = None,
     max_resolution: int | None = None,
     tol: float | None = None,
@@ -367,11 +365,13 @@ def noise(
         displacement at b when the model defines one.
     model : BCPHS, optional
         The symbolic model, for parameters in the text of performance outputs.
-    method : {"galerkin", "fd"}
+    method : str, optional
+        A registered discretization; default: the table's (:mod:`phdesign.core.defaults`).
     resolution, max_resolution : int, optional
         First and largest resolution (default: the spectrum's, e.g. 20 and 110).
     tol : float, optional
-        Relative agreement that makes a figure converged (default 1e-6 Galerkin, 1e-3 FD).
+        Relative agreement that makes a figure converged (default: the method's row of the
+        table, 1e-6 Galerkin, 1e-3 FD).
     discretizations : dict, optional
         A cache ``{resolution: DiscretePHS}`` shared between calls (filled as needed).
 
@@ -394,8 +394,10 @@ def noise(
     feedback_matrix(C, Lm, nm.n_ports)  # shapes and L + L^T > 0, before any work
     sigma, w_in = noise_intensities(nm, C.shape[0], intensity, input_intensity)
     functionals = parse_functionals(performance, nm, model)
-    tol = DEFAULT_TOL.get(method, 1e-3) if tol is None else positive_number(tol, "tol")
-    rtol = RESOLVED_RTOL.get(method, 1e-2)
+    method = method_or_default(method)
+    row = current().discretization(method, nm.order)  # the noise's and spectrum's tolerances
+    tol = row.noise_tol if tol is None else positive_number(tol, "tol")
+    rtol = row.resolved_rtol
     p0, pmax = default_resolutions(nm, method)
     p = p0 if resolution is None else positive_int(resolution, "resolution")
     limits.check_noise_resolution(nm, p, "resolution")

@@ -331,7 +331,7 @@ def tradeoff(
     input_intensity: Any = None,
     performance: Sequence[Functional | str] | None = None,
     model: Any = None,
-    method: str = "galerkin",
+    method: str | None = None,
 ) -> Tradeoff:
     """Decay rate and noise figures over a family of gains, Pareto-optimal gains marked.
 

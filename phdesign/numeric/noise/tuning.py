@@ -9,8 +9,9 @@ Two problems over positive diagonal gains :math:`L = \operatorname{diag}(e^{x})`
 ``objective="rms"``, ``min_decay=a``
     minimize :math:`\max_i \mathrm{rms}_i(L)` subject to :math:`\alpha(L) \le -a`.
 
-The abscissa is the resolved one (:func:`phdesign.numeric.spectrum.converged.resolved_abscissa` on
-a resolution pair, as the plain tuning does) and the variances are the Lyapunov values at
+The abscissa is the resolved one (the drift test of :mod:`phdesign.numeric.spectrum.drift`
+and the abscissa rule of :mod:`phdesign.numeric.spectrum.abscissa` on a resolution pair, with
+the method's tolerances, as the plain tuning does) and the variances are the Lyapunov values at
 a resolution where they converged for the starting gain.  The abscissa is not smooth
 (its minimum typically sits at a coalescence of eigenvalues), so the search is a
 log-grid of starts followed by Nelder-Mead on the exact penalty
@@ -36,6 +37,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 
+from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
@@ -43,7 +45,10 @@ from phdesign.numeric.discretization.registry import discretize, feedback_matrix
 from phdesign.numeric.noise.figures import error_statistics, noise, noise_intensities, sensor_rows
 from phdesign.numeric.noise.report import NoiseReport, describe_gain, html_table
 from phdesign.numeric.noise.settle import finite_or_none
-from phdesign.numeric.spectrum.converged import SpectrumReport, eigen, resolved_abscissa, spectrum
+from phdesign.numeric.spectrum.abscissa import estimate_abscissa
+from phdesign.numeric.spectrum.converged import eigen, spectrum
+from phdesign.numeric.spectrum.drift import pair_spectrum
+from phdesign.numeric.spectrum.report import SpectrumReport
 
 __all__ = ["NoiseTuneResult", "tune_noise"]
 
@@ -213,13 +218,15 @@ def tune_noise(
         )
     start = noise(nm, C, np.eye(q), intensity=sigma, input_intensity=w_in, performance=functionals)
     first = spectrum(nm, C, np.eye(q))
-    p_lo = first.resolutions[0] if first.converged else 30
-    p_rms = max(_first_agreeing(e, _tol_of(start)) or 30 for e in start.performance)
+    row = current().discretization(first.method, nm.order)
+    p_lo = first.resolutions[0] if first.converged else row.tune_fallback
+    # the agreement the starting figures were judged with: the method's noise tolerance
+    p_rms = max(_first_agreeing(e, row.noise_tol) or row.tune_fallback for e in start.performance)
     # the variance is solved at the coarse member of the abscissa pair when it has converged
     # there (one triangularization then gives both), else at its own resolution
     p_lo = p_rms if p_rms <= p_lo else p_lo
-    pair = [discretize(nm, "galerkin", p) for p in (p_lo, math.ceil(1.5 * p_lo))]
-    d_rms = pair[0] if p_rms <= p_lo else discretize(nm, "galerkin", p_rms)
+    pair = [discretize(nm, first.method, p) for p in (p_lo, math.ceil(1.5 * p_lo))]
+    d_rms = pair[0] if p_rms <= p_lo else discretize(nm, first.method, p_rms)
     rows = [f.row(d_rms) for f in functionals]
     count = [0]
 
@@ -230,7 +237,16 @@ def tune_noise(
         stats = error_statistics(d_rms, C, L, sigma, w_in)
         coarse = stats.eigenvalues if d_rms is pair[0] else eigen(pair[0], K)[0]
         fine, kappa = eigen(pair[1], K, condition=True)
-        alpha = resolved_abscissa(fine, coarse, kappa=kappa)
+        drift = pair_spectrum(
+            fine,
+            coarse,
+            resolutions=(0, 0),
+            rtol=row.resolved_rtol,
+            scale=1.0,
+            kappa=kappa,
+            dissipative=True,
+        )
+        alpha = estimate_abscissa(drift, row.abscissa_tol).value
         return alpha, math.sqrt(max(stats.variance(r) for r in rows))
 
     def merit(x: np.ndarray) -> float:
@@ -303,13 +319,6 @@ def tune_noise(
         evaluations=count[0],
         warnings=tuple(warnings),
     )
-
-
-def _tol_of(report: NoiseReport) -> float:
-    """Return the agreement the noise report was judged with (its method's default)."""
-    from phdesign.numeric.noise.figures import DEFAULT_TOL
-
-    return DEFAULT_TOL.get(report.method, 1e-3)
 
 
 def _first_agreeing(est: Any, tol: float) -> int | None:

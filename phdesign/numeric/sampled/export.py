@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.checks import positive_number
-from phdesign.core.defaults import EXPORT
+from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError
 from phdesign.core.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
@@ -71,9 +71,6 @@ __all__ = [
 
 #: Export formats of :meth:`SampledObserver.write`.
 FORMATS = ("json", "c", "npz", "statespace")
-#: Galerkin degree of the verification plant when none is given: the paper's beam
-#: observer of degree 16 (34 states) then meets a plant of 98 states.
-PLANT_DEGREE = 48
 
 
 def _matrix(a: np.ndarray) -> list[list[float]]:
@@ -260,7 +257,7 @@ class SampledObserver:
 def verification_plant_degree(
     nm: NumericModel, order: int | None, plant_resolution: int | None, reduction: str = "none"
 ) -> int:
-    """Degree of the verification plant: given, or PLANT_DEGREE raised to 2x the order.
+    """Degree of the verification plant: given, or the export's default raised to 2x the order.
 
     Checks the whole request first (:func:`phdesign.numeric.sampled.order.check_order`), so that a
     command refuses it before any computation.
@@ -288,7 +285,7 @@ def _plant_degree(nm: NumericModel, order: int | None, plant_resolution: int | N
             )
         return plant_resolution
     if order is None or isinstance(order, bool) or not isinstance(order, int) or order < 1:
-        return PLANT_DEGREE
+        return current().export.plant_degree
     from phdesign.numeric.spectrum.converged import default_resolutions
 
     needed = -(-2 * order // nm.size) - 1
@@ -299,7 +296,7 @@ def _plant_degree(nm: NumericModel, order: int | None, plant_resolution: int | N
             f"largest for this model has {nm.size * (largest + 1)} (Galerkin degree "
             f"{largest}): lower the order"
         )
-    return max(PLANT_DEGREE, needed)
+    return max(current().export.plant_degree, needed)
 
 
 def displacement_points(nm: NumericModel, points: Any, name: str = "points") -> tuple[float, ...]:
@@ -342,15 +339,15 @@ def export_observer(
     L: np.ndarray,
     *,
     dt: float,
-    sampler: str = EXPORT.sampler,
+    sampler: str | None = None,
     order: int | None = None,
     reduction: str = "none",
-    tol: float = EXPORT.tol,
-    output_tol: float = EXPORT.output_tol,
+    tol: float | None = None,
+    output_tol: float | None = None,
     verify: bool = False,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     x0_text: str | None = None,
-    t_end: float = EXPORT.t_end,
+    t_end: float | None = None,
     plant_resolution: int | None = None,
     points: float | Sequence[float] | None = None,
     model_name: str | None = None,
@@ -364,14 +361,15 @@ def export_observer(
         Sensors and gain.
     dt : float
         Sampling period (> 0).
-    sampler : {"average", "point"}
+    sampler : {"average", "point"}, optional
         The controller's front end (module docstring). ``average`` is the safe default.
+        This and the other defaults are the export's (:mod:`phdesign.core.defaults`).
     order : int, optional
         Number of observer states; chosen from ``tol``/``output_tol`` when omitted.
     reduction : {"none", "modal", "balanced"}
         See :mod:`phdesign.numeric.sampled.order`.
-    tol, output_tol : float
-        Spectral and performance targets of the order selection.
+    tol, output_tol : float, optional
+        Spectral and performance targets of the order selection (1e-6 and 1e-3).
     verify : bool
         Run the exported observer against the verification plant.
     x0 : callable, optional
@@ -379,8 +377,8 @@ def export_observer(
         default every component ``(z - a)/(b - a) - 0.9``.
     x0_text : str, optional
         How ``x0`` is described in reports.
-    t_end : float
-        Length of those runs.
+    t_end : float, optional
+        Length of those runs (5 s).
     plant_resolution : int, optional
         Galerkin degree of the verification plant (default 48, raised to twice the order).
     points : float or sequence of float, optional
@@ -404,6 +402,7 @@ def export_observer(
     """
     from phdesign.numeric.discretization.registry import discretize
 
+    sampler, tol, output_tol, t_end = current().export.fill(sampler, tol, output_tol, t_end)
     dt = check_sampling(dt, sampler)
     if reduction not in REDUCTIONS:
         raise NumericError(f"unknown reduction {reduction!r}; expected one of {REDUCTIONS}")
@@ -445,7 +444,8 @@ def export_observer(
         )
     if verification is not None or missed:
         # one finer plant serves both checks, on the verification's records when there are any
-        t = np.linspace(0.0, float(t_end), 501) if verification is None else verification.t
+        samples = current().simulation.samples
+        t = np.linspace(0.0, float(t_end), samples) if verification is None else verification.t
         found = plant_gap(nm, plant, continuous, initial, t)
         if verification is not None:
             verification = with_plant_gap(verification, found, plant.resolution)

@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sl
 
-from phdesign.numeric.discretization.defaults import defaults_for
+from phdesign.core.defaults import current
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize
 
@@ -119,7 +119,7 @@ def resolved_mask(
     lam: np.ndarray, reference: np.ndarray, rtol: float, kappa: np.ndarray | None = None
 ) -> np.ndarray:
     """Boolean mask of the eigenvalues ``lam`` kept by the module's rule."""
-    from phdesign.numeric.spectrum.converged import in_band_unresolved, match_resolved
+    from phdesign.numeric.spectrum.drift import in_band_unresolved, match_resolved
 
     mask = np.zeros(lam.size, dtype=bool)
     idx, _ = match_resolved(lam, reference, rtol)
@@ -166,7 +166,7 @@ def truncate_to_resolved(
     finer = discretize(d.model, d.method, math.ceil(1.5 * d.resolution), basis=_basis(d))
     reference, _ = eigen(finer, K)  # the eigen stage of the spectrum, at 1.5 p
     lam, kappa = eigen(d, K, condition=True)
-    rtol = defaults_for(d.method, d.model.order).resolved_rtol
+    rtol = current().discretization(d.method, d.model.order).resolved_rtol
     mask = resolved_mask(lam, reference, rtol, kappa)
     F = np.linalg.solve(d.E, A)
     kept_values = lam[mask]
@@ -196,4 +196,5 @@ def truncate_to_resolved(
 
 
 def _basis(d: DiscretePHS) -> str | None:
-    return d.info.get("basis") if d.method == "galerkin" else None
+    """Return the basis ``d`` was built in (a method without bases records none)."""
+    return d.info.get("basis")

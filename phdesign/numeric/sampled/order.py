@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sl
 
-from phdesign.core.defaults import EXPORT
+from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.phs import DiscretePHS
@@ -268,7 +268,7 @@ def modal_truncation(
 
     Returns the reduced observer and the dropped poles.
     """
-    from phdesign.numeric.spectrum.converged import match_resolved
+    from phdesign.numeric.spectrum.drift import match_resolved
 
     poles = np.linalg.eigvals(observer.A)
     kept_idx, _ = match_resolved(poles, reference, tol)
@@ -354,9 +354,9 @@ def select_order(
     points: tuple[float, ...] = (),
     order: int | None = None,
     reduction: str = "none",
-    tol: float = EXPORT.tol,
-    output_tol: float = EXPORT.output_tol,
-    count: int = 6,
+    tol: float | None = None,
+    output_tol: float | None = None,
+    count: int | None = None,
 ) -> tuple[OrderSelection, ContinuousObserver]:
     """Choose the exported observer (module docstring) and report the choice.
 
@@ -376,10 +376,11 @@ def select_order(
     order : int, optional
         Number of states; None chooses it from the targets.
     reduction : {"none", "modal", "balanced"}
-    tol, output_tol : float
-        Spectral and performance targets.
-    count : int
-        Number of converged rightmost eigenvalues the observer must reproduce.
+    tol, output_tol : float, optional
+        Spectral and performance targets (default: the export's, :mod:`phdesign.core.defaults`).
+    count : int, optional
+        Number of converged rightmost eigenvalues the observer must reproduce (default:
+        the spectrum's).
 
     Returns
     -------
@@ -387,6 +388,7 @@ def select_order(
     """
     from phdesign.numeric.spectrum.converged import eigen, spectrum
 
+    _, tol, output_tol, _ = current().export.fill(tol=tol, output_tol=output_tol)
     if reduction not in REDUCTIONS:
         raise NumericError(f"unknown reduction {reduction!r}; expected one of {REDUCTIONS}")
     for name, value in (("tol", tol), ("output_tol", output_tol)):

@@ -21,6 +21,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
 from phdesign.core.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
@@ -69,11 +70,11 @@ def simulate_sampled(
     *,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     xhat0: Callable[[np.ndarray], np.ndarray] | None = None,
-    t_end: float = 5.0,
-    samples: int = 501,
+    t_end: float | None = None,
+    samples: int | None = None,
     dt: float | None = None,
-    sampler: str = "average",
-    method: str = "galerkin",
+    sampler: str | None = None,
+    method: str | None = None,
     resolution: int | None = None,
     observer_resolution: int | None = None,
     u: Callable[[float], np.ndarray] | None = None,
@@ -88,15 +89,17 @@ def simulate_sampled(
         Sensors and gain.
     x0, xhat0 : callable, optional
         Initial states ``f(z) -> (m, n)`` of plant and observer; default zero.
-    t_end : float
-        Final time.
-    samples : int
-        About this many records: every ``s`` periods, ``s = round(T / ((samples - 1) dt))``
-        (every one of ``samples - 1`` equal steps for a continuous observer).
+    t_end : float, optional
+        Final time (default 5).
+    samples : int, optional
+        About this many records (default 501): every ``s`` periods,
+        ``s = round(T / ((samples - 1) dt))`` (every one of ``samples - 1`` equal steps for
+        a continuous observer).
     dt : float, optional
         Sampling period; None runs the continuous observer.
-    sampler : {"average", "point"}
-        The observer's front end when ``dt`` is given.
+    sampler : {"average", "point"}, optional
+        The observer's front end when ``dt`` is given (default ``"average"``, the
+        exported observer's; the defaults are those of :mod:`phdesign.core.defaults`).
     method, resolution
         The plant's discretization (:func:`phdesign.numeric.discretization.registry.discretize`).
     observer_resolution : int, optional
@@ -111,6 +114,8 @@ def simulate_sampled(
     SimulationResult
         With ``info`` holding ``dt``, ``sampler`` and ``observer_resolution``.
     """
+    t_end, samples, _, _ = current().simulation.fill(t_end, samples)
+    sampler = current().export.sampler if sampler is None else sampler
     if not (np.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a positive number; found {t_end}")
     if int(samples) < 2:

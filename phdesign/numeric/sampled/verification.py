@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from phdesign.core.defaults import current
 from phdesign.core.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.sampled.order import OrderSelection, check_order
@@ -153,15 +154,17 @@ def verify_observer(
     sampler: str,
     x0: np.ndarray,
     t_end: float,
-    samples: int = 501,
+    samples: int | None = None,
     x0_text: str = "x0",
 ) -> Verification:
     """Run the sampled and the continuous observer against ``plant`` from ``x0``.
 
     Both are stepped exactly (:func:`phdesign.numeric.sampled.samplers.run_loop`) over
     round(t_end / dt) periods, the sampler applied to the plant's outputs, and recorded
-    on the same instants (every ``stride`` periods, about ``samples`` records).
+    on the same instants (every ``stride`` periods, about ``samples`` records; default
+    the simulations', :mod:`phdesign.core.defaults`).
     """
+    samples = current().simulation.samples if samples is None else samples
     dt = check_sampling(dt, sampler)
     check_periods(dt, t_end)
     check_order(observer.order, plant.dim, plant.resolution)

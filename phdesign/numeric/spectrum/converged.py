@@ -32,16 +32,20 @@ Galerkin matrix), in three stages:
    (round-off at high degree can make a true eigenvalue fail the drift test at a finer
    pair).
 
-3. **Warnings** (:func:`report_warnings`): not converged and why, a limit at high
-   frequency, no exponential decay, ill-conditioned rightmost eigenvalues (energy-norm
-   condition number above 1e4, or a relative gap below 1e-3: near a coalescence),
-   eigenvalues right of the abscissa that do not count, artefacts.
+3. **Warnings** (:func:`~phdesign.numeric.spectrum.warnings.report_warnings`): not
+   converged and why, a limit at high frequency, no exponential decay, ill-conditioned
+   rightmost eigenvalues (energy-norm condition number above 1e4, or a relative gap below
+   1e-3: near a coalescence), eigenvalues right of the abscissa that do not count,
+   artefacts.
 
 The spectrum is *unbounded below* (finite-time extinction, e.g. the string with the
 matched damper) only on evidence: no eigenvalue resolved at the last two pairs and every
 discrete eigenvalue outside the disk of radius 5 s (rule 5 of
 :mod:`phdesign.numeric.spectrum.abscissa`).  Without that evidence an unresolved spectrum is
 "not resolved at these resolutions", never a number.
+
+Where the refinement starts and stops and its tolerances come from the method's row of
+the table of defaults (:class:`RefinementPlan`, :mod:`phdesign.core.defaults`).
 
 Examples
 --------
@@ -56,24 +60,21 @@ Examples
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
+from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_spectrum_arguments
-from phdesign.numeric.discretization.defaults import band_resolution, spectrum_resolutions
-from phdesign.numeric.discretization.phs import DiscretePHS
-from phdesign.numeric.discretization.registry import feedback_matrix
-from phdesign.numeric.scales import ProblemScales
-from phdesign.numeric.spectrum.abscissa import estimate_abscissa
-from phdesign.numeric.spectrum.drift import in_band_unresolved, match_resolved, pair_spectrum
+from phdesign.numeric.discretization.phs import DiscretePHS, feedback_matrix
 from phdesign.numeric.spectrum.eigen import prepare
-from phdesign.numeric.spectrum.evaluator import default_tolerances
 from phdesign.numeric.spectrum.refinement import (
     ClosedLoopSolver,
     Discretizations,
     PairResult,
+    ResolutionSolver,
     choose_pair,
     extinct_twice,
     refine,
@@ -83,17 +84,10 @@ from phdesign.numeric.spectrum.warnings import report_warnings, reported_value, 
 from phdesign.numeric.threads import small_dense_threads
 
 __all__ = [
-    "PairResult",
-    "SpectrumReport",
+    "RefinementPlan",
     "abscissa_digits",
-    "choose_pair",
     "default_resolutions",
     "eigen",
-    "in_band_unresolved",
-    "match_resolved",
-    "refine",
-    "report_warnings",
-    "resolved_abscissa",
     "rightmost_indices",
     "spectrum",
 ]
@@ -123,45 +117,78 @@ def eigen(
     return system.eigen_condition(K)
 
 
-def resolved_abscissa(
-    fine: np.ndarray,
-    coarse: np.ndarray,
-    rtol: float = 1e-6,
-    kappa: np.ndarray | None = None,
-    scale: float = 1.0,
-    tol: float = 1e-10,
-    dissipative: bool = True,
-) -> float | None:
-    """Return the abscissa of two sets of eigenvalues, or None.
-
-    The abscissa is that of :mod:`phdesign.numeric.spectrum.abscissa`.
-
-    Kept for callers of earlier versions;
-    :class:`phdesign.numeric.spectrum.evaluator.AbscissaEvaluator`
-    prepares a resolution pair once and evaluates it for many gains.  Without condition
-    numbers ``kappa`` every in-band unresolved eigenvalue is kept (an upper bound).
-    ``dissipative=True`` (the default: a closed loop ũ = −Kỹ of a discretization) states
-    that every exact eigenvalue has Re λ <= 0 (:mod:`phdesign.numeric.spectrum.drift`).
-    """
-    pair = pair_spectrum(
-        fine,
-        coarse,
-        resolutions=(0, 0),
-        rtol=rtol,
-        scale=scale,
-        kappa=kappa,
-        dissipative=dissipative,
-    )
-    return estimate_abscissa(pair, tol).value
-
-
 def default_resolutions(nm: NumericModel, method: str) -> tuple[int, int]:
-    """Return the starting and maximal resolution for ``method`` (degree or nodes per group).
+    """Return the first and largest resolution of the spectrum's refinement for ``method``.
 
-    The values live in one table,
-    :func:`phdesign.numeric.discretization.defaults.spectrum_resolutions`.
+    The method's row of the table of defaults (:mod:`phdesign.core.defaults`) for the
+    model's order.
     """
-    return spectrum_resolutions(nm.order, method)
+    row = current().discretization(method, nm.order)
+    return row.spectrum_start, row.spectrum_max
+
+
+@dataclass(frozen=True)
+class RefinementPlan:
+    """Where the refinement of the resolution pairs starts and stops, and its tolerances.
+
+    Attributes
+    ----------
+    start, stop : int
+        First and largest resolution (degree or nodes per group).
+    band_stop : int
+        Largest resolution while the band does not reach the onset of the principal part.
+    tol, rtol_resolved : float
+        Abscissa agreement and drift of a resolved eigenvalue, relative to the rate.
+    """
+
+    start: int
+    stop: int
+    band_stop: int
+    tol: float
+    rtol_resolved: float
+
+    @classmethod
+    def of(
+        cls,
+        nm: NumericModel,
+        method: str,
+        *,
+        resolution: int | None = None,
+        max_resolution: int | None = None,
+        tol: float | None = None,
+        rtol_resolved: float | None = None,
+        start: int | None = None,
+    ) -> RefinementPlan:
+        """Return the plan of the arguments given, the method's row of the table elsewhere.
+
+        ``start`` replaces the row's first resolution when ``resolution`` is None.  A
+        band short of the onset refines up to the row's band cap, within a cap the
+        user gives (``max_resolution``).
+        """
+        row = current().discretization(method, nm.order)
+        if resolution is not None:
+            start = int(resolution)
+        p = row.spectrum_start if start is None else start
+        stop = int(max_resolution) if max_resolution is not None else max(row.spectrum_max, p)
+        band_stop = stop if max_resolution is not None else max(row.band_max, row.spectrum_max)
+        return cls(
+            start=p,
+            stop=stop,
+            band_stop=band_stop,
+            tol=row.abscissa_tol if tol is None else float(tol),
+            rtol_resolved=row.resolved_rtol if rtol_resolved is None else float(rtol_resolved),
+        )
+
+    def refine(self, solver: ResolutionSolver) -> list[PairResult]:
+        """Run :func:`~phdesign.numeric.spectrum.refinement.refine` by this plan."""
+        return refine(
+            solver,
+            start=self.start,
+            stop=self.stop,
+            tol=self.tol,
+            rtol_resolved=self.rtol_resolved,
+            band_stop=self.band_stop,
+        )
 
 
 def rightmost_indices(chosen: PairResult, count: int) -> np.ndarray:
@@ -180,22 +207,27 @@ def abscissa_digits(chosen: PairResult) -> float:
     return -math.log10(max(a.uncertainty, np.finfo(float).eps * scale) / scale)
 
 
-def _unresolved_report(
-    trail: list[PairResult],
-    method: str,
-    system: str,
-    model: str,
-    scales: ProblemScales,
-    sensors: list[list[float]] | None,
-    gain: list[list[float]] | None,
-) -> SpectrumReport:
+@dataclass(frozen=True)
+class _Labels:
+    """What a report says it is about: method, system, model, rate, sensors and gain."""
+
+    method: str
+    system: str
+    model: str
+    rate: float
+    sensors: list[list[float]] | None
+    gain: list[list[float]] | None
+
+
+def _unresolved_report(trail: list[PairResult], labels: _Labels) -> SpectrumReport:
+    """Stage 3 without a number: an empty spectrum (seen twice) or one not resolved."""
     last = trail[-1]
     extinct = extinct_twice(trail)
     p, q = last.pair.resolutions
     if extinct:
         warning = (
             f"no eigenvalue converges under refinement up to resolution {q} and every discrete "
-            f"eigenvalue stays outside |λ| <= {5 * scales.rate:.3g} (5 times the rate) at every "
+            f"eigenvalue stays outside |λ| <= {5 * labels.rate:.3g} (5 times the rate) at every "
             "resolution, the nearest ones decaying faster than they oscillate: the spectrum is "
             "empty (finite-time extinction); the spectral abscissa is unbounded below"
         )
@@ -213,19 +245,19 @@ def _unresolved_report(
         n_resolved=0,
         n_total=int(last.pair.eigenvalues.size),
         resolutions=(p, q),
-        method=method,
-        system=system,
+        method=labels.method,
+        system=labels.system,
         unbounded_below=extinct,
         all_eigenvalues_max_real=last.pair.all_max_real,
         history=tuple(r.step() for r in trail),
         warnings=[warning],
-        model=model,
+        model=labels.model,
         kind="unbounded below" if extinct else "not resolved",
-        rate_scale=scales.rate,
+        rate_scale=labels.rate,
         eigenvalues=last.pair.eigenvalues,
         resolved=last.pair.resolved,
-        sensors=sensors,
-        gain=gain,
+        sensors=labels.sensors,
+        gain=labels.gain,
     )
 
 
@@ -234,16 +266,19 @@ def spectrum(
     C_m: np.ndarray | None = None,
     L: np.ndarray | None = None,
     *,
-    method: str = "galerkin",
+    method: str | None = None,
     resolution: int | None = None,
     max_resolution: int | None = None,
     tol: float | None = None,
     rtol_resolved: float | None = None,
-    count: int = 6,
+    count: int | None = None,
     basis: str | None = None,
     discretizations: Discretizations | None = None,
 ) -> SpectrumReport:
     """Converged spectral abscissa and rightmost eigenvalues (module docstring).
+
+    Every default is the method's row of the table of defaults
+    (:mod:`phdesign.core.defaults`).
 
     Parameters
     ----------
@@ -251,7 +286,8 @@ def spectrum(
     C_m, L : ndarray, optional
         Sensors and gain; when given the error system (ũ = −C_mᵀ L C_m ỹ) is analysed,
         otherwise the closed plant with u = 0.
-    method : {"galerkin", "fd"}
+    method : str, optional
+        A registered discretization (``"galerkin"``, ``"fd"``); default: the table's.
     resolution, max_resolution : int, optional
         First and largest resolution (degree or nodes per group).
     tol : float, optional
@@ -261,13 +297,11 @@ def spectrum(
     rtol_resolved : float, optional
         Relative drift under which an eigenvalue counts as resolved; default 1e-6 for
         Galerkin, 1e-2 for finite differences.
-    count : int
-        How many rightmost eigenvalues to report.
-    basis : {"scaled", "legendre"}, optional
-        The Galerkin basis (default: the defaults table's for the model's order,
-        :mod:`phdesign.numeric.discretization.defaults`); the plain Legendre basis lowers the
-        largest
-        resolution for N >= 3, where its round-off grows with the degree.
+    count : int, optional
+        How many rightmost eigenvalues to report (default 6).
+    basis : str, optional
+        The basis of a method that has several (Galerkin: ``"scaled"`` or
+        ``"legendre"``); default: the row's.
     discretizations : Discretizations, optional
         The model's discretizations by ``method`` and ``basis``, shared by many calls at
         different gains (:class:`~phdesign.numeric.spectrum.refinement.Discretizations`):
@@ -277,6 +311,8 @@ def spectrum(
     -------
     SpectrumReport
     """
+    method = method_or_default(method)
+    count = current().spectrum.count if count is None else count
     check_spectrum_arguments(
         nm,
         C_m,
@@ -287,42 +323,57 @@ def spectrum(
         tol=tol,
         rtol_resolved=rtol_resolved,
         count=count,
+        basis=basis,
     )
-    if (C_m is None) != (L is None):
-        raise NumericError("give both the sensors C_m and the gain L, or neither")
     K = None if C_m is None or L is None else feedback_matrix(C_m, L, nm.n_ports)
-    default_tol, default_rtol = default_tolerances(method)
-    tol = default_tol if tol is None else float(tol)
-    rtol_resolved = default_rtol if rtol_resolved is None else float(rtol_resolved)
-    if basis is not None and method != "galerkin":
-        raise NumericError(f"basis applies to method='galerkin' only; found basis={basis!r}")
-    p0, pmax = spectrum_resolutions(nm.order, method, basis)
-    p = int(resolution) if resolution is not None else p0
-    pmax = int(max_resolution) if max_resolution is not None else max(pmax, p)
-    # a band short of the onset of the principal part refines further, within the user's cap
-    band_stop = pmax if max_resolution is not None else band_resolution(nm.order, method, basis)
-    system = "plant (u = 0)" if K is None else "observer error system"
+    plan = RefinementPlan.of(
+        nm,
+        method,
+        resolution=resolution,
+        max_resolution=max_resolution,
+        tol=tol,
+        rtol_resolved=rtol_resolved,
+    )
     with small_dense_threads():
         solver = ClosedLoopSolver(
             nm, K, method=method, basis=basis, discretizations=discretizations
         )
-        trail = refine(
-            solver,
-            start=p,
-            stop=pmax,
-            tol=tol,
-            rtol_resolved=rtol_resolved,
-            band_stop=band_stop,
-        )
-    scales = solver.scales
-    sensors = None if C_m is None else np.atleast_2d(np.asarray(C_m, float)).tolist()
-    gain = None if L is None else np.atleast_2d(np.asarray(L, float)).tolist()
+        trail = plan.refine(solver)
+    labels = _Labels(
+        method=method,
+        system="plant (u = 0)" if K is None else "observer error system",
+        model=nm.name,
+        rate=solver.scales.rate,
+        sensors=None if C_m is None else np.atleast_2d(np.asarray(C_m, float)).tolist(),
+        gain=None if L is None else np.atleast_2d(np.asarray(L, float)).tolist(),
+    )
     chosen, notes = choose_pair(trail)
-    a, pair = chosen.abscissa, chosen.pair
+    a = chosen.abscissa
     if a.value is None or a.uncertainty is None or a.attained is None:
-        return _unresolved_report(trail, method, system, nm.name, scales, sensors, gain)
-    warnings, ill, no_decay = report_warnings(chosen, a.value, a.uncertainty, a.attained, tol)
+        return _unresolved_report(trail, labels)
+    warnings, ill, no_decay = report_warnings(chosen, a.value, a.uncertainty, a.attained, plan.tol)
     value, uncertainty = reported_value(a.value, a.uncertainty, no_decay)
+    return _report(
+        chosen, trail, (value, uncertainty), (notes + warnings, ill, no_decay), count, labels
+    )
+
+
+def _report(
+    chosen: PairResult,
+    trail: list[PairResult],
+    abscissa: tuple[float, float],
+    verdict: tuple[list[str], bool, bool],
+    count: int,
+    labels: _Labels,
+) -> SpectrumReport:
+    """Stage 3: the report of the chosen pair, its abscissa (value, uncertainty) a number.
+
+    ``verdict`` holds the warnings, whether the rightmost eigenvalues are ill-conditioned
+    and whether the spectrum shows no decay.
+    """
+    a, pair = chosen.abscissa, chosen.pair
+    value, uncertainty = abscissa
+    warnings, ill, no_decay = verdict
     lower_bound = a.kind == "lower bound"
     lam = pair.eigenvalues
     top = rightmost_indices(chosen, count)
@@ -337,23 +388,23 @@ def spectrum(
         n_resolved=pair.n_resolved,
         n_total=int(lam.size),
         resolutions=pair.resolutions,
-        method=method,
-        system=system,
+        method=labels.method,
+        system=labels.system,
         unbounded_below=False,
         ill_conditioned=ill,
         condition_numbers=[float(c) for c in kappa[top]],
         all_eigenvalues_max_real=pair.all_max_real,
         history=tuple(r.step() for r in trail),
-        warnings=notes + warnings,
-        model=nm.name,
+        warnings=warnings,
+        model=labels.model,
         uncertainty=None if lower_bound else uncertainty,
         kind=a.kind,
         no_decay=no_decay,
-        rate_scale=scales.rate,
+        rate_scale=labels.rate,
         eigenvalues=lam,
         resolved=pair.resolved,
-        sensors=sensors,
-        gain=gain,
+        sensors=labels.sensors,
+        gain=labels.gain,
         branches=a.branches,
         complete_band=pair.complete_band,
     )

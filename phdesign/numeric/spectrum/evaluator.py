@@ -42,6 +42,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.registry import feedback_matrix
@@ -56,17 +57,7 @@ from phdesign.numeric.spectrum.refinement import (
 )
 from phdesign.numeric.threads import small_dense_threads
 
-__all__ = ["AbscissaEvaluator", "default_tolerances", "fine_resolution"]
-
-
-def default_tolerances(method: str) -> tuple[float, float]:
-    """Return (tol, rtol_resolved): abscissa agreement and drift of a resolved eigenvalue.
-
-    Both are relative to the problem's rate (:mod:`phdesign.numeric.scales`): 1e-10 and
-    1e-6 for the spectrally accurate Galerkin method, 1e-3 and 1e-2 for the second-order
-    finite differences.
-    """
-    return (1e-10, 1e-6) if method == "galerkin" else (1e-3, 1e-2)
+__all__ = ["AbscissaEvaluator"]
 
 
 class AbscissaEvaluator:
@@ -79,9 +70,12 @@ class AbscissaEvaluator:
         Sensors; None evaluates the plant with u = 0 (then call with ``L=None``).
     resolutions : (int, int) or int
         The pair (p, p_fine), or p alone for (p, ⌈1.5 p⌉).
-    method : {"galerkin", "fd"}
+    method : str, optional
+        A registered discretization; default: the table's (:mod:`phdesign.core.defaults`).
     tol, rtol_resolved : float, optional
-        Abscissa tolerance and drift tolerance (:func:`default_tolerances`).
+        Abscissa tolerance and drift tolerance, relative to the problem's rate
+        (:mod:`phdesign.numeric.scales`); default: the method's row of the table (Galerkin
+        1e-10 and 1e-6, finite differences 1e-3 and 1e-2).
 
     Attributes
     ----------
@@ -97,7 +91,7 @@ class AbscissaEvaluator:
         C_m: np.ndarray | None,
         resolutions: tuple[int, int] | int,
         *,
-        method: str = "galerkin",
+        method: str | None = None,
         tol: float | None = None,
         rtol_resolved: float | None = None,
     ) -> None:
@@ -105,12 +99,13 @@ class AbscissaEvaluator:
             p, p_fine = (int(r) for r in resolutions)
         else:
             p, p_fine = int(resolutions), fine_resolution(int(resolutions))
-        default_tol, default_rtol = default_tolerances(method)
+        method = method_or_default(method)
+        row = current().discretization(method, nm.order)
         self.model = nm
         self.method = method
         self.resolutions = (p, p_fine)
-        self.tol = default_tol if tol is None else float(tol)
-        self.rtol_resolved = default_rtol if rtol_resolved is None else float(rtol_resolved)
+        self.tol = row.abscissa_tol if tol is None else float(tol)
+        self.rtol_resolved = row.resolved_rtol if rtol_resolved is None else float(rtol_resolved)
         self.C_m = None if C_m is None else np.atleast_2d(np.asarray(C_m, dtype=float))
         self.discretizations = Discretizations(nm, method)
         self.scales = self.discretizations.scales

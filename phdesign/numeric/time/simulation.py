@@ -1,13 +1,11 @@
 r"""Simulation of plant and observer together, exact in time for these LTI systems.
 
 With the discretization :math:`E \dot{\hat e} = (J - R)\hat e + B u`,
-:math:`y = B^\top \hat e + D u` (:mod:`phdesign.numeric.discretization.registry`), the observer is
-the
-same system driven by :math:`\hat u = u + C_m^\top L (y_m - \hat y_m)`, i.e. the loop
-:math:`\hat u = v - K \hat y` with :math:`K = C_m^\top L C_m` and
+:math:`y = B^\top \hat e + D u` (:mod:`phdesign.numeric.discretization.registry`), the
+observer is the same system driven by :math:`\hat u = u + C_m^\top L (y_m - \hat y_m)`, i.e.
+the loop :math:`\hat u = v - K \hat y` with :math:`K = C_m^\top L C_m` and
 :math:`v = u + C_m^\top L y_m` (:meth:`~phdesign.numeric.discretization.phs.DiscretePHS.close`).
-In the
-coordinates (plant :math:`\hat e`, error :math:`\tilde e = \hat e - \hat e_{obs}`) the
+In the coordinates (plant :math:`\hat e`, error :math:`\tilde e = \hat e - \hat e_{obs}`) the
 coupled system is block triangular,
 
 .. math::
@@ -51,6 +49,7 @@ from typing import Any
 
 import numpy as np
 
+from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_simulate_arguments
@@ -59,7 +58,6 @@ from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.threads import limited_threads
 from phdesign.numeric.time.display import SimulationDisplay
 from phdesign.numeric.time.stepping import (
-    MIDPOINT_RTOL,
     SCHEMES,
     Trajectory,
     energy_balance_residual,
@@ -314,15 +312,15 @@ def simulate(
     *,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     xhat0: Callable[[np.ndarray], np.ndarray] | None = None,
-    t_end: float = 5.0,
-    samples: int = 501,
-    method: str = "galerkin",
+    t_end: float | None = None,
+    samples: int | None = None,
+    method: str | None = None,
     resolution: int | None = None,
     u: Callable[[float], np.ndarray] | None = None,
-    scheme: str = "expm",
+    scheme: str | None = None,
     z_w: np.ndarray | None = None,
     discrete: DiscretePHS | None = None,
-    tol: float = MIDPOINT_RTOL,
+    tol: float | None = None,
     check_resolution: bool = True,
 ) -> SimulationResult:
     """Simulate the plant, and the observer when sensors are given.
@@ -335,25 +333,25 @@ def simulate(
     x0, xhat0 : callable, optional
         Initial states ``f(z) -> (m, n)`` (see
         :func:`phdesign.numeric.inputs.initial_state_function`); default zero.
-    t_end : float
-        Final time (> 0).
-    samples : int
-        Number of output samples on [0, t_end] (>= 2).
+    t_end : float, optional
+        Final time (> 0); default 5.
+    samples : int, optional
+        Number of output samples on [0, t_end] (>= 2); default 501.
     method, resolution
         Discretization (see :func:`phdesign.numeric.discretization.registry.discretize`).
     u : callable, optional
         Plant input ``u(t) -> (N n,)``, sampled on the output grid and linear in between;
         default zero.
-    scheme : {"expm", "midpoint"}
-        Exact exponential, or implicit midpoint with substeps chosen so that its
+    scheme : {"expm", "midpoint"}, optional
+        Exact exponential (the default), or implicit midpoint with substeps chosen so that its
         estimated error is below ``tol`` (:mod:`phdesign.numeric.time.stepping`).
     z_w : ndarray, optional
         Points where the displacement is reported (default 21 uniform points).
     discrete : DiscretePHS, optional
         A ready discretization (overrides ``method``/``resolution``).
-    tol : float
+    tol : float, optional
         Midpoint: largest estimated error of the states, relative to their largest
-        energy norm (default 1e-6).
+        energy norm (default 1e-6; the defaults are those of :mod:`phdesign.core.defaults`).
     check_resolution : bool
         With an observer, step the error system again at ⌈1.5 p⌉ to find how far
         H_err is resolved (module docstring); default True.
@@ -362,6 +360,8 @@ def simulate(
     -------
     SimulationResult
     """
+    t_end, samples, scheme, tol = current().simulation.fill(t_end, samples, scheme, tol)
+    method = method_or_default(method)
     check_simulate_arguments(
         nm,
         C_m,
@@ -377,12 +377,7 @@ def simulate(
         z_w=z_w,
         discrete=discrete,
     )
-    if not (np.isfinite(t_end) and t_end > 0):
-        raise NumericError(f"t_end must be a positive number; found {t_end}")
-    if int(samples) < 2:
-        raise NumericError(f"samples must be at least 2; found {samples}")
-    if (C_m is None) != (L is None):
-        raise NumericError("give both the sensors C_m and the gain L, or neither")
+    # t_end, samples and (C_m, L) were checked above: the scheme's name is left
     if scheme not in SCHEMES:
         raise NumericError(f"unknown time-stepping scheme {scheme!r}; expected one of {SCHEMES}")
     d = discrete if discrete is not None else discretize(nm, method, resolution)

@@ -31,7 +31,6 @@ from phdesign.core.errors import NumericError
 
 __all__ = [
     "MIDPOINT_MAX_DOUBLINGS",
-    "MIDPOINT_RTOL",
     "SCHEMES",
     "Trajectory",
     "dissipation_integral",
@@ -41,8 +40,6 @@ __all__ = [
 ]
 
 SCHEMES = ("expm", "midpoint")
-#: Default tolerance of the midpoint step control (relative error in the energy norm).
-MIDPOINT_RTOL = 1e-6
 #: Largest number of step doublings per output interval (2^24 substeps: round-off ~1e-9).
 MIDPOINT_MAX_DOUBLINGS = 24
 

@@ -137,9 +137,9 @@ def simulate_noisy(
     seed: int | None = None,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     xhat0: Callable[[np.ndarray], np.ndarray] | None = None,
-    t_end: float = 5.0,
-    samples: int = 501,
-    method: str = "galerkin",
+    t_end: float | None = None,
+    samples: int | None = None,
+    method: str | None = None,
     resolution: int | None = None,
     u: Callable[[float], np.ndarray] | None = None,
     scheme: str = "expm",
@@ -151,7 +151,7 @@ def simulate_noisy(
     Parameters
     ----------
     nm, C_m, L, x0, xhat0, t_end, samples, method, resolution, u, z_w, discrete
-        As for :func:`phdesign.numeric.time.simulation.simulate`.
+        As for :func:`phdesign.numeric.time.simulation.simulate` (the same defaults).
     noise_intensity : float or sequence of float, optional
         Sensor noise intensities σᵢ² (one per sensor or one for all; needs sensors).
     input_intensity : float or sequence of float, optional

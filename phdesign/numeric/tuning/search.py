@@ -56,6 +56,7 @@ import numpy as np
 import scipy.linalg as sl
 from scipy.optimize import minimize
 
+from phdesign.core.defaults import method_or_default
 from phdesign.core.errors import NumericError, ObserverError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_tune_arguments
@@ -291,7 +292,7 @@ def tune(
     resolution: int | None = None,
     maxiter: int = 100,
     robust: float | None = None,
-    method: str = "galerkin",
+    method: str | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> TuneResult:
     """Tune the observer gain L for the sensors ``C_m`` (module docstring).
@@ -317,7 +318,8 @@ def tune(
         Nelder-Mead iterations per start and parameter.
     robust : float, optional
         Minimize the worst abscissa over the ±robust box of gains instead (0.05 for 5 %).
-    method : {"galerkin", "fd"}
+    method : str, optional
+        A registered discretization; default: the table's (:mod:`phdesign.core.defaults`).
     progress : callable, optional
         Called with a one-line status now and then (the command line shows it on a
         terminal).
@@ -326,6 +328,7 @@ def tune(
     -------
     TuneResult
     """
+    method = method_or_default(method)
     check_tune_arguments(
         nm,
         C_m,

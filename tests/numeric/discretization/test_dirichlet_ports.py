@@ -24,7 +24,8 @@ from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.galerkin import galerkin
 from phdesign.numeric.discretization.registry import discretize, feedback_matrix
 from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.spectrum.converged import match_resolved, spectrum
+from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.spectrum.drift import match_resolved
 from phdesign.numeric.time.simulation import simulate
 
 COMBINATIONS = every_combination()

@@ -9,7 +9,8 @@ from numeric_models import PAPER_SENSORS, TABLE_I, numeric
 
 from phdesign.core.errors import NumericError, ObserverError
 from phdesign.numeric.discretization.registry import discretize, feedback_matrix
-from phdesign.numeric.spectrum.converged import match_resolved, spectrum
+from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.spectrum.drift import match_resolved
 
 SENSOR2 = np.array([[0.0, 1.0]])  # wave: y2 = e1(1), the velocity at z = 1
 
