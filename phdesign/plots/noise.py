@@ -102,7 +102,7 @@ def plot_tradeoff(
         xlabel=f"RMS of the estimation error of {result.performance}",
         ylabel="decay rate −α [1/s]",
         title=literal(
-            f"{result.model}, sensors {describe_sensors(result.sensors, result.output_labels)}: "
+            f"{result.model}, sensors {describe_sensors(result.sensors)}: "
             "speed against noise"
         ),
     )

@@ -201,10 +201,6 @@ class Ports:
     identities: dict[str, sympy.Expr]
     model: PortedSystem | None = field(default=None, compare=False)
 
-    def boundary_variables(self) -> sympy.ImmutableMatrix:
-        r"""Return :math:`(f_\partial; e_\partial)` as expressions in the traces."""
-        return self.R_ext * sympy.ImmutableMatrix(self.trace_vector)
-
     def to_dict(self) -> dict[str, Any]:
         """Return the JSON of ``phdesign ports --json`` (matrices as rows of exact strings)."""
         return display.ports_dict(self)

@@ -204,11 +204,6 @@ class Variant:
         """``"asymptotic"`` (3.1) or ``"exponential"`` (3.2 to 3.4)."""
         return self.statement.convergence
 
-    @property
-    def needs_partition(self) -> bool:
-        """Whether the right-hand side refers to the blocks of Assumption 3.1."""
-        return any(group.block != "all" for group in self.groups)
-
     def applicable_order(self, order: int) -> bool:
         """Whether the proposition is stated for a model of order ``N = order``."""
         return self.statement.applies_to(order)
@@ -235,8 +230,8 @@ class Variant:
         order, size : int
             :math:`N` and :math:`n` of the model.
         partition : (x1 components, x2 components), optional
-            1-based state components of each block; required when
-            :attr:`needs_partition`.
+            1-based state components of each block; required when a group refers to
+            the blocks of Assumption 3.1.
         """
         selected: list[Trace] = []
         for group in self.groups:

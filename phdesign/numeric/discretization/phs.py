@@ -28,7 +28,7 @@ from phdesign.numeric.discretization.invariants import (
     require_skew,
 )
 
-__all__ = ["ClosedLoop", "DiscretePHS", "SensorLoop", "feedback_matrix"]
+__all__ = ["ClosedLoop", "DiscretePHS", "feedback_matrix"]
 
 
 def _html_table(rows: list[tuple[str, object]]) -> str:
@@ -151,26 +151,15 @@ class DiscretePHS:
             system=self,
             K=Km,
             gain=G,
-            input_map=M,
             A=self.J - self.R - BG @ self.B.T,
             B=self.B @ M,
             C=self.B.T - self.D @ G @ self.B.T,
             D=self.D @ M,
         )
 
-    def sensor_loop(self, C_m: np.ndarray) -> SensorLoop:
-        """Precompute the loops ũ = −C_mᵀ L C_m ỹ for one sensor matrix and many gains L."""
-        C = np.atleast_2d(np.asarray(C_m, dtype=float))
-        check_shape("C_m", C, (C.shape[0], self.n_ports))
-        return SensorLoop(self, C, self.J - self.R, self.B @ C.T, C @ self.D @ C.T)
-
     def closed_matrix(self, K: np.ndarray | None = None) -> np.ndarray:
         """Right-hand matrix ``E ê' = (J − R − B (I + K D)⁻¹ K Bᵀ) ê`` of :meth:`close`."""
         return self.close(K).A
-
-    def standard_form(self, K: np.ndarray | None = None) -> np.ndarray:
-        """E⁻¹ times :meth:`closed_matrix` (dense)."""
-        return np.linalg.solve(self.E, self.closed_matrix(K))
 
     @property
     def spurious_removed(self) -> int:
@@ -247,8 +236,8 @@ class ClosedLoop:
     Attributes
     ----------
     system : DiscretePHS
-    K, gain, input_map : ndarray
-        K, G = (I + K D)⁻¹ K and M = (I + K D)⁻¹.
+    K, gain : ndarray
+        K and G = (I + K D)⁻¹ K.
     A, B, C, D : ndarray
         Descriptor matrices of the loop: E ê' = A ê + B v, y = C ê + D v.
     """
@@ -256,7 +245,6 @@ class ClosedLoop:
     system: DiscretePHS
     K: np.ndarray
     gain: np.ndarray
-    input_map: np.ndarray
     A: np.ndarray
     B: np.ndarray
     C: np.ndarray
@@ -266,15 +254,6 @@ class ClosedLoop:
     def E(self) -> np.ndarray:
         """Mass matrix (that of the open system)."""
         return self.system.E
-
-    def standard_form(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(E⁻¹A, E⁻¹B, C, D)``: the loop as an explicit state-space system."""
-        return (
-            np.linalg.solve(self.E, self.A),
-            np.linalg.solve(self.E, self.B),
-            self.C.copy(),
-            self.D.copy(),
-        )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary: the system and the feedback matrix."""
@@ -288,43 +267,6 @@ class ClosedLoop:
 
     def _repr_html_(self) -> str:
         return _html_table([("system", repr(self.system)), ("K", self.K.tolist())])
-
-
-@dataclass(frozen=True, repr=False)
-class SensorLoop:
-    r"""Loop matrices of one sensor matrix :math:`C_m` for many gains L (tuning).
-
-    With :math:`K = C_m^\top L C_m` the push-through identity gives
-    :math:`(I + K D)^{-1} K = C_m^\top (I + L C_m D C_m^\top)^{-1} L C_m`, so
-
-    .. math::
-
-        A(L) = J - R - B_c (I_q + L D_c)^{-1} L B_c^\top, \qquad
-        B_c = B C_m^\top, \; D_c = C_m D C_m^\top,
-
-    one q x q solve per gain (none when D = 0), equal to ``system.close(K).A``.
-    """
-
-    system: DiscretePHS
-    C_m: np.ndarray
-    A0: np.ndarray
-    Bc: np.ndarray
-    Dc: np.ndarray
-
-    def gain(self, L: np.ndarray) -> np.ndarray:
-        """Return the q x q effective gain :math:`(I + L D_c)^{-1} L`."""
-        Lm = np.atleast_2d(np.asarray(L, dtype=float))
-        check_shape("L", Lm, (self.C_m.shape[0],) * 2)
-        if not np.any(self.Dc):
-            return Lm
-        return np.linalg.solve(np.eye(Lm.shape[0]) + Lm @ self.Dc, Lm)
-
-    def matrix(self, L: np.ndarray) -> np.ndarray:
-        r"""Return A(L), the right-hand matrix of the error system :math:`E \dot e = A(L) e`."""
-        return self.A0 - self.Bc @ self.gain(L) @ self.Bc.T
-
-    def __repr__(self) -> str:
-        return f"SensorLoop({self.system!r}, sensors={self.C_m.shape[0]})"
 
 
 def feedback_matrix(C_m: np.ndarray, L: np.ndarray, n_outputs: int) -> np.ndarray:

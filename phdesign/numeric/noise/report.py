@@ -248,7 +248,7 @@ class NoiseReport:
         noise = f"sensor noise intensity {_numbers(self.intensity)}"
         if self.input_intensity is not None:
             noise += f", input noise intensity {_numbers(self.input_intensity)}"
-        sensors = describe_sensors(self.sensors, self.output_labels)
+        sensors = describe_sensors(self.sensors)
         gain = describe_gain(self.gain)
         return f"model: {self.model}   sensors: {sensors}   gain L = {gain}   {noise}"
 
@@ -317,7 +317,7 @@ class NoiseReport:
         return plot_noise_report(self, path, force=force)
 
 
-def describe_sensors(C_m: np.ndarray, labels: Sequence[str] = ()) -> str:
+def describe_sensors(C_m: np.ndarray) -> str:
     """``y3, y4`` when C_m picks outputs, else its rows."""
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
     picks = []

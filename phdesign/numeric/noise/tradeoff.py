@@ -191,7 +191,7 @@ class Tradeoff:
         return buf.getvalue()
 
     def __str__(self) -> str:
-        sensors = describe_sensors(self.sensors, self.output_labels)
+        sensors = describe_sensors(self.sensors)
         intensity = ", ".join(f"{s:g}" for s in self.intensity)
         head = f"model: {self.model}   sensors: {sensors}   sensor noise intensity {intensity}"
         lines = [

@@ -19,9 +19,6 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 __all__ = ["LocalSearch", "TuneResult"]
 
-STATUSES = ("optimum", "extinction", "no decay")
-
-
 @dataclass(frozen=True)
 class LocalSearch:
     """One local search of the tuner: where it started and where it ended."""
