@@ -53,8 +53,10 @@ Why these numbers:
   rate, and needs the pair (153, 230); a resolution of 330 costs about 5 s for n = 4.
 * ``tune_fallback``: the coarse degree of noise-aware tuning's pair when the spectrum at
   L = I did not converge (an unconverged start says nothing about a good pair).
-* ``basis``: the Galerkin basis (:mod:`phdesign.numeric.discretization.galerkin` says why
-  N >= 3 takes the trace-scaled one); None for a method without bases.
+* ``basis``: the Galerkin basis; N >= 3 takes the trace-scaled one, in which the noise
+  figures' QZ keeps 15 digits on airy where the plain Legendre basis loses them, and in
+  which airy's spectrum with sensor 1 converges (the measurements are in
+  :mod:`phdesign.numeric.discretization.legendre`); None for a method without bases.
 * ``abscissa_tol`` and ``resolved_rtol``: the agreement of the spectral abscissa that
   counts as converged and the drift under which an eigenvalue counts as resolved, both
   relative to the problem's rate (:mod:`phdesign.numeric.scales`); ``noise_tol`` the

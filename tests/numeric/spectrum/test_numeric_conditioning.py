@@ -4,7 +4,9 @@ Before (orthonormal Legendre, E = I): on airy (N = 3, all sensors, L = I) the cl
 matrix has norm 7.5e14 at degree 40 and the QZ error of the rightmost eigenvalue grows
 with the degree (8.5e-10 at p = 12, 5e-3 at p = 40).  After (each basis function divided
 by its largest boundary trace, a diagonal congruence): norm 40.5, error ~1e-14 at every
-degree, and the spectrum converges to 1e-10 at its first resolution pair.
+degree, and the spectrum converges to 1e-10 at its first resolution pair.  The spectrum's
+shift and invert is accurate in both bases; what still factors the whole pencil by QZ
+(the noise figures' Lyapunov solver) needs the scaled one (numeric/discretization/legendre.py).
 """
 
 from __future__ import annotations
@@ -16,9 +18,14 @@ import scipy.linalg as sl
 from numeric_models import BUILTINS, PAPER_SENSORS, VARYING, numeric
 
 from phdesign.core.errors import NumericError
+from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretization.galerkin import galerkin, resolve_basis, trace_scaling
+from phdesign.numeric.discretization.feedback import close_plant_feedback
+from phdesign.numeric.discretization.functionals import parse_functionals
+from phdesign.numeric.discretization.galerkin import galerkin, resolve_basis
+from phdesign.numeric.discretization.legendre import trace_scaling
 from phdesign.numeric.discretization.registry import feedback_matrix
+from phdesign.numeric.noise.figures import error_statistics
 from phdesign.numeric.spectrum.converged import default_resolutions, eigen, spectrum
 from phdesign.numeric.spectrum.drift import match_resolved
 
@@ -154,6 +161,27 @@ def test_an_agreed_eigenvalue_is_kept_when_round_off_spoils_a_finer_pair():
     rep = spectrum(numeric("airy"), C, np.eye(2))
     assert rep.converged
     assert abs(rep.spectral_abscissa + 9.250156111211) < 1e-11
+
+
+def test_shift_and_invert_serves_both_bases_and_the_noise_figures_need_the_scaled_one():
+    # Rightmost error eigenvalue of airy (every sensor, L = I) against the mpmath root:
+    # 14.5 to 16 digits in both bases at p = 16..60 by the spectrum's shift and invert.
+    nm = numeric("airy")
+    for basis in ("scaled", "legendre"):
+        lam = eigen(galerkin(nm, 40, basis), K_ALL)[0]
+        assert np.min(np.abs(lam - EXACT)) < 1e-13, basis  # measured 2e-15 and 3e-15
+    # The Lyapunov solver of the noise figures triangularizes the pencil by QZ: the
+    # variance of int x1 is 0.5 to 15 digits in the scaled basis at every degree, and
+    # 3e-3 off in the Legendre basis at p = 40 (0.149 at p = 60)
+    functional = parse_functionals(["x1: 1"], nm, load_builtin("airy"))[0]
+    variance = {}
+    for basis in ("scaled", "legendre"):
+        d = close_plant_feedback(galerkin(nm, 40, basis))
+        stats = error_statistics(d, np.eye(3), np.eye(3), np.ones(3))
+        row = functional.row(d)
+        variance[basis] = float(row @ stats.covariance @ row)
+    assert abs(variance["scaled"] - 0.5) < 1e-12, variance
+    assert abs(variance["legendre"] - 0.5) > 1e-4, variance
 
 
 def test_trace_scaling_and_bad_basis():
