@@ -31,6 +31,9 @@ B = B_nat S⁻¹ and skew feedthrough D = K_d S⁻¹.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 
 from phdesign.core.errors import NumericError
@@ -114,73 +117,150 @@ def _native_ports(N: int, n: int, p: list[int], q: list[int], G: np.ndarray):
 def staggered_fd(nm: NumericModel, m: int) -> DiscretePHS:
     """Discretize ``nm`` by staggered finite differences with ``m`` nodes per group.
 
-    The system has n m states (the paper's beam: m = 70, 140 states).
+    The system has n m states (the paper's beam: m = 70, 140 states).  Its stages: the
+    supported structure, the grids, the skew difference operator with the P0 coupling,
+    the mass matrix, the native input matrix and the change to the model's own ports.
     """
-    N, n = nm.order, nm.size
-    if N not in (1, 2):
-        raise NumericError(f"staggered finite differences support N = 1 and 2; found N = {N}")
+    if nm.order not in (1, 2):
+        raise NumericError(
+            f"staggered finite differences support N = 1 and 2; found N = {nm.order}"
+        )
     if m < 3:
         raise NumericError(f"finite-difference resolution must be at least 3 nodes; found {m}")
+    n = nm.size
+    p, q, G = _supported(nm)
+    grids = _Grids.of(nm, m)
+    J, R = _structure(nm, grids, p, q, G)
+    E, Hp, Hq = _mass(nm, grids, p, q)
+    B, D = _model_ports(nm, _native_inputs(nm, grids, len(p), G), p, q, G)
+    space = _NodalSpace(n, grids, p, q, Hp, Hq)
+    r, dim = len(p), n * m
+    disp = None
+    if nm.displacement is not None:
+        disp = _fd_displacement(nm, p, q, grids.zp, grids.zq, Hp, Hq, r, m, dim)
+    return DiscretePHS(
+        model=nm,
+        method=StaggeredFD.name,
+        resolution=m,
+        E=E,
+        J=0.5 * (J - J.T),
+        R=0.5 * (R + R.T),
+        B=B,
+        D=D,
+        effort_basis=space.effort_basis,
+        project=space.project,
+        displacement_basis=disp,
+        info={
+            "h": grids.h,
+            "groups": (p, q),
+            # (component, node) of each state: node-major within the p block, then the q block
+            "coordinates": tuple((g[c], j) for g in (p, q) for j in range(m) for c in range(r)),
+        },
+    )
+
+
+def _supported(nm: NumericModel) -> tuple[list[int], list[int], np.ndarray]:
+    """Return the groups (p, q) and G of a supported model (module docstring), else raise."""
+    N = nm.order
     for k in range(1, N):
         if np.any(nm.P[k]):
             raise NumericError(f"staggered finite differences need P{k} = 0 for this order")
     p, q = _groups(nm)
-    r = len(p)
     PN = nm.P[N]
     G = PN[np.ix_(q, p)]
     if np.any(PN[np.ix_(p, p)]) or np.any(PN[np.ix_(q, q)]) or abs(np.linalg.det(G)) < 1e-12:
         raise NumericError(
             "staggered finite differences need P_N = [[0, *], [G, 0]] in (p, q) with G invertible"
         )
-    a, b = nm.interval
-    h = (b - a) / m
-    ip = np.arange(1, m + 1)
-    zp = a + ip * h
-    wp = np.full(m, h)
-    wp[-1] = h / 2
-    if N == 1:
-        zq = a + (np.arange(m) + 0.5) * h
-        wq = np.full(m, h)
-        Dm = np.eye(m) - np.eye(m, k=-1)  # (W_q ∂e_p)_j = p_{j+1} - p_j, p_0 -> input
-        Pi = 0.5 * (np.eye(m) + np.eye(m, k=1))  # q values at p nodes (averaging)
-        Pi[-1, -1] = 1.0
-    else:
-        zq = a + np.arange(m) * h
-        wq = np.full(m, h)
-        wq[0] = h / 2
-        Dm = (np.eye(m) - 2 * np.eye(m, k=-1) + np.eye(m, k=-2)) / h
-        Dm[0, :] = 0.0
-        Dm[0, 0] = 1.0 / h
-        Pi = np.eye(m, k=1)  # q_i at p node i; last p node takes q_{m-1}
-        Pi[-1, -1] = 1.0
-    Kpq = np.kron(Dm, G)  # W_q x_q' = Kpq e_p + ...
+    return p, q, G
+
+
+@dataclass(frozen=True)
+class _Grids:
+    """The two staggered grids of m nodes: points, weights, difference and averaging maps."""
+
+    m: int
+    h: float
+    zp: np.ndarray
+    zq: np.ndarray
+    wp: np.ndarray
+    wq: np.ndarray
+    Dm: np.ndarray  # (W_q ∂^N e_p) at the q nodes, from the p nodes
+    Pi: np.ndarray  # q values at the p nodes
+
+    @classmethod
+    def of(cls, nm: NumericModel, m: int) -> _Grids:
+        """Return the grids of ``nm``'s order (module docstring)."""
+        a, b = nm.interval
+        h = (b - a) / m
+        zp = a + np.arange(1, m + 1) * h
+        wp = np.full(m, h)
+        wp[-1] = h / 2
+        if nm.order == 1:
+            zq = a + (np.arange(m) + 0.5) * h
+            wq = np.full(m, h)
+            Dm = np.eye(m) - np.eye(m, k=-1)  # (W_q ∂e_p)_j = p_{j+1} - p_j, p_0 -> input
+            Pi = 0.5 * (np.eye(m) + np.eye(m, k=1))  # q values at p nodes (averaging)
+            Pi[-1, -1] = 1.0
+        else:
+            zq = a + np.arange(m) * h
+            wq = np.full(m, h)
+            wq[0] = h / 2
+            Dm = (np.eye(m) - 2 * np.eye(m, k=-1) + np.eye(m, k=-2)) / h
+            Dm[0, :] = 0.0
+            Dm[0, 0] = 1.0 / h
+            Pi = np.eye(m, k=1)  # q_i at p node i; last p node takes q_{m-1}
+            Pi[-1, -1] = 1.0
+        return cls(m, h, zp, zq, wp, wq, Dm, Pi)
+
+
+def _structure(
+    nm: NumericModel, grids: _Grids, p: list[int], q: list[int], G: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return J (the difference operator of q the negative transpose of p's) and R."""
+    r, m = len(p), grids.m
+    Kpq = np.kron(grids.Dm, G)  # W_q x_q' = Kpq e_p + ...
     # Layout: [p block (node-major, r comps), q block (node-major, r comps)].
-    dim = n * m
+    dim = nm.size * m
     sp, sq = slice(0, r * m), slice(r * m, dim)
     J0 = np.zeros((dim, dim))
     J0[sq, sp] = Kpq
     J0[sp, sq] = -Kpq.T
     # P0(z) in weak form, nodal; cross blocks through the averaging Pi (q values at p nodes)
-    K0 = staggered_p0(nm, (p, q), (zp, zq), (wp, wq), Pi)
+    K0 = staggered_p0(nm, (p, q), (grids.zp, grids.zq), (grids.wp, grids.wq), grids.Pi)
     J = J0 + 0.5 * (K0 - K0.T)
     R = -0.5 * (K0 + K0.T)
     if np.min(np.linalg.eigvalsh(R)) < -1e-12 * max(1.0, np.max(np.abs(R))):
         raise NumericError(
             "staggered finite differences: the discrete P0 coupling is not dissipative"
         )
-    # Mass matrix from H (must be block diagonal in (p, q)).
-    Hp, Hq = nm.H_at(zp), nm.H_at(zq)
+    return J, R
+
+
+def _mass(
+    nm: NumericModel, grids: _Grids, p: list[int], q: list[int]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return the mass matrix E (weights times H⁻¹ at the nodes) and H at both grids."""
+    Hp, Hq = nm.H_at(grids.zp), nm.H_at(grids.zq)
     if np.any(np.abs(Hp[:, p][:, :, q]) > 0) or np.any(np.abs(Hq[:, p][:, :, q]) > 0):
         raise NumericError(
             "staggered finite differences need H block diagonal in the (p, q) groups"
         )
-    E = np.zeros((dim, dim))
+    r, m = len(p), grids.m
+    E = np.zeros((nm.size * m, nm.size * m))
     for j in range(m):
-        E[j * r : (j + 1) * r, j * r : (j + 1) * r] = wp[j] * np.linalg.inv(Hp[j][np.ix_(p, p)])
+        E[j * r : (j + 1) * r, j * r : (j + 1) * r] = grids.wp[j] * np.linalg.inv(
+            Hp[j][np.ix_(p, p)]
+        )
         o = r * m + j * r
-        E[o : o + r, o : o + r] = wq[j] * np.linalg.inv(Hq[j][np.ix_(q, q)])
-    # Native input matrix, columns ordered as in _native_ports.
-    Bn = np.zeros((dim, N * n))
+        E[o : o + r, o : o + r] = grids.wq[j] * np.linalg.inv(Hq[j][np.ix_(q, q)])
+    return E, Hp, Hq
+
+
+def _native_inputs(nm: NumericModel, grids: _Grids, r: int, G: np.ndarray) -> np.ndarray:
+    """Return the native input matrix, columns ordered as in :func:`_native_ports`."""
+    N, m, h = nm.order, grids.m, grids.h
+    Bn = np.zeros((nm.size * m, N * nm.size))
     qo, GT = r * m, G.T
     if N == 1:
         Bn[qo : qo + r, 0:r] = -G  # q node 0 gets -G e_p(a)
@@ -192,6 +272,14 @@ def staggered_fd(nm: NumericModel, m: int) -> DiscretePHS:
         Bn[(m - 2) * r : (m - 1) * r, 2 * r : 3 * r] = -GT / h
         Bn[(m - 1) * r : m * r, 2 * r : 3 * r] = GT / h
         Bn[(m - 1) * r : m * r, 3 * r : 4 * r] = -GT
+    return Bn
+
+
+def _model_ports(
+    nm: NumericModel, Bn: np.ndarray, p: list[int], q: list[int], G: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return B and the skew feedthrough D of the model's own ports (module docstring)."""
+    N, n = nm.order, nm.size
     Un, Yn = _native_ports(N, n, p, q, G)
     S = nm.U @ np.linalg.pinv(Un)
     if np.max(np.abs(S @ Un - nm.U)) > 1e-10 * max(1.0, np.max(np.abs(nm.U))):
@@ -206,49 +294,46 @@ def staggered_fd(nm: NumericModel, m: int) -> DiscretePHS:
         raise NumericError(
             "staggered finite differences: the model's outputs are not power conjugate"
         )
-    B = Bn @ Sinv
     D = Kd @ Sinv
-    D = 0.5 * (D - D.T)
+    return Bn @ Sinv, 0.5 * (D - D.T)
 
-    def effort_basis(z: np.ndarray) -> np.ndarray:
+
+class _NodalSpace:
+    """Evaluation (piecewise linear between the nodes) and nodal projection of the efforts."""
+
+    def __init__(
+        self,
+        n: int,
+        grids: _Grids,
+        p: list[int],
+        q: list[int],
+        Hp: np.ndarray,
+        Hq: np.ndarray,
+    ) -> None:
+        self.n, self.grids, self.p, self.q, self.Hp, self.Hq = n, grids, p, q, Hp, Hq
+
+    def effort_basis(self, z: np.ndarray) -> np.ndarray:
+        """``(len(z), n, dim)`` values: e(z) = effort_basis(z) @ ê."""
         zz = np.atleast_1d(np.asarray(z, dtype=float))
-        out = np.zeros((zz.size, n, dim))
-        for grid, comps, off in ((zp, p, 0), (zq, q, r * m)):
+        r, m = len(self.p), self.grids.m
+        out = np.zeros((zz.size, self.n, self.n * m))
+        for grid, comps, off in ((self.grids.zp, self.p, 0), (self.grids.zq, self.q, r * m)):
             Wt = _linear_interp_matrix(grid, zz)
             for c_, comp in enumerate(comps):
                 out[:, comp, off + c_ : off + r * m : r] = Wt
         return out
 
-    def project(x0) -> np.ndarray:  # type: ignore[no-untyped-def]
-        eh = np.zeros(dim)
-        Xp = np.einsum("qij,qj->qi", Hp, np.asarray(x0(zp), dtype=float).reshape(m, n))
-        Xq = np.einsum("qij,qj->qi", Hq, np.asarray(x0(zq), dtype=float).reshape(m, n))
-        eh[: r * m] = Xp[:, p].reshape(-1)
-        eh[r * m :] = Xq[:, q].reshape(-1)
+    def project(self, x0: Any) -> np.ndarray:
+        """Return the efforts e = H x0 at the nodes of each group."""
+        r, m, n = len(self.p), self.grids.m, self.n
+        eh = np.zeros(n * m)
+        X = np.asarray(x0(self.grids.zp), dtype=float).reshape(m, n)
+        Xp = np.einsum("qij,qj->qi", self.Hp, X)
+        X = np.asarray(x0(self.grids.zq), dtype=float).reshape(m, n)
+        Xq = np.einsum("qij,qj->qi", self.Hq, X)
+        eh[: r * m] = Xp[:, self.p].reshape(-1)
+        eh[r * m :] = Xq[:, self.q].reshape(-1)
         return eh
-
-    disp = None
-    if nm.displacement is not None:
-        disp = _fd_displacement(nm, p, q, zp, zq, Hp, Hq, r, m, dim)
-    return DiscretePHS(
-        model=nm,
-        method=StaggeredFD.name,
-        resolution=m,
-        E=E,
-        J=0.5 * (J - J.T),
-        R=0.5 * (R + R.T),
-        B=B,
-        D=D,
-        effort_basis=effort_basis,
-        project=project,
-        displacement_basis=disp,
-        info={
-            "h": h,
-            "groups": (p, q),
-            # (component, node) of each state: node-major within the p block, then the q block
-            "coordinates": tuple((g[c], j) for g in (p, q) for j in range(m) for c in range(r)),
-        },
-    )
 
 
 def _linear_interp_matrix(grid: np.ndarray, z: np.ndarray) -> np.ndarray:
