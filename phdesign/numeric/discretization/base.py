@@ -14,6 +14,13 @@ tolerances, the bases it accepts) are the entry of the same name in the table of
 defaults (:mod:`phdesign.core.defaults`), which the command line reads without loading
 the numeric layer; :func:`check_registered` says whether builders and entries agree, and
 :func:`phdesign.numeric.discretization.registry.discretize` dispatches by name.
+
+Adding a method is three edits: its module in ``numeric/discretization/`` with the
+subclass (and a convergence-rate test beside the others), its
+:class:`~phdesign.core.defaults.MethodDefaults` entry in the table, and its class in
+the registry's tuple of built-in methods (importing the module registers it).  The
+command line's ``--method`` choices, the design objects, the sweep, the loop, the noise
+figures and the spectrum read the registry and the table; nothing else changes.
 """
 
 from __future__ import annotations
