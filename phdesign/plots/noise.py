@@ -102,8 +102,7 @@ def plot_tradeoff(
         xlabel=f"RMS of the estimation error of {result.performance}",
         ylabel="decay rate −α [1/s]",
         title=literal(
-            f"{result.model}, sensors {describe_sensors(result.sensors)}: "
-            "speed against noise"
+            f"{result.model}, sensors {describe_sensors(result.sensors)}: speed against noise"
         ),
     )
     ax.grid(True, which="both", alpha=0.3)

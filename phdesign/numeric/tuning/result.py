@@ -19,6 +19,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 __all__ = ["LocalSearch", "TuneResult"]
 
+
 @dataclass(frozen=True)
 class LocalSearch:
     """One local search of the tuner: where it started and where it ended."""
