@@ -2,11 +2,11 @@ r"""Observer gain tuning: minimize the converged spectral abscissa of the error 
 
 The error system is the closed loop :math:`\tilde u = -C_m^\top L C_m \tilde y` of the
 discretization (``DiscretePHS.closed_matrix``: any feedthrough D is accounted for).  The
-objective is the abscissa of :mod:`phdesign.numeric.spectrum.abscissa` at a fixed resolution pair
-(:class:`~phdesign.numeric.spectrum.evaluator.AbscissaEvaluator`): the largest real part over
-the eigenvalues that are resolved, never over all discrete eigenvalues (the unresolved high
-frequencies of any semi-discretization would flatten the landscape), or the limit the real
-parts approach at high frequency when no mode attains it.
+objective is the abscissa of :mod:`phdesign.numeric.spectrum.abscissa` at a fixed
+resolution pair (:class:`~phdesign.numeric.spectrum.evaluator.AbscissaEvaluator`): the
+largest real part over the eigenvalues that are resolved, never over all discrete
+eigenvalues (the unresolved high frequencies of any semi-discretization would flatten the
+landscape), or the limit the real parts approach at high frequency when no mode attains it.
 
 The gain is searched in the problem's own units: :math:`L = \operatorname{diag}(g\, e^{x})`
 with g the natural gain of each sensor (:mod:`phdesign.numeric.scales`: for the string
@@ -26,10 +26,9 @@ with the damper at its end, its impedance), or, with ``full=True``,
    -5.83335), where the abscissa is not Lipschitz and a direct search stalls; Newton's
    method on the cluster's central moments locates the point to round-off
    (:mod:`phdesign.numeric.spectrum.coalescence`);
-4. **verification**: :func:`~phdesign.numeric.spectrum.converged.spectrum` at the returned gain,
-and
-   the **robustness figure**, the worst abscissa over a ±5 % box of gains around it
-   (:mod:`phdesign.numeric.tuning.robustness`).
+4. **verification**: :func:`~phdesign.numeric.spectrum.converged.spectrum` at the
+   returned gain, and the **robustness figure**, the worst abscissa over a ±5 % box of
+   gains around it (:mod:`phdesign.numeric.tuning.robustness`).
 
 Questions without an optimum get an answer that says so: when the search meets an empty
 spectrum (finite-time extinction, the string with the matched damper k = √(ρT)), the
@@ -319,10 +318,8 @@ def tune(
     robust : float, optional
         Minimize the worst abscissa over the ±robust box of gains instead (0.05 for 5 %).
     method : str, optional
-        A registered discretization; default: the table's (:mod:`phdesign.core.defaults`).
     progress : callable, optional
-        Called with a one-line status now and then (the command line shows it on a
-        terminal).
+        Called with a one-line status now and then (the command line shows it on a terminal).
 
     Returns
     -------
