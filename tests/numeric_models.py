@@ -55,3 +55,17 @@ FEEDTHROUGH = BCPHS.define(
     inputs=["2*e1(0)", "e2(1)"],
     outputs=["-e2(0)/2 + e2(1)", "e1(1) - 2*e1(0)"],
 )
+
+
+def observer_loop_residual(d, K, states_hat, u, y, y_hat):
+    r"""Largest relative residual of the observer's implicit input in a simulated run.
+
+    From the definitions, not from ``close()``: the observer runs on
+    :math:`\hat u = u + K (y - \hat y)` (:math:`K = C_m^\top L C_m`) and reports
+    :math:`\hat y = B^\top \hat e_{obs} + D \hat u`, so with a feedthrough D ≠ 0 its output
+    solves :math:`\hat y = B^\top \hat e_{obs} + D (u + K (y - \hat y))`.
+    """
+    u = np.zeros_like(y) if u is None else np.asarray(u)
+    u_hat = u + (y - y_hat) @ K.T
+    residual = y_hat - states_hat @ d.B - u_hat @ d.D.T
+    return float(np.max(np.abs(residual)) / np.max(np.abs(y_hat)))

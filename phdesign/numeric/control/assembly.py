@@ -24,6 +24,12 @@ observer output is :math:`\hat y = C_{\hat y} X + D u` with :math:`C_{\hat y} =
     u = F X + P v, \quad F = -M K_a C_f, \quad P = M S_r^\top, \qquad
     E_2 \dot X = (A_2 + B_2 F) X + B_2 P v .
 
+Both loops with the feedthrough D are solved by
+:meth:`~phdesign.numeric.discretization.phs.DiscretePHS.close`, the one place that does:
+the observer's with G (its gain is Γ, and :math:`\hat y = y - \tilde y`, :math:`\tilde y =
+(I - D\Gamma) B^\top \tilde e`), the controller's with :math:`K_a` (gain :math:`M K_a`, and
+:math:`M = I - M K_a D`).
+
 This is the assembled loop in the original coordinates :math:`(\hat e, \hat e_{obs})`.
 In :math:`Z = T X = (\hat e, \tilde e)`, :math:`T = \left[\begin{smallmatrix} I & 0 \\
 I & -I \end{smallmatrix}\right] = T^{-1}` (and :math:`T E_2 T = E_2`), it is
@@ -46,7 +52,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.core.errors import LoopError, NumericError, check_shape
+from phdesign.core.errors import LoopError, check_shape
 from phdesign.numeric.discretization.invariants import require_definite
 from phdesign.numeric.discretization.registry import DiscretePHS, feedback_matrix
 from phdesign.numeric.time.simulation import coupled_system
@@ -154,11 +160,6 @@ class LoopSystem:
         return A_Z[:n, :n], A_Z[n:, n:]
 
 
-def _observer_gain(d: DiscretePHS, G: np.ndarray) -> np.ndarray:
-    """Γ = (I + G D)⁻¹ G: the injection û − u = Γ Bᵀ ẽ with the feedthrough loop solved."""
-    return np.linalg.solve(np.eye(d.n_ports) + G @ d.D, G)
-
-
 def assemble(d: DiscretePHS, loop: NumericLoop) -> LoopSystem:
     """Assemble plant, observer and feedback of ``loop`` on the discretization ``d``.
 
@@ -167,7 +168,8 @@ def assemble(d: DiscretePHS, loop: NumericLoop) -> LoopSystem:
     LoopError
         If an index or a shape does not fit ``d``.
     NumericError
-        If the feedthrough makes the loop ill-posed (I + K_a D singular).
+        If the feedthrough makes the loop ill-posed (I + K_a D singular:
+        :meth:`~phdesign.numeric.discretization.phs.DiscretePHS.close`).
 
     Examples
     --------
@@ -184,20 +186,19 @@ def assemble(d: DiscretePHS, loop: NumericLoop) -> LoopSystem:
     loop.check(m)
     G = feedback_matrix(loop.C_m, loop.L, m)  # checks C_m, L shapes and L + Lᵀ ≻ 0
     E2, A2, B2 = coupled_system(d, G)
-    Gamma = _observer_gain(d, G)
-    DGB = d.D @ Gamma @ d.B.T
-    C_yhat = np.hstack([DGB, d.B.T - DGB])
+    # ŷ = y − ỹ with ỹ = C ẽ the error system's output and ẽ = ê − ê_obs
+    error_output = d.close(G).C
+    C_yhat = np.hstack([d.B.T - error_output, error_output])
     C_y = np.hstack([d.B.T, np.zeros((m, n))])
     S_a = loop.selection(m)
     others = tuple(j for j in range(m) if j not in set(loop.actuated))
     S_r_T = np.eye(m)[:, list(others)]
     K_a = S_a.T @ np.asarray(loop.K, dtype=float) @ S_a
     C_f = C_yhat if loop.source == "estimate" else C_y
-    feedthrough = np.eye(m) + K_a @ d.D
-    if np.linalg.cond(feedthrough) > 1e12:
-        raise NumericError("the loop is ill-posed: I + K_a D is singular for this feedthrough")
-    F = -np.linalg.solve(feedthrough, K_a @ C_f)
-    P = np.linalg.solve(feedthrough, S_r_T)
+    # u = −K_a (C_f X + D u) + S_rᵀ v is the loop u = v' − K_a y' that close() solves
+    G_a = d.close(K_a).gain  # M K_a, M = (I + K_a D)⁻¹
+    F = -G_a @ C_f
+    P = S_r_T - G_a @ d.D @ S_r_T  # M = I - M K_a D
     return LoopSystem(
         discrete=d,
         loop=loop,

@@ -31,6 +31,21 @@ from phdesign.numeric.discretization.invariants import (
 __all__ = ["ClosedLoop", "DiscretePHS", "feedback_matrix"]
 
 
+#: Largest condition number of I + K D for which :meth:`DiscretePHS.close` solves the loop.
+LOOP_CONDITION = 1e12
+
+
+def _well_posed(loop: np.ndarray) -> np.ndarray:
+    """Return ``loop`` = I + K D, refusing it when it is singular to round-off."""
+    condition = float(np.linalg.cond(loop))
+    if not condition <= LOOP_CONDITION:
+        raise NumericError(
+            "the loop u = v - K y is ill-posed: I + K D is singular for this feedthrough "
+            f"(condition number {condition:.3g}, expected at most {LOOP_CONDITION:g})"
+        )
+    return loop
+
+
 def _html_table(rows: list[tuple[str, object]]) -> str:
     cells = "".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in rows)
     return f"<table>{cells}</table>"
@@ -134,6 +149,12 @@ class DiscretePHS:
 
         The one place where the loop with a feedthrough D is solved; see
         :class:`ClosedLoop` for the equations.
+
+        Raises
+        ------
+        NumericError
+            If the loop is ill-posed: I + K D singular to round-off (condition number above
+            :data:`LOOP_CONDITION`).
         """
         m = self.n_ports
         Km = np.zeros((m, m)) if K is None else np.asarray(K, dtype=float)
@@ -144,7 +165,7 @@ class DiscretePHS:
             M = np.eye(m)
             G = Km
         else:
-            M = np.linalg.inv(np.eye(m) + Km @ self.D)
+            M = np.linalg.inv(_well_posed(np.eye(m) + Km @ self.D))
             G = M @ Km
         BG = self.B @ G
         return ClosedLoop(

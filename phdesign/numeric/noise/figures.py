@@ -167,9 +167,8 @@ def noise_input(
     """
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
     Lm = np.atleast_2d(np.asarray(L, dtype=float))
-    K = feedback_matrix(C, Lm, d.n_ports)
-    A = d.closed_matrix(K)
-    BM = d.B @ np.linalg.inv(np.eye(d.n_ports) + K @ d.D)
+    loop = d.close(feedback_matrix(C, Lm, d.n_ports))
+    A, BM = loop.A, loop.B  # B M = B (I + K D)⁻¹
     columns = [-BM @ C.T @ Lm @ np.diag(np.sqrt(intensity))]
     labels = [f"nu{i + 1}" for i in range(C.shape[0])]
     keep = [bool(s > 0) for s in intensity]

@@ -97,7 +97,7 @@ import numpy as np
 import scipy.linalg as sl
 
 from phdesign.core.errors import NumericError
-from phdesign.numeric.discretization.phs import DiscretePHS, feedback_matrix
+from phdesign.numeric.discretization.phs import LOOP_CONDITION, DiscretePHS, feedback_matrix
 
 __all__ = [
     "ObserverModel",
@@ -106,10 +106,6 @@ __all__ = [
     "hold_discretization",
     "sample_plant",
 ]
-
-#: The loop matrix I + K D_s is refused above this condition number (never reached by a
-#: Galerkin observer, for which it is invertible for every period).
-LOOP_CONDITION = 1e12
 
 
 def hold_discretization(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -289,6 +285,8 @@ class ObserverModel:
         K = feedback_matrix(self.C_m, self.L, m)
         loop = np.eye(m) + K @ measure_u
         condition = float(np.linalg.cond(loop))
+        # refused where close() refuses I + K D: never for a Galerkin observer, for which
+        # I + K D_s is invertible for every period
         if not condition <= LOOP_CONDITION:
             raise NumericError(
                 "the observer's correction loop I + C_m^T L C_m D_s is singular (condition "

@@ -78,11 +78,11 @@ def noisy_coupled_system(
     plant_w = d.B @ np.diag(np.sqrt(w_in))
     if K is None or C_m is None or L is None:
         return E2, A2, B2, plant_w
-    M = np.linalg.inv(np.eye(d.n_ports) + K @ d.D)
+    loop = d.close(K)  # B M = loop.B, G = M K = loop.gain
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
     Lm = np.atleast_2d(np.asarray(L, dtype=float))
-    observer_nu = d.B @ M @ C.T @ Lm @ np.diag(np.sqrt(sigma))
-    observer_w = d.B @ (M @ K) @ d.D @ np.diag(np.sqrt(w_in))
+    observer_nu = loop.B @ C.T @ Lm @ np.diag(np.sqrt(sigma))
+    observer_w = d.B @ loop.gain @ d.D @ np.diag(np.sqrt(w_in))
     top = np.hstack([np.zeros_like(observer_nu), plant_w])
     bottom = np.hstack([observer_nu, observer_w])
     return E2, A2, B2, np.vstack([top, bottom])
@@ -195,9 +195,8 @@ def simulate_noisy(
     changes: dict[str, Any] = {"states": eh, "H": d.hamiltonian(eh), "y": d.output(eh, U)}
     if C_m is not None and L is not None:
         eo = np.asarray(base.states_hat) + extra[:, n:]
-        K = feedback_matrix(C_m, L, d.n_ports)
-        Gk = np.linalg.solve(np.eye(d.n_ports) + K @ d.D, K)
-        uo = (eh - eo) @ (d.B @ Gk.T) + (0.0 if U is None else U)
+        G = d.close(feedback_matrix(C_m, L, d.n_ports)).gain
+        uo = (eh - eo) @ (d.B @ G.T) + (0.0 if U is None else U)
         changes.update(
             states_hat=eo,
             H_hat=d.hamiltonian(eo),
