@@ -26,6 +26,7 @@ from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 from phdesign.numeric.tuning.search import tune
 
@@ -55,7 +56,13 @@ def main(argv: list[str] | None = None) -> int:
     C = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])  # sensors y3, y4
     x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=beam)
     runs = {
-        name: simulate(nm, C, np.diag(g), x0=x0, t_end=5.0, samples=401, z_w=np.linspace(0, 1, 41))
+        name: simulate(
+            nm,
+            C,
+            np.diag(g),
+            x0=x0,
+            options=SimulationOptions(t_end=5.0, samples=401, z_w=np.linspace(0, 1, 41)),
+        )
         for name, g in DESIGNS.items()
     }
     labels = {name: f"{name}, L = diag{g}" for name, g in DESIGNS.items()}

@@ -39,7 +39,9 @@ from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize, feedback_matrix
 from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.time.simulation import coupled_system, simulate, step_lti
+from phdesign.numeric.time.options import SimulationOptions
+from phdesign.numeric.time.simulation import coupled_system, simulate
+from phdesign.numeric.time.stepping import step_lti
 
 
 def best_of(fn, repeat):
@@ -85,7 +87,9 @@ def changes() -> bool:
     X0 = np.concatenate([d.project(x0), np.zeros(d.dim)])
     X = step_lti(E2, A2, B2, X0, t)
     old = d.hamiltonian(X[:, : d.dim] - X[:, d.dim :])
-    new = simulate(nm, C_m, L, x0=x0, t_end=4.5, samples=46, discrete=d).H_err
+    new = simulate(
+        nm, C_m, L, x0=x0, discrete=d, options=SimulationOptions(t_end=4.5, samples=46)
+    ).H_err
     ref = control.initial_response(error_statespace(d, C_m, L), T=t, X0=d.project(x0))
     H_ref = d.hamiltonian(ref.states.T)
     e_old, e_new = (float(np.max(np.abs(h / H_ref - 1))) for h in (old, new))
@@ -179,7 +183,9 @@ def main(argv: list[str]) -> int:
         return step_lti(E2, A2, B2, X0, t)
 
     def ours_full():  # the user-facing call: projection, outputs, energies, deflection
-        return simulate(nm, C_m, L, x0=x0, t_end=t_end, samples=samples, discrete=d)
+        return simulate(
+            nm, C_m, L, x0=x0, discrete=d, options=SimulationOptions(t_end=t_end, samples=samples)
+        )
 
     def bdf():
         sol = solve_ivp(

@@ -34,6 +34,7 @@ from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.spectrum.converged import spectrum
 from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 from phdesign.numeric.tuning.search import tune
 from phdesign.symbolic.classify import classify
@@ -107,11 +108,19 @@ designs = {"design 1": (0.03, 0.3), "design 2": (0.1, 1.0), "design 3": (0.2, 2.
 z_w = np.linspace(0.0, 1.0, 41)
 T_END, SAMPLES = 8.0, 801
 runs = {
-    name: simulate(nm, C, np.diag(g), x0=x0, t_end=T_END, samples=SAMPLES, z_w=z_w)
+    name: simulate(
+        nm, C, np.diag(g), x0=x0, options=SimulationOptions(t_end=T_END, samples=SAMPLES, z_w=z_w)
+    )
     for name, g in designs.items()
 }
 runs_fd = {
-    name: simulate(nm, C, np.diag(g), x0=x0, t_end=T_END, samples=SAMPLES, method="fd")
+    name: simulate(
+        nm,
+        C,
+        np.diag(g),
+        x0=x0,
+        options=SimulationOptions(t_end=T_END, samples=SAMPLES, method="fd"),
+    )
     for name, g in designs.items()
 }
 for name in designs:
@@ -298,7 +307,9 @@ print(
     f"alpha = {best.fun:.4f}; tune: alpha = {tuned.spectral_abscissa:.6f} at a coalescence "
     f"of {tuned.coalescence.size} eigenvalues"
 )
-run_tuned = simulate(nm, C, tuned.gain, x0=x0, t_end=T_END, samples=SAMPLES, z_w=z_w)
+run_tuned = simulate(
+    nm, C, tuned.gain, x0=x0, options=SimulationOptions(t_end=T_END, samples=SAMPLES, z_w=z_w)
+)
 print(
     f"H̃/H̃(0) < 1e-2 at {run_tuned.time_below(1e-2):.2f} s and < 1e-4 at "
     f"{run_tuned.time_below(1e-4):.2f} s with the tuned gain "

@@ -27,6 +27,7 @@ from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.observer import gain_matrix, sensor_matrix
@@ -128,7 +129,9 @@ runs, reps = {}, {}
 for label, sensors in designs.items():
     C = np.eye(4)[[s - 1 for s in sensors]]
     reps[label] = spectrum(nm_timo, C, np.eye(2))
-    runs[label] = simulate(nm_timo, C, np.eye(2), x0=x0, t_end=10.0, samples=401)
+    runs[label] = simulate(
+        nm_timo, C, np.eye(2), x0=x0, options=SimulationOptions(t_end=10.0, samples=401)
+    )
     verdict = found.subset(sensors).verdict
     # below its resolved floor H̃ is made of unresolved modes: time_below() then says None
     times = [runs[label].time_below(r) for r in (1e-2, 1e-4)]

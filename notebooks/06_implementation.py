@@ -51,6 +51,7 @@ from phdesign.numeric.sampled.export import export_observer, verify_observer
 from phdesign.numeric.sampled.order import balanced_truncation
 from phdesign.numeric.sampled.samplers import ContinuousObserver
 from phdesign.numeric.sampled.simulation import simulate_sampled
+from phdesign.numeric.time.options import SimulationOptions
 
 beam = load_builtin("euler-bernoulli")
 nm = to_numeric(beam)
@@ -308,7 +309,11 @@ fig, ax = plt.subplots(figsize=(7, 3.5), layout="constrained")
 energy = {}
 for sampler in ("average", "point"):
     r = simulate_sampled(
-        nm, C_m, L, x0=x0, dt=1e-3, sampler=sampler, resolution=48, observer_resolution=16
+        nm,
+        C_m,
+        L,
+        x0=x0,
+        options=SimulationOptions(dt=1e-3, sampler=sampler, resolution=48, observer_resolution=16),
     )
     energy[sampler] = r.H_err[-1] / r.H_err[0]
     ax.semilogy(r.t, r.H_err / r.H_err[0], label=f"{sampler}, 1 ms")

@@ -55,7 +55,8 @@ _EXPORTS: dict[str, str] = {
     "spectrum": "phdesign.numeric.spectrum.converged",
     "SpectrumReport": "phdesign.numeric.spectrum.report",
     "simulate": "phdesign.numeric.time.simulation",
-    "SimulationResult": "phdesign.numeric.time.simulation",
+    "SimulationOptions": "phdesign.numeric.time.options",
+    "SimulationResult": "phdesign.numeric.time.result",
     "tune": "phdesign.numeric.tuning.search",
     "TuneResult": "phdesign.numeric.tuning.search",
     "NoiseReport": "phdesign.numeric.noise.report",
@@ -77,6 +78,7 @@ __all__ = [
     "Ports",
     "SampledObserver",
     "SensorSearch",
+    "SimulationOptions",
     "SimulationResult",
     "SpectrumReport",
     "Tradeoff",
@@ -117,7 +119,9 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
     from phdesign.numeric.sampled.export import SampledObserver
     from phdesign.numeric.spectrum.converged import spectrum
     from phdesign.numeric.spectrum.report import SpectrumReport
-    from phdesign.numeric.time.simulation import SimulationResult, simulate
+    from phdesign.numeric.time.options import SimulationOptions
+    from phdesign.numeric.time.result import SimulationResult
+    from phdesign.numeric.time.simulation import simulate
     from phdesign.numeric.tuning.search import TuneResult, tune
     from phdesign.symbolic.classify import Classification, classify
     from phdesign.symbolic.definition import Displacement

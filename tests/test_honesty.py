@@ -19,6 +19,7 @@ from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import ENERGY_BALANCE_RTOL, simulate
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.observer import gain_matrix, sensor_matrix
@@ -65,7 +66,13 @@ def _airy_run(resolution):
     airy = load_builtin("airy")
     nm = to_numeric(airy)
     x0 = initial_state_function("x1: sin(pi*z)", nm, model=airy)
-    return simulate(nm, np.eye(3), np.eye(3), x0=x0, t_end=1.0, resolution=resolution)
+    return simulate(
+        nm,
+        np.eye(3),
+        np.eye(3),
+        x0=x0,
+        options=SimulationOptions(t_end=1.0, resolution=resolution),
+    )
 
 
 def test_healthy_simulation_balances_energy_to_round_off():
@@ -77,7 +84,9 @@ def test_healthy_simulation_balances_energy_to_round_off():
     beam = load_builtin("euler-bernoulli")
     nm = to_numeric(beam)
     x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=beam)
-    result = simulate(nm, TIP_SENSORS, np.diag([0.1, 1.0]), x0=x0, method="fd")
+    result = simulate(
+        nm, TIP_SENSORS, np.diag([0.1, 1.0]), x0=x0, options=SimulationOptions(method="fd")
+    )
     assert not any("energy balance" in w for w in result.warnings)
     assert result.info["energy_balance_residual_plant"] < 1e-12
     assert result.info["energy_balance_residual_error_system"] < 1e-12

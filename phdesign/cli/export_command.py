@@ -27,9 +27,9 @@ from phdesign.cli.design_arguments import add_observer_arguments, observer_from_
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError, ObserverError, OutputFileError
 
-__all__ = ["add_sampling_arguments", "register", "sampled_simulation"]
+__all__ = ["add_sampling_arguments", "register", "sampling_options"]
 
-SAMPLER_CHOICES = ("average", "point")  # phdesign.numeric.sampled.samplers.SAMPLERS, without numpy
+SAMPLER_CHOICES = ("average", "point")  # phdesign.numeric.checks.SAMPLERS, without numpy
 FORMAT_CHOICES = ("json", "c", "npz", "statespace")  # phdesign.codegen.FORMATS
 
 
@@ -147,9 +147,9 @@ def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
 def _export(args: argparse.Namespace) -> int:
     from phdesign.codegen import check_export_path
     from phdesign.core.limits import check_periods
+    from phdesign.numeric.checks import check_sampling
     from phdesign.numeric.inputs import initial_state_function
     from phdesign.numeric.sampled.export import export_observer, verification_plant_degree
-    from phdesign.numeric.sampled.samplers import check_sampling
 
     dt = check_sampling(args.dt, args.sampler, dt_name="--dt")
     _finite_positive("--t-end", args.t_end)
@@ -217,21 +217,18 @@ def add_sampling_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def sampled_simulation(
-    args: argparse.Namespace, nm: Any, C_m: Any, L: Any, x0: Any, xhat0: Any, u: Any = None
-) -> Any:
-    """Run ``simulate`` through :func:`simulate_sampled` when a sampling flag is given.
+def sampling_options(args: argparse.Namespace, observed: bool) -> dict[str, Any]:
+    """Return the simulation options of ``--dt``, ``--sampler``, ``--observer-resolution``.
 
-    Returns None when none of ``--dt``, ``--sampler``, ``--observer-resolution`` is set
-    (the continuous simulation then runs as before).
+    Checked here with the flags' names; empty when none is given (the continuous
+    observer then runs as before).  ``observed``: whether the command has an observer.
     """
     if args.dt is None and args.sampler is None and args.observer_resolution is None:
-        return None
+        return {}
     from phdesign.core.limits import check_periods
-    from phdesign.numeric.sampled.samplers import check_sampling
-    from phdesign.numeric.sampled.simulation import simulate_sampled
+    from phdesign.numeric.checks import check_sampling
 
-    if C_m is None:
+    if not observed:
         raise NumericError(
             "--dt, --sampler and --observer-resolution act on the observer: give --sensors or --cm"
         )
@@ -243,18 +240,8 @@ def sampled_simulation(
     if args.scheme != "expm":
         raise NumericError("a sampled or lower-order observer is stepped exactly: drop --scheme")
     check_positive("--observer-resolution", args.observer_resolution)
-    return simulate_sampled(
-        nm,
-        C_m,
-        L,
-        x0=x0,
-        xhat0=xhat0,
-        t_end=args.t_end,
-        samples=args.samples,
-        dt=args.dt,
-        sampler=args.sampler or "average",
-        method=args.method,
-        resolution=args.resolution,
-        observer_resolution=args.observer_resolution,
-        u=u,
-    )
+    return {
+        "dt": args.dt,
+        "sampler": args.sampler,
+        "observer_resolution": args.observer_resolution,
+    }

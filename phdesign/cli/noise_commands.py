@@ -41,9 +41,9 @@ __all__ = [
     "add_noise_arguments",
     "add_noise_tuning_arguments",
     "add_stochastic_arguments",
+    "noise_options",
     "noise_tuning",
     "register",
-    "stochastic_simulation",
 ]
 
 
@@ -309,13 +309,13 @@ def add_stochastic_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, help="seed of the noise (with the noise options)")
 
 
-def stochastic_simulation(args: argparse.Namespace) -> Any:
-    """Return the stochastic simulator bound to the noise options, or None without them."""
+def noise_options(args: argparse.Namespace) -> dict[str, Any]:
+    """Return the simulation options of the noise flags (empty without them), checked here."""
     noisy = args.noise_intensity is not None or args.input_noise is not None
     if not noisy:
         if args.seed is not None:
             raise NumericError("--seed needs --noise-intensity or --input-noise")
-        return None
+        return {}
     sampled = [
         flag
         for flag, name in (
@@ -330,19 +330,14 @@ def stochastic_simulation(args: argparse.Namespace) -> Any:
             f"the noise options run the continuous observer; {sampled[0]} asks for a sampled "
             "one: give one or the other"
         )
-    from functools import partial
-
-    from phdesign.numeric.time.stochastic import simulate_noisy
-
     sensors = getattr(args, "sensors", None) or getattr(args, "cm", None)
     if args.noise_intensity is not None and sensors is None:
         raise ObserverError("--noise-intensity needs an observer: give --sensors or --cm")
-    return partial(
-        simulate_noisy,
-        noise_intensity=_listed_intensities(args.noise_intensity, "--noise-intensity"),
-        input_intensity=_listed_intensities(args.input_noise, "--input-noise"),
-        seed=args.seed,
-    )
+    return {
+        "noise_intensity": _listed_intensities(args.noise_intensity, "--noise-intensity"),
+        "input_intensity": _listed_intensities(args.input_noise, "--input-noise"),
+        "seed": args.seed,
+    }
 
 
 def _listed_intensities(text: str | None, flag: str) -> Any:

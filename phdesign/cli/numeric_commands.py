@@ -31,12 +31,12 @@ from phdesign.cli.common import (
     warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
-from phdesign.cli.export_command import add_sampling_arguments, sampled_simulation
+from phdesign.cli.export_command import add_sampling_arguments, sampling_options
 from phdesign.cli.noise_commands import (
     add_noise_tuning_arguments,
     add_stochastic_arguments,
+    noise_options,
     noise_tuning,
-    stochastic_simulation,
 )
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
@@ -208,6 +208,7 @@ def _spectrum(args: argparse.Namespace) -> int:
 def _simulate(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from phdesign import SimulationOptions
     from phdesign.design.observer import Plant
     from phdesign.numeric.inputs import input_function
 
@@ -229,41 +230,23 @@ def _simulate(args: argparse.Namespace) -> int:
     x0 = plant.initial_state(args.x0, "x0")
     xhat0 = plant.initial_state(args.xhat0, "xhat0")
     u = input_function(args.u, plant.numeric, model=model)
-    C_m, L = (None, None) if observer is None else observer.numeric_gain("simulate")
-    # a sampled or lower-order observer (--dt, --sampler, --observer-resolution), a noisy
-    # run (--noise-intensity, --input-noise), else the continuous noiseless one
-    noisy = stochastic_simulation(args)
+    # how to run: a sampled or lower-order observer (--dt, --sampler,
+    # --observer-resolution), a noisy run (--noise-intensity, --input-noise), else the
+    # continuous noiseless one; the design object picks the simulator from the options
+    options = SimulationOptions(
+        t_end=args.t_end,
+        samples=args.samples,
+        scheme=args.scheme,
+        tol=args.tol,
+        **sampling_options(args, observed=observer is not None),
+        **noise_options(args),
+    )
     with run_outputs(args) as commit:
         with np.errstate(all="ignore"):  # an overflow is refused below, with one line
-            res = sampled_simulation(args, plant.numeric, C_m, L, x0, xhat0, u)
-            if res is None and noisy is not None:
-                res = noisy(
-                    plant.numeric,
-                    C_m,
-                    L,
-                    x0=x0,
-                    xhat0=xhat0,
-                    t_end=args.t_end,
-                    samples=args.samples,
-                    method=args.method,
-                    resolution=args.resolution,
-                    scheme=args.scheme,
-                    u=u,
-                )
-            if res is not None:
-                res = plant.labelled(res, **({} if observer is None else observer.labels()))
+            if observer is not None:
+                res = observer.simulate(x0, xhat0=xhat0, u=u, options=options)
             else:
-                options = {
-                    "t_end": args.t_end,
-                    "samples": args.samples,
-                    "scheme": args.scheme,
-                    "u": u,
-                    "tol": args.tol,
-                }
-                if observer is not None:
-                    res = observer.simulate(x0, xhat0=xhat0, **options)
-                else:
-                    res = plant.simulate(x0, **options)
+                res = plant.simulate(x0, u=u, options=options)
         check_finite_series(res)
         commit(simulation_text(args, model.name, res), res)
     notices = []

@@ -61,6 +61,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.numeric.control.simulation import LoopSimulation
     from phdesign.numeric.control.spectrum import LoopSpectrum
     from phdesign.numeric.control.tuning import LoopTuneResult
+    from phdesign.numeric.time.options import SimulationOptions
 
 __all__ = ["Loop"]
 
@@ -288,17 +289,20 @@ class Loop:
         x0: str | Callable[[Any], Any] | None = None,
         xhat0: str | Callable[[Any], Any] | None = None,
         u: str | Callable[[float], Any] | None = None,
-        t_end: float | None = None,
-        samples: int | None = None,
-        scheme: str | None = None,
+        options: SimulationOptions | None = None,
+        **settings: Any,
     ) -> LoopSimulation:
         """Simulate the loop (:func:`~phdesign.numeric.control.simulation.simulate_loop`).
 
         ``x0``, ``xhat0`` and ``u`` may be text (``"x1: 0, x2: z - 0.9"``,
-        ``"u1: sin(t)"``), read as on the command line, or callables.
+        ``"u1: sin(t)"``), read as on the command line, or callables.  ``options`` and
+        ``settings`` (its fields by name: ``t_end``, ``samples``, ``scheme``, ``z_w``) say
+        how to run (:class:`~phdesign.numeric.time.options.SimulationOptions`); the
+        discretization is the loop's.
         """
         from phdesign.numeric.control.simulation import simulate_loop
         from phdesign.numeric.inputs import initial_state_function, input_function
+        from phdesign.numeric.time.options import SimulationOptions
 
         nm = self.numeric_model
 
@@ -312,17 +316,14 @@ class Loop:
         inputs = (
             input_function(u, nm, model=self.model) if (u is None or isinstance(u, str)) else u
         )
+        opts = SimulationOptions.merged(options, **settings)
         return simulate_loop(
             nm,
             self.numeric,
             x0=state(x0),
             xhat0=state(xhat0),
             u=inputs,
-            t_end=t_end,
-            samples=samples,
-            method=self.method,
-            resolution=self.resolution,
-            scheme=scheme,
+            options=opts.discretized(self.method, self.resolution, "Loop"),
         )
 
     def tune(

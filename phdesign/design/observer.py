@@ -50,7 +50,8 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.numeric.noise.tradeoff import Tradeoff
     from phdesign.numeric.sampled.export import SampledObserver
     from phdesign.numeric.spectrum.report import SpectrumReport
-    from phdesign.numeric.time.simulation import SimulationResult
+    from phdesign.numeric.time.options import SimulationOptions
+    from phdesign.numeric.time.result import SimulationResult
     from phdesign.numeric.tuning.search import TuneResult
     from phdesign.symbolic.classify import Classification
 
@@ -221,14 +222,11 @@ class Observer:
         x0: str | Callable[[Any], Any] | None = None,
         *,
         xhat0: str | Callable[[Any], Any] | None = None,
-        t_end: float | None = None,
-        samples: int | None = None,
-        u: Callable[[float], Any] | None = None,
-        scheme: str | None = None,
-        z_w: Any = None,
-        tol: float | None = None,
+        u: str | Callable[[float], Any] | None = None,
+        options: SimulationOptions | None = None,
+        **settings: Any,
     ) -> SimulationResult:
-        """Simulate plant and observer together.
+        """Simulate plant and observer together: what ``phdesign simulate`` runs.
 
         Parameters
         ----------
@@ -237,23 +235,29 @@ class Observer:
             (state names or efforts ``e1``, expressions in ``z`` and the parameters) or a
             function ``f(z) -> (len(z), n)``.  Both default to zero: without ``x0`` and
             ``u`` every series is zero.
-        t_end, samples, u, scheme, z_w, tol
-            See :func:`phdesign.numeric.time.simulation.simulate` (and its defaults).
+        u : str or callable, optional
+            Plant inputs: text such as ``"u2: sin(2*t)"`` or a function ``u(t)``.
+        options : SimulationOptions, optional
+            How to run (:class:`~phdesign.numeric.time.options.SimulationOptions`).
+        **settings
+            Its fields by name, over ``options``: ``t_end``, ``samples``, ``scheme``,
+            ``tol``, ``z_w``; ``dt``, ``sampler``, ``observer_resolution`` (a sampled or
+            lower-order observer, :func:`~phdesign.numeric.sampled.simulation.simulate_sampled`);
+            ``noise_intensity``, ``input_intensity``, ``seed`` (a noisy run,
+            :func:`~phdesign.numeric.time.stochastic.simulate_noisy`).  A name that is not
+            an option is refused; the discretization is the plant's.
+
+        Examples
+        --------
+        >>> from phdesign.models import load_builtin
+        >>> string = Observer(load_builtin("wave"), sensors=[2], gain=0.5, resolution=8)
+        >>> run = string.simulate("x2: 1", t_end=1.0, samples=3, dt=0.01, sampler="point")
+        >>> run.info["sampler"], run.t.tolist()
+        ('point', [0.0, 0.5, 1.0])
         """
         C, L = self.numeric_gain("simulate")
-        return self.plant.run(
-            C,
-            L,
-            x0,
-            xhat0=xhat0,
-            labels=self.labels(),
-            t_end=t_end,
-            samples=samples,
-            u=u,
-            scheme=scheme,
-            z_w=z_w,
-            tol=tol,
-        )
+        opts = self.plant.simulation_options(options, **settings)
+        return self.plant.run(C, L, x0, xhat0=xhat0, u=u, options=opts, labels=self.labels())
 
     def tune(
         self, *, full: bool = False, starts: int = 6, seed: int = 0, resolution: int | None = None

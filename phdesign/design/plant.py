@@ -29,7 +29,8 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.numeric.bridge import NumericModel
     from phdesign.numeric.discretization.phs import DiscretePHS
     from phdesign.numeric.spectrum.report import SpectrumReport
-    from phdesign.numeric.time.simulation import SimulationResult
+    from phdesign.numeric.time.options import SimulationOptions
+    from phdesign.numeric.time.result import SimulationResult
 
 __all__ = ["Plant", "numeric_matrix"]
 
@@ -126,16 +127,10 @@ class Plant:
 
     def initial_state(self, x0: str | Callable[[Any], Any] | None, name: str) -> Any:
         """Return an initial state as a function of z (text ``"x1: z - 0.9"`` is parsed)."""
-        if x0 is None or callable(x0):
-            return x0
-        if not isinstance(x0, str):
-            raise ArgumentError(
-                f"{name} must be text such as 'x1: 0, x2: z - 0.9' or a function of z; "
-                f"found {type(x0).__name__}"
-            )
         from phdesign.numeric.inputs import initial_state_function
 
-        return initial_state_function(x0, self.numeric)
+        text = _text_or_function(x0, name, "'x1: 0, x2: z - 0.9'", "z")
+        return x0 if text is None else initial_state_function(text, self.numeric)
 
     def spectrum(
         self,
@@ -176,18 +171,33 @@ class Plant:
         self,
         x0: str | Callable[[Any], Any] | None = None,
         *,
-        t_end: float | None = None,
-        samples: int | None = None,
-        u: Callable[[float], Any] | None = None,
-        scheme: str | None = None,
-        tol: float | None = None,
+        u: str | Callable[[float], Any] | None = None,
+        options: SimulationOptions | None = None,
+        **settings: Any,
     ) -> SimulationResult:
         """Simulate the plant alone from ``x0`` (text or a function of z; zero by default).
 
-        ``tol`` bounds the error of ``scheme="midpoint"`` (its substeps are chosen to meet
-        it; :func:`phdesign.numeric.time.simulation.simulate`, whose defaults apply).
+        ``u``, ``options`` and ``settings`` as for :meth:`phdesign.Observer.simulate`
+        (``t_end=2``, ``scheme="midpoint"``, ``input_intensity=0.1`` ...); the noise on
+        the inputs is the only kind of run a plant without sensors has besides the plain one.
         """
-        return self.run(None, None, x0, t_end=t_end, samples=samples, u=u, scheme=scheme, tol=tol)
+        return self.run(None, None, x0, u=u, options=self.simulation_options(options, **settings))
+
+    def simulation_options(
+        self, options: SimulationOptions | None = None, **settings: Any
+    ) -> SimulationOptions:
+        """Return ``options`` with ``settings`` (fields by name) on this plant's discretization.
+
+        Raises
+        ------
+        ArgumentError
+            A setting that is not an option, or another method or resolution than the
+            plant's (:meth:`~phdesign.numeric.time.options.SimulationOptions.discretized`).
+        """
+        from phdesign.numeric.time.options import SimulationOptions
+
+        merged = SimulationOptions.merged(options, **settings)
+        return merged.discretized(self.method, self.resolution, "Plant")
 
     def run(
         self,
@@ -196,28 +206,55 @@ class Plant:
         x0: str | Callable[[Any], Any] | None = None,
         *,
         xhat0: str | Callable[[Any], Any] | None = None,
+        u: str | Callable[[float], Any] | None = None,
+        options: SimulationOptions | None = None,
         labels: Mapping[str, str] | None = None,
-        **options: Any,
     ) -> SimulationResult:
         """Simulate the plant, with the observer of ``(C_m, L)`` when given.
 
-        ``options`` are those of :func:`phdesign.numeric.time.simulation.simulate` (``t_end``,
-        ``samples``, ``u``, ``scheme``, ``z_w``), checked there; ``labels`` name the design
-        in the result (presentation only: the plots' titles and the JSON).
-        """
-        from phdesign.numeric.time.simulation import simulate
+        The one route of :meth:`simulate`, :meth:`phdesign.Observer.simulate` and
+        ``phdesign simulate``: the kind of run the options ask for
+        (:attr:`~phdesign.numeric.time.options.SimulationOptions.kind`) picks the
+        simulator: :func:`~phdesign.numeric.sampled.simulation.simulate_sampled` for a
+        sampled or lower-order observer, :func:`~phdesign.numeric.time.stochastic.simulate_noisy`
+        for noise, else :func:`~phdesign.numeric.time.simulation.simulate`.  ``labels`` name
+        the design in the result (presentation only: the plots' titles and the JSON).
 
-        result = simulate(
-            self.numeric,
-            C_m,
-            L,
-            x0=self.initial_state(x0, "x0"),
-            xhat0=self.initial_state(xhat0, "xhat0"),
-            method=self.method,
-            resolution=self.resolution,
-            **options,
-        )
+        Raises
+        ------
+        ObserverError
+            A sampled or lower-order observer asked for without sensors.
+        """
+        opts = self.simulation_options(options)
+        inputs = {
+            "x0": self.initial_state(x0, "x0"),
+            "xhat0": self.initial_state(xhat0, "xhat0"),
+            "u": self.input_signal(u),
+        }
+        if opts.kind == "sampled":
+            from phdesign.numeric.sampled.simulation import simulate_sampled
+
+            if C_m is None or L is None:
+                raise ObserverError(
+                    "dt, sampler and observer_resolution act on the observer: give the sensors"
+                )
+            result = simulate_sampled(self.numeric, C_m, L, options=opts, **inputs)
+        elif opts.kind == "noisy":
+            from phdesign.numeric.time.stochastic import simulate_noisy
+
+            result = simulate_noisy(self.numeric, C_m, L, options=opts, **inputs)
+        else:
+            from phdesign.numeric.time.simulation import simulate
+
+            result = simulate(self.numeric, C_m, L, options=opts, **inputs)
         return self.labelled(result, **(labels or {}))
+
+    def input_signal(self, u: str | Callable[[float], Any] | None) -> Any:
+        """Return plant inputs as a function of t (text ``"u2: sin(2*t)"`` is parsed)."""
+        from phdesign.numeric.inputs import input_function
+
+        text = _text_or_function(u, "u", "'u2: sin(2*t)'", "t")
+        return u if text is None else input_function(text, self.numeric, model=self.model)
 
     def labelled(self, result: SimulationResult, **labels: str) -> SimulationResult:
         """Return the result with the model's name (and the design's ``labels``) in its ``info``.
@@ -230,3 +267,15 @@ class Plant:
         extra = f", parameters={self.parameters}" if self.parameters else ""
         text = f"Plant(model={self.model.name!r}{extra}, method={self.method!r})"
         return shorten(text, REPR_LIMIT)
+
+
+def _text_or_function(value: Any, name: str, example: str, variable: str) -> str | None:
+    """Return ``value`` if it is text to parse, None if it is None or callable; else refuse."""
+    if value is None or callable(value):
+        return None
+    if not isinstance(value, str):
+        raise ArgumentError(
+            f"{name} must be text such as {example} or a function of {variable}; found "
+            f"{type(value).__name__}"
+        )
+    return value

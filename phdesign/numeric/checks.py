@@ -1,4 +1,4 @@
-r"""The argument checks of the numeric front door: spectrum, simulate and tune.
+r"""The argument checks of the numeric front door: spectrum, simulate, tune and sampling.
 
 Each public numeric function calls one checker of this module first, so that a wrong
 argument is refused before any work with a phdesign error that names it (never an
@@ -23,6 +23,7 @@ phdesign.core.errors.ObserverError: C_m must have full row rank ...; expected ra
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -36,12 +37,42 @@ from phdesign.numeric.bridge import require_numeric_model
 from phdesign.numeric.discretization.registry import check_basis
 
 __all__ = [
+    "SAMPLERS",
     "check_initial_state",
+    "check_sampling",
     "check_sensors_and_gain",
     "check_simulate_arguments",
     "check_spectrum_arguments",
     "check_tune_arguments",
 ]
+
+
+#: The samplers a controller's front end may have; the first is the default.
+SAMPLERS = ("average", "point")
+
+
+def check_sampling(dt: object, sampler: object, *, dt_name: str = "dt") -> float:
+    """Return ``dt`` as a float after checking it and the sampler's name.
+
+    ``dt_name`` is how the period is called in the message (``"--dt"`` on the command line).
+
+    Examples
+    --------
+    >>> check_sampling(1e-3, "average")
+    0.001
+    >>> check_sampling(0, "point")
+    Traceback (most recent call last):
+    ...
+    phdesign.core.errors.NumericError: dt must be a finite positive number of seconds; found 0
+    """
+    value = math.nan
+    if not isinstance(dt, bool) and isinstance(dt, (int, float, np.floating, np.integer)):
+        value = float(dt)
+    if not (math.isfinite(value) and value > 0):
+        raise NumericError(f"{dt_name} must be a finite positive number of seconds; found {dt!r}")
+    if sampler not in SAMPLERS:
+        raise NumericError(f"unknown sampler {sampler!r}; expected one of {', '.join(SAMPLERS)}")
+    return value
 
 
 def check_sensors_and_gain(
@@ -146,21 +177,18 @@ def check_simulate_arguments(
     *,
     x0: Any,
     xhat0: Any,
-    t_end: Any,
-    samples: Any,
-    method: str,
-    resolution: Any,
     u: Callable[[float], Any] | None,
-    scheme: Any,
-    z_w: Any,
+    options: Any,
     discrete: Any = None,
 ) -> None:
-    """Check the arguments of :func:`~phdesign.numeric.time.simulation.simulate` and its budget."""
-    _common(nm, method, resolution)
-    positive_number(t_end, "t_end")
-    positive_int(samples, "samples", minimum=2)
-    if not isinstance(scheme, str):
-        raise ArgumentError(f"scheme must be a name such as 'expm'; found {scheme!r}")
+    """Check what a simulation's options cannot check alone: the model's part, the budget.
+
+    ``options`` is a checked :class:`~phdesign.numeric.time.options.SimulationOptions`;
+    here are the sensors and gain, the initial states and inputs against the model, the
+    points ``z_w`` against its interval, and the budget of
+    :func:`phdesign.core.limits.check_simulation`.
+    """
+    require_numeric_model(nm)
     check_sensors_and_gain(nm, C_m, L, what="a simulation")
     check_initial_state(x0, nm, "x0")
     check_initial_state(xhat0, nm, "xhat0")
@@ -168,14 +196,13 @@ def check_simulate_arguments(
         raise NumericError("xhat0 needs an observer: give the sensors C_m and the gain L")
     if u is not None and not callable(u):
         raise ArgumentError(f"u must be a function of t returning the inputs; found {u!r}")
-    if z_w is not None:
-        points = np.asarray(z_w, dtype=float)
+    if options.z_w is not None:
         a, b = nm.interval
-        if points.ndim != 1 or not points.size or not np.all(np.isfinite(points)):
-            raise NumericError(f"z_w must be a non-empty list of finite points; found {z_w!r}")
-        if points.min() < a or points.max() > b:
-            raise NumericError(f"z_w must lie in [{a:g}, {b:g}]; found {points.tolist()}")
-    limits.check_simulation(nm, C_m, t_end, samples, method, resolution, discrete)
+        if min(options.z_w) < a or max(options.z_w) > b:
+            raise NumericError(f"z_w must lie in [{a:g}, {b:g}]; found {list(options.z_w)}")
+    limits.check_simulation(
+        nm, C_m, options.t_end, options.samples, options.method, options.resolution, discrete
+    )
 
 
 def check_tune_arguments(

@@ -1,7 +1,7 @@
 r"""Plots for observer design: energies, deflections, outputs, spectra and gain maps.
 
 A front end: every function draws data that a lower layer computed
-(:class:`phdesign.numeric.time.simulation.SimulationResult`, eigenvalues from
+(:class:`phdesign.numeric.time.result.SimulationResult`, eigenvalues from
 :mod:`phdesign.numeric.spectrum.converged`, abscissas from :mod:`phdesign.numeric.tuning.search`)
 and returns
 the :class:`matplotlib.figure.Figure` it drew on.  Functions that draw one panel accept an

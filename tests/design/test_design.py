@@ -162,6 +162,7 @@ def test_every_command_refuses_a_rank_deficient_C_m(capsys, argv):
 def test_numeric_functions_refuse_what_classify_refuses(wave):
     from phdesign.numeric.bridge import to_numeric
     from phdesign.numeric.spectrum.converged import spectrum
+    from phdesign.numeric.time.options import SimulationOptions
     from phdesign.numeric.time.simulation import simulate
     from phdesign.numeric.tuning.search import tune
 
@@ -169,7 +170,7 @@ def test_numeric_functions_refuse_what_classify_refuses(wave):
     singular = np.array([[0.0, 0.0]])
     for call in (
         lambda: spectrum(nm, singular, np.eye(1)),
-        lambda: simulate(nm, singular, np.eye(1), t_end=0.1),
+        lambda: simulate(nm, singular, np.eye(1), options=SimulationOptions(t_end=0.1)),
         lambda: tune(nm, singular),
     ):
         with pytest.raises(ObserverError, match="full row rank"):
@@ -184,6 +185,7 @@ def test_public_functions_name_their_arguments(wave, beam):
 
     from phdesign.numeric.bridge import to_numeric
     from phdesign.numeric.spectrum.converged import spectrum
+    from phdesign.numeric.time.options import SimulationOptions
     from phdesign.numeric.time.simulation import simulate
 
     nm = to_numeric(wave)
@@ -219,7 +221,11 @@ def test_public_functions_name_their_arguments(wave, beam):
             r"count must be a positive integer; found 0",
         ),
         (lambda: spectrum(nm, tol=float("nan")), NumericError, r"tol must be a finite positive"),
-        (lambda: simulate(nm, samples=2.5), NumericError, r"samples must be an integer >= 2"),
+        (
+            lambda: simulate(nm, options=SimulationOptions(samples=2.5)),
+            NumericError,
+            r"samples must be an integer >= 2",
+        ),
         (
             lambda: simulate(nm, x0=lambda z: np.full((np.size(z), 2), np.nan)),
             NumericError,
@@ -242,12 +248,18 @@ def test_public_functions_name_their_arguments(wave, beam):
         # issue 30: foreign errors (numpy's reshape, os, AttributeError) and a silent
         # reading of bytes as their code points (gain=b"1" was diag(49, 49))
         (
-            lambda: simulate(nm, u=lambda t: [1], t_end=0.1, samples=3, resolution=4),
+            lambda: simulate(
+                nm, u=lambda t: [1], options=SimulationOptions(t_end=0.1, samples=3, resolution=4)
+            ),
             ArgumentError,
             r"u\(t\) must return 2 numbers \(one per input\); found 1 at t = 0",
         ),
         (
-            lambda: simulate(nm, u=lambda t: [np.nan, 0], t_end=0.1, samples=3, resolution=4),
+            lambda: simulate(
+                nm,
+                u=lambda t: [np.nan, 0],
+                options=SimulationOptions(t_end=0.1, samples=3, resolution=4),
+            ),
             NumericError,
             r"u\(t\) must be finite; found nan in input u1 at t = 0",
         ),

@@ -23,6 +23,7 @@ from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.spectrum.converged import spectrum
 from phdesign.numeric.statespace import plant_statespace
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.closing import close_inputs, closed_ports
@@ -194,7 +195,7 @@ def test_beam_tip_damper_simulation_audits_the_damper_dissipation_exactly():
     np.testing.assert_allclose(d.R, np.outer(c, c), atol=1e-12)  # k = 1, d = 0: R = k c cᵀ
     x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=beam)
     t_end, samples = 2.0, 81
-    run = simulate(nm, x0=x0, t_end=t_end, samples=samples, discrete=d)
+    run = simulate(nm, x0=x0, discrete=d, options=SimulationOptions(t_end=t_end, samples=samples))
     assert run.info["energy_balance_residual_plant"] < 1e-12
     assert not run.warnings
     F = np.linalg.solve(d.E, d.J - d.R)

@@ -15,6 +15,7 @@ from phdesign.io import model_from_toml, model_to_toml
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.inputs import input_function
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 from phdesign.symbolic.model import BCPHS
 
@@ -40,7 +41,9 @@ def test_plot_labels_carry_the_units_the_model_states_and_none_it_does_not():
         (string(), "time t", "energy"),  # nothing stated: no unit claimed
         (load_builtin("wave"), "time t [s]", "energy [J]"),  # the built-ins state SI
     ):
-        run = simulate(to_numeric(model), t_end=0.1, samples=3, resolution=6)
+        run = simulate(
+            to_numeric(model), options=SimulationOptions(t_end=0.1, samples=3, resolution=6)
+        )
         ax = plots.plot_hamiltonians(run).axes[0]
         assert (ax.get_xlabel(), ax.get_ylabel()) == (time, energy)
         assert run.to_dict()["units"] == model.unit_map
@@ -70,7 +73,11 @@ def test_plant_inputs_from_the_command_line_drive_the_library_simulation(capsys)
     assert main([*argv, "--json"]) == 0
     cli = json.loads(capsys.readouterr().out)
     nm = to_numeric(load_builtin("wave"))
-    run = simulate(nm, t_end=2.0, samples=2001, u=lambda t: np.array([0.0, np.sin(2 * t)]))
+    run = simulate(
+        nm,
+        u=lambda t: np.array([0.0, np.sin(2 * t)]),
+        options=SimulationOptions(t_end=2.0, samples=2001),
+    )
     np.testing.assert_array_equal(np.array(cli["y"]), run.y)
     t = run.t
     supplied = simpson(np.sin(2 * t) * run.y[:, 1], x=t)

@@ -14,7 +14,8 @@ import pytest
 
 from phdesign import plots
 from phdesign.core.errors import NumericError, OutputFileError
-from phdesign.numeric.time.simulation import SimulationResult
+from phdesign.numeric.time.options import SimulationOptions
+from phdesign.numeric.time.result import SimulationResult
 
 T = np.linspace(0.0, 2.0, 41)
 Z = np.linspace(0.0, 1.0, 11)
@@ -278,7 +279,13 @@ def test_plot_simulation_on_a_real_wave_simulation(tmp_path):
     wave = load_builtin("wave")
     nm = to_numeric(wave)
     x0 = initial_state_function("x2: sin(pi*z)", nm, model=wave)
-    res = simulate(nm, np.array([[0.0, 1.0]]), np.array([[0.5]]), x0=x0, t_end=1.0, samples=21)
+    res = simulate(
+        nm,
+        np.array([[0.0, 1.0]]),
+        np.array([[0.5]]),
+        x0=x0,
+        options=SimulationOptions(t_end=1.0, samples=21),
+    )
     fig = plots.plot_simulation(res, tmp_path / "wave.svg")
     assert (tmp_path / "wave.svg").read_text().lstrip().startswith("<?xml")
     lines = lines_by_label(fig.axes[0])

@@ -20,6 +20,7 @@ from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 from phdesign.symbolic.model import BCPHS
 
@@ -135,7 +136,12 @@ def test_simulation_with_variable_damping_keeps_its_exact_energy_balance():
     d = discretize(nm, "galerkin", 20)
     # the weak form: ∫ Ψᵀ P0 Ψ splits into J (skew z-coupling) and R = -∫ Ψᵀ sym(P0) Ψ
     assert d.check_structure()["R_min_eig"] > -1e-13
-    run = simulate(nm, x0=initial_state_function("x1: sin(pi*z)", nm), t_end=3.0, discrete=d)
+    run = simulate(
+        nm,
+        x0=initial_state_function("x1: sin(pi*z)", nm),
+        discrete=d,
+        options=SimulationOptions(t_end=3.0),
+    )
     assert run.info["energy_balance_residual_plant"] < 1e-12
     # dissipated energy is positive: H decreases monotonically
     assert np.all(np.diff(run.H) <= 1e-15)

@@ -7,14 +7,14 @@ coordinates
 it is never formed as the difference :math:`\hat e - \hat e_{obs}` of two large numbers,
 and its round-off is the error system's own, not that of the whole loop's exponential;
 :math:`\hat e_{obs} = \hat e - \tilde e`.  Stepping is
-:func:`phdesign.numeric.time.simulation.step_lti` (matrix exponential, exact for inputs linear
+:func:`phdesign.numeric.time.stepping.step_lti` (matrix exponential, exact for inputs linear
 between samples; or implicit midpoint).
 
 Energy audit, as :func:`phdesign.numeric.time.simulation.simulate` does: without free inputs
 the loop is autonomous, :math:`E_2 \dot Z = A_Z Z`, and its energy
 :math:`H + \tilde H = \tfrac12 Z^\top E_2 Z` changes over each step by exactly
 :math:`Z_k^\top (\int_0^{\Delta t} e^{F^\top s} \operatorname{sym}(A_Z) e^{F s} ds) Z_k`
-(:func:`~phdesign.numeric.time.simulation.energy_balance_residual`); the error system is
+(:func:`~phdesign.numeric.time.stepping.energy_balance_residual`); the error system is
 autonomous whatever the inputs and is audited on its own.  A residual above
 :data:`~phdesign.numeric.time.simulation.ENERGY_BALANCE_RTOL` of the largest energy warns.
 """
@@ -27,25 +27,22 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.core.defaults import current
-from phdesign.core.errors import LoopError, NumericError
+from phdesign.core.errors import ArgumentError, LoopError
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.control.assembly import NumericLoop, assemble
+from phdesign.numeric.control.assembly import LoopSystem, NumericLoop, assemble
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import input_samples
-from phdesign.numeric.time.simulation import (
-    ENERGY_BALANCE_RTOL,
-    SimulationResult,
-    energy_balance_residual,
-    step_lti,
-)
+from phdesign.numeric.time.options import SimulationOptions
+from phdesign.numeric.time.result import SimulationResult
+from phdesign.numeric.time.simulation import ENERGY_BALANCE_RTOL
+from phdesign.numeric.time.stepping import energy_balance_residual, step_lti
 
 __all__ = ["LoopSimulation", "simulate_loop"]
 
 
 @dataclass(frozen=True)
 class LoopSimulation(SimulationResult):
-    """Time series of the loop: a :class:`~phdesign.numeric.time.simulation.SimulationResult`.
+    """Time series of the loop: a :class:`~phdesign.numeric.time.result.SimulationResult`.
 
     Its fields (energies H, Ĥ, H̃, outputs y, ŷ, the displacement and its estimate) have
     the meaning they have for ``simulate``; ``states_hat`` holds the observer's discrete
@@ -129,13 +126,8 @@ def simulate_loop(
     *,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     xhat0: Callable[[np.ndarray], np.ndarray] | None = None,
-    t_end: float | None = None,
-    samples: int | None = None,
-    method: str | None = None,
-    resolution: int | None = None,
     u: Callable[[float], np.ndarray] | None = None,
-    scheme: str | None = None,
-    z_w: np.ndarray | None = None,
+    options: SimulationOptions | None = None,
 ) -> LoopSimulation:
     """Simulate plant, observer and feedback together (module docstring).
 
@@ -145,12 +137,13 @@ def simulate_loop(
     loop : NumericLoop
     x0, xhat0 : callable, optional
         Initial plant and observer states ``f(z) -> (m, n)``; default zero.
-    t_end, samples, method, resolution, scheme, z_w
-        As for :func:`phdesign.numeric.time.simulation.simulate` (defaults: the table's,
-        :mod:`phdesign.core.defaults`).
     u : callable, optional
         ``u(t) -> (n_ports,)``: signals on the inputs that are *not* actuated (the
         actuated entries must be zero; the controller sets them).
+    options : SimulationOptions, optional
+        ``t_end``, ``samples``, ``method``, ``resolution``, ``scheme`` and ``z_w``, as for
+        :func:`phdesign.numeric.time.simulation.simulate`.  The loop's midpoint steps once
+        per output interval (no ``tol``); a sampled or noisy loop is not simulated.
 
     Returns
     -------
@@ -170,45 +163,70 @@ def simulate_loop(
     >>> nm = to_numeric(beam)
     >>> loop = NumericLoop((2,), np.eye(1), np.array([[0, 0, 0, 1.0]]), np.eye(1))
     >>> x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=beam)
-    >>> run = simulate_loop(nm, loop, x0=x0, t_end=1.0, samples=3, resolution=12)
+    >>> options = SimulationOptions(t_end=1.0, samples=3, resolution=12)
+    >>> run = simulate_loop(nm, loop, x0=x0, options=options)
     >>> bool(run.H[-1] < run.H[0]), run.warnings
     (True, ())
     """
-    t_end, samples, scheme, _ = current().simulation.fill(t_end, samples, scheme)
-    if not (np.isfinite(t_end) and t_end > 0):
-        raise NumericError(f"t_end must be a positive number; found {t_end}")
-    if int(samples) < 2:
-        raise NumericError(f"samples must be at least 2; found {samples}")
-    system = assemble(discretize(nm, method, resolution), loop)
-    d, n, m = system.discrete, system.dim, system.discrete.n_ports
-    t = np.linspace(0.0, float(t_end), int(samples))
-    V = None
-    if u is not None:
-        U = input_samples(u, t, m)
-        driven = [a + 1 for a in loop.actuated if np.any(U[:, a])]
-        if driven:
-            raise LoopError(
-                f"u{driven[0]} is actuated by the feedback; --u drives only the other inputs "
-                f"({', '.join(f'u{j + 1}' for j in system.others) or 'none'})"
-            )
-        V = U[:, list(system.others)] if np.any(U) else None
+    opts = SimulationOptions.merged(options)
+    opts.require("simulate_loop", "continuous")
+    if opts.tol is not None:
+        raise ArgumentError(
+            f"tol: the loop's midpoint steps once per output interval, without a tolerance; "
+            f"found tol={opts.tol!r}"
+        )
+    system = assemble(discretize(nm, opts.method, opts.resolution), loop)
+    d, n = system.discrete, system.dim
+    t = opts.times()
+    V = None if u is None else _free_inputs(input_samples(u, t, d.n_ports), system)
     zero = lambda z: np.zeros((np.atleast_1d(z).size, nm.size))  # noqa: E731
     e0, eo0 = d.project(x0 or zero), d.project(xhat0 or zero)
     A_Z, B_Z = system.error_coordinates()
-    Z = step_lti(system.E, A_Z, B_Z, np.concatenate([e0, e0 - eo0]), t, V, scheme)
+    Z = step_lti(system.E, A_Z, B_Z, np.concatenate([e0, e0 - eo0]), t, V, opts.scheme)
     # the error block is autonomous: stepped on its own, its round-off is the error
     # system's, not that of a stiff controlled plant (a damper on a derivative trace
     # makes ‖A_K‖ ≫ ‖Ã‖, and one exponential of the whole loop carries it into ẽ)
     A_err = A_Z[n:, n:]
-    err = step_lti(d.E, A_err, np.zeros((n, 0)), e0 - eo0, t, None, scheme)
-    eh = Z[:, :n]
+    err = step_lti(d.E, A_err, np.zeros((n, 0)), e0 - eo0, t, None, opts.scheme)
+    audits = {"error system": energy_balance_residual(d.E, A_err, err, t, opts.scheme)}
+    if V is None:  # the loop is autonomous only without free inputs
+        audits["loop"] = energy_balance_residual(system.E, A_Z, Z, t, opts.scheme)
+    return _result(nm, system, opts, t, Z[:, :n], err, V, audits)
+
+
+def _free_inputs(U: np.ndarray, system: LoopSystem) -> np.ndarray | None:
+    """Return the samples of the inputs not actuated (None when all are zero).
+
+    Raises
+    ------
+    LoopError
+        If ``U`` drives an actuated input.
+    """
+    driven = [a + 1 for a in system.loop.actuated if np.any(U[:, a])]
+    if driven:
+        raise LoopError(
+            f"u{driven[0]} is actuated by the feedback; --u drives only the other inputs "
+            f"({', '.join(f'u{j + 1}' for j in system.others) or 'none'})"
+        )
+    return U[:, list(system.others)] if np.any(U) else None
+
+
+def _result(
+    nm: NumericModel,
+    system: LoopSystem,
+    options: SimulationOptions,
+    t: np.ndarray,
+    eh: np.ndarray,
+    err: np.ndarray,
+    V: np.ndarray | None,
+    audits: dict[str, float],
+) -> LoopSimulation:
+    """Return the loop's series: inputs and outputs from the assembled maps, energies."""
+    d, loop = system.discrete, system.loop
     X = np.hstack([eh, eh - err])
     inputs = X @ system.C_u.T + (0.0 if V is None else V @ system.D_u.T)
     y = X @ system.C_y.T + (0.0 if V is None else V @ system.D_y.T)
     y_hat = X @ system.C_yhat.T + (0.0 if V is None else V @ system.D_yhat.T)
-    audits = {"error system": energy_balance_residual(d.E, A_err, err, t, scheme)}
-    if V is None:  # the loop is autonomous only without free inputs
-        audits["loop"] = energy_balance_residual(system.E, A_Z, Z, t, scheme)
     warnings = tuple(
         f"the {name}'s energy balance drifts by {value:.3g} of its largest energy "
         f"(tolerance {ENERGY_BALANCE_RTOL:g}): the time stepping lost accuracy; "
@@ -218,8 +236,7 @@ def simulate_loop(
     )
     w = w_hat = zw = None
     if d.displacement_basis is not None:
-        a, b = nm.interval
-        zw = np.linspace(a, b, 21) if z_w is None else np.asarray(z_w, dtype=float)
+        zw = options.displacement_points(nm.interval)
         W = d.displacement_basis(zw)
         w, w_hat = eh @ W.T, (eh - err) @ W.T
     return LoopSimulation(
@@ -242,8 +259,8 @@ def simulate_loop(
         states_hat=eh - err,
         states_err=err,
         info={
-            "scheme": scheme,
-            "states": int(2 * n),
+            "scheme": options.scheme,
+            "states": int(2 * d.dim),
             "feedback_source": loop.source,
             **{f"energy_balance_residual_{k.replace(' ', '_')}": v for k, v in audits.items()},
         },

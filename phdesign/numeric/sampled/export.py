@@ -43,11 +43,10 @@ from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError
 from phdesign.core.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.checks import check_initial_state
+from phdesign.numeric.checks import check_initial_state, check_sampling
 from phdesign.numeric.sampled.order import REDUCTIONS, OrderSelection, check_order, select_order
 from phdesign.numeric.sampled.samplers import (
     ContinuousObserver,
-    check_sampling,
     default_initial_state,
     displacement_label,
 )

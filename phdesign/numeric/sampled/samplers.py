@@ -54,6 +54,7 @@ import numpy as np
 import scipy.linalg as sl
 
 from phdesign.core.errors import NumericError, check_shape
+from phdesign.numeric.checks import check_sampling
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.sampled.period_maps import (
     ObserverModel,
@@ -65,12 +66,10 @@ from phdesign.numeric.sampled.period_maps import (
 
 __all__ = [
     "ALIASING_RATIO",
-    "SAMPLERS",
     "ContinuousObserver",
     "LoopRun",
     "SampledPlant",
     "aliasing_warning",
-    "check_sampling",
     "default_initial_state",
     "error_floor",
     "hold_discretization",
@@ -80,36 +79,10 @@ __all__ = [
     "sensor_names",
 ]
 
-#: The samplers a controller's front end may have; the first is the default.
-SAMPLERS = ("average", "point")
 #: A sampled error floor above this multiple of the continuous observer's is flagged.
 ALIASING_RATIO = 10.0
 #: The floor is the largest error over this final fraction of a run.
 FLOOR_WINDOW = 0.2
-
-
-def check_sampling(dt: object, sampler: object, *, dt_name: str = "dt") -> float:
-    """Return ``dt`` as a float after checking it and the sampler's name.
-
-    ``dt_name`` is how the period is called in the message (``"--dt"`` on the command line).
-
-    Examples
-    --------
-    >>> check_sampling(1e-3, "average")
-    0.001
-    >>> check_sampling(0, "point")
-    Traceback (most recent call last):
-    ...
-    phdesign.core.errors.NumericError: dt must be a finite positive number of seconds; found 0
-    """
-    value = math.nan
-    if not isinstance(dt, bool) and isinstance(dt, (int, float, np.floating, np.integer)):
-        value = float(dt)
-    if not (math.isfinite(value) and value > 0):
-        raise NumericError(f"{dt_name} must be a finite positive number of seconds; found {dt!r}")
-    if sampler not in SAMPLERS:
-        raise NumericError(f"unknown sampler {sampler!r}; expected one of {', '.join(SAMPLERS)}")
-    return value
 
 
 def displacement_label(z: float) -> str:

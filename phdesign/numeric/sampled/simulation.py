@@ -18,10 +18,10 @@ and checked); discretizations that do not nest are refused.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
-from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
 from phdesign.core.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
@@ -30,11 +30,12 @@ from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.sampled.samplers import (
     ContinuousObserver,
-    check_sampling,
+    LoopRun,
     run_against_continuous,
     run_loop,
 )
-from phdesign.numeric.time.simulation import SimulationResult
+from phdesign.numeric.time.options import SAMPLED_SCHEME, SimulationOptions
+from phdesign.numeric.time.result import SimulationResult
 
 __all__ = ["embedding", "simulate_sampled"]
 
@@ -70,15 +71,8 @@ def simulate_sampled(
     *,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     xhat0: Callable[[np.ndarray], np.ndarray] | None = None,
-    t_end: float | None = None,
-    samples: int | None = None,
-    dt: float | None = None,
-    sampler: str | None = None,
-    method: str | None = None,
-    resolution: int | None = None,
-    observer_resolution: int | None = None,
     u: Callable[[float], np.ndarray] | None = None,
-    z_w: np.ndarray | None = None,
+    options: SimulationOptions | None = None,
 ) -> SimulationResult:
     """Simulate the plant with a continuous or sampled observer of its own resolution.
 
@@ -89,76 +83,88 @@ def simulate_sampled(
         Sensors and gain.
     x0, xhat0 : callable, optional
         Initial states ``f(z) -> (m, n)`` of plant and observer; default zero.
-    t_end : float, optional
-        Final time (default 5).
-    samples : int, optional
-        About this many records (default 501): every ``s`` periods,
-        ``s = round(T / ((samples - 1) dt))`` (every one of ``samples - 1`` equal steps for
-        a continuous observer).
-    dt : float, optional
-        Sampling period; None runs the continuous observer.
-    sampler : {"average", "point"}, optional
-        The observer's front end when ``dt`` is given (default ``"average"``, the
-        exported observer's; the defaults are those of :mod:`phdesign.core.defaults`).
-    method, resolution
-        The plant's discretization (:func:`phdesign.numeric.discretization.registry.discretize`).
-    observer_resolution : int, optional
-        The observer's resolution (default the plant's).
     u : callable, optional
         Plant input ``u(t)``, held over each period (default zero).
-    z_w : ndarray, optional
-        Points of the displacement (default 21 uniform points).
+    options : SimulationOptions, optional
+        As for :func:`phdesign.numeric.time.simulation.simulate`, with the sampling:
+        ``dt`` (the sampling period; None runs the continuous observer), ``sampler``
+        (the observer's front end) and ``observer_resolution`` (the observer's degree,
+        default the plant's).  About ``samples`` records are kept: every ``s`` periods,
+        ``s = round(T / ((samples - 1) dt))`` (every one of ``samples - 1`` equal steps for
+        a continuous observer).  ``method`` and ``resolution`` are the plant's.
 
     Returns
     -------
     SimulationResult
         With ``info`` holding ``dt``, ``sampler`` and ``observer_resolution``.
     """
-    t_end, samples, _, _ = current().simulation.fill(t_end, samples)
-    sampler = current().export.sampler if sampler is None else sampler
-    if not (np.isfinite(t_end) and t_end > 0):
-        raise NumericError(f"t_end must be a positive number; found {t_end}")
-    if int(samples) < 2:
-        raise NumericError(f"samples must be at least 2; found {samples}")
-    if dt is not None:
-        check_periods(check_sampling(dt, sampler), t_end)
-    plant = discretize(nm, method, resolution)
-    same = observer_resolution is None or int(observer_resolution) == plant.resolution
-    d_obs = plant if same else discretize(nm, method, observer_resolution)
-    if dt is not None and u is not None:  # every period is stepped, with its input
-        check_periods(float(dt), t_end, states=plant.dim + d_obs.dim)
+    opts = SimulationOptions.merged(options)
+    opts.require("simulate_sampled", "sampled", "continuous")
+    if opts.scheme != "expm":
+        raise NumericError(SAMPLED_SCHEME.format(scheme=opts.scheme))
+    if opts.dt is not None:
+        check_periods(opts.dt, opts.t_end)
+    plant = discretize(nm, opts.method, opts.resolution)
+    same = opts.observer_resolution in (None, plant.resolution)
+    d_obs = plant if same else discretize(nm, opts.method, opts.observer_resolution)
+    if opts.dt is not None and u is not None:  # every period is stepped, with its input
+        check_periods(opts.dt, opts.t_end, states=plant.dim + d_obs.dim)
     P = embedding(d_obs, plant)
     points: tuple[float, ...] = ()
     if plant.displacement_basis is not None:
-        a, b = nm.interval
-        zw = np.linspace(a, b, 21) if z_w is None else np.asarray(z_w, dtype=float)
-        points = tuple(float(z) for z in zw)
+        points = tuple(float(z) for z in opts.displacement_points(nm.interval))
     observer = ContinuousObserver.from_discretization(d_obs, C_m, L, points)
-    if dt is None:
-        step, n_steps, stride = t_end / (int(samples) - 1), int(samples) - 1, 1
-    else:
-        step = check_sampling(dt, sampler)
-        n_steps = max(1, round(t_end / step))
-        stride = max(1, round(t_end / ((int(samples) - 1) * step)))
+    grid = _Grid.of(opts)
+    U = None if u is None else input_samples(u, grid.step * np.arange(grid.steps + 1), nm.n_ports)
     zero = lambda z: np.zeros((np.atleast_1d(z).size, nm.size))  # noqa: E731
-    U = None
-    if u is not None:
-        U = input_samples(u, step * np.arange(n_steps + 1), nm.n_ports)
-    e0 = plant.project(x0 or zero)
-    xh0 = d_obs.project(xhat0 or zero)
-    kind = None if dt is None else sampler
+    e0, xh0 = plant.project(x0 or zero), d_obs.project(xhat0 or zero)
     warnings: tuple[str, ...] = ()
-    if kind is None:
-        run = run_loop(plant, observer, C_m, x0=e0, xhat0=xh0, dt=step, n_steps=n_steps, u=U)
+    if opts.dt is None:
+        run = run_loop(
+            plant, observer, C_m, x0=e0, xhat0=xh0, dt=grid.step, n_steps=grid.steps, u=U
+        )
     else:
         run, _, _, warning = run_against_continuous(
-            plant, observer, C_m, sampler=kind, x0=e0, xhat0=xh0, dt=step, n_steps=n_steps,
-            stride=stride, u=U,
+            plant, observer, C_m, sampler=opts.sampler_name, x0=e0, xhat0=xh0, dt=grid.step,
+            n_steps=grid.steps, stride=grid.stride, u=U,
         )  # fmt: skip
         warnings = () if warning is None else (warning,)
+    return _result(nm, plant, d_obs, observer, P, run, opts, warnings)
+
+
+@dataclass(frozen=True)
+class _Grid:
+    """The periods of a run: ``steps`` of length ``step``, a record every ``stride``."""
+
+    step: float
+    steps: int
+    stride: int
+
+    @classmethod
+    def of(cls, options: SimulationOptions) -> _Grid:
+        """Return the continuous observer's output grid, or the sampling periods."""
+        t_end, samples = options.t_end, int(options.samples)
+        if options.dt is None:
+            return cls(t_end / (samples - 1), samples - 1, 1)
+        steps = max(1, round(t_end / options.dt))
+        return cls(options.dt, steps, max(1, round(t_end / ((samples - 1) * options.dt))))
+
+
+def _result(
+    nm: NumericModel,
+    plant: DiscretePHS,
+    d_obs: DiscretePHS,
+    observer: ContinuousObserver,
+    P: np.ndarray,
+    run: LoopRun,
+    options: SimulationOptions,
+    warnings: tuple[str, ...],
+) -> SimulationResult:
+    """Return the run's series as a :class:`SimulationResult` (module docstring's energies)."""
     m = nm.n_ports
     gap = run.x - run.xhat @ P.T
-    has_w = bool(points)
+    has_w = bool(observer.points)
+    sampled = options.dt is not None
     return SimulationResult(
         t=run.t,
         H=plant.hamiltonian(run.x),
@@ -169,17 +175,17 @@ def simulate_sampled(
         output_labels=nm.output_labels,
         method=plant.method,
         resolution=plant.resolution,
-        z_w=np.array(points) if has_w else None,
+        z_w=np.array(observer.points) if has_w else None,
         w=run.target if has_w else None,
         w_hat=run.yhat[:, m:] if has_w else None,
         states=run.x,
         states_hat=run.xhat,
         info={
-            "scheme": "exact, sampled" if kind else "exact",
+            "scheme": "exact, sampled" if sampled else "exact",
             "states": int(plant.dim),
             "observer_resolution": int(d_obs.resolution),
             "observer_states": int(d_obs.dim),
-            **({"dt": step, "sampler": sampler} if kind else {}),
+            **({"dt": options.dt, "sampler": options.sampler_name} if sampled else {}),
         },
         warnings=warnings,
     )

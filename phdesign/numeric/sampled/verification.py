@@ -19,10 +19,10 @@ import numpy as np
 from phdesign.core.defaults import current
 from phdesign.core.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.checks import check_sampling
 from phdesign.numeric.sampled.order import OrderSelection, check_order
 from phdesign.numeric.sampled.samplers import (
     ContinuousObserver,
-    check_sampling,
     run_against_continuous,
 )
 

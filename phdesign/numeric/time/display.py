@@ -1,6 +1,6 @@
 r"""How a simulation shows itself: ``str`` is the CSV of ``phdesign simulate``, ``.plot()``.
 
-A mixin of :class:`~phdesign.numeric.time.simulation.SimulationResult` (which owns the numbers):
+A mixin of :class:`~phdesign.numeric.time.result.SimulationResult` (which owns the numbers):
 a one-line ``repr`` with the energies at both ends, ``str`` as the command line prints it
 (CSV: t, H, H_hat, H_err, the outputs and the tip displacement), ``_repr_html_`` for
 notebooks, and :meth:`SimulationDisplay.plot`, the summary figure of ``simulate --plot``.

@@ -38,43 +38,32 @@ observer and :math:`\tilde H` for the error.
 
 from __future__ import annotations
 
-import csv
-import io
-import json
 import math
-import warnings as _warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_simulate_arguments
+from phdesign.numeric.discretization.phs import ClosedLoop
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.threads import limited_threads
-from phdesign.numeric.time.display import SimulationDisplay
-from phdesign.numeric.time.stepping import (
-    SCHEMES,
-    Trajectory,
-    energy_balance_residual,
-    integrate,
-    step_lti,
-)
+from phdesign.numeric.time.options import SimulationOptions
+from phdesign.numeric.time.result import SimulationResult
+from phdesign.numeric.time.stepping import Trajectory, energy_balance_residual, integrate
 
 __all__ = [
     "ENERGY_BALANCE_RTOL",
     "RESOLVED_RTOL",
-    "ResolutionWarning",
-    "SimulationResult",
     "coupled_system",
-    "energy_balance_residual",
     "simulate",
-    "step_lti",
 ]
+
+InitialState = Callable[[np.ndarray], np.ndarray]
 
 #: Largest energy-balance residual, relative to the largest energy of the run, that a
 #: simulation may show before it warns. Exact stepping leaves round-off (about 1e-13).
@@ -82,165 +71,6 @@ ENERGY_BALANCE_RTOL = 1e-8
 #: Relative disagreement of the error energy between the resolution p and ⌈1.5 p⌉ beyond
 #: which it is not resolved.
 RESOLVED_RTOL = 0.05
-
-
-class ResolutionWarning(UserWarning):
-    """A quantity was asked for below what the discretization resolves."""
-
-
-def _finite_list(values: np.ndarray | None) -> list[Any] | None:
-    """Nested list with non-finite entries as None (strict JSON)."""
-    if values is None:
-        return None
-    arr = np.asarray(values, dtype=float)
-    if np.all(np.isfinite(arr)):
-        return arr.tolist()  # type: ignore[no-any-return]
-    cells = arr.astype(object)
-    cells[~np.isfinite(arr)] = None
-    return cells.tolist()  # type: ignore[no-any-return]
-
-
-def _json_safe(value: Any) -> Any:
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, list):
-        return [_json_safe(v) for v in value]
-    return value
-
-
-@dataclass(frozen=True, repr=False)
-class SimulationResult(SimulationDisplay):
-    """Time series of a plant (and observer) simulation.
-
-    Attributes
-    ----------
-    t : ndarray (nt,)
-    H, H_hat, H_err : ndarray (nt,)
-        Plant, observer and error energies (``H_hat``/``H_err`` are None without observer).
-    y, y_hat : ndarray (nt, N n)
-        Plant and observer outputs.
-    output_labels : tuple of str
-    z_w : ndarray or None
-        Points where the displacement is sampled.
-    w, w_hat : ndarray (nt, len(z_w)) or None
-        Displacement of the plant and its estimate (models with a displacement only).
-    states, states_hat : ndarray (nt, dim)
-        Discrete effort coordinates (kept for exports and checks; not written to files).
-    units : mapping or None
-        Units the model states (``t``, ``z``, ``energy``, ``displacement``, ...), for labels
-        and JSON; ``None`` for a result built by hand (plots then assume SI).
-    resolved_floor : float or None
-        Smallest H_err / H_err(0) down to which the error energy agrees with the finer
-        resolution (None: resolved over the whole run, or not checked).
-    resolved_until : float or None
-        Last sample time at which it still agrees (None likewise).
-    """
-
-    t: np.ndarray
-    H: np.ndarray
-    H_hat: np.ndarray | None
-    H_err: np.ndarray | None
-    y: np.ndarray
-    y_hat: np.ndarray | None
-    output_labels: tuple[str, ...]
-    method: str
-    resolution: int
-    z_w: np.ndarray | None = None
-    w: np.ndarray | None = None
-    w_hat: np.ndarray | None = None
-    states: np.ndarray | None = field(default=None, repr=False)
-    states_hat: np.ndarray | None = field(default=None, repr=False)
-    info: dict[str, Any] = field(default_factory=dict, repr=False)
-    warnings: tuple[str, ...] = ()
-    units: dict[str, str] | None = field(default=None, repr=False)
-    resolved_floor: float | None = None
-    resolved_until: float | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary of the time series (no discrete states; strict JSON)."""
-        out: dict[str, Any] = {
-            "method": self.method,
-            "resolution": self.resolution,
-            "t": _finite_list(self.t),
-            "H": _finite_list(self.H),
-            "H_hat": _finite_list(self.H_hat),
-            "H_err": _finite_list(self.H_err),
-            "output_labels": list(self.output_labels),
-            "y": _finite_list(self.y),
-            "y_hat": _finite_list(self.y_hat),
-            "resolved_floor": _json_safe(self.resolved_floor),
-            "resolved_until": _json_safe(self.resolved_until),
-        }
-        if self.w is not None and self.z_w is not None:
-            out["z_w"] = _finite_list(self.z_w)
-            out["w"] = _finite_list(self.w)
-            out["w_hat"] = _finite_list(self.w_hat)
-        out.update(
-            {
-                k: _json_safe(v)
-                for k, v in self.info.items()
-                if isinstance(v, (int, float, str)) and k not in out
-            }
-        )
-        out["warnings"] = list(self.warnings)
-        out["units"] = dict(self.units or {})
-        return out
-
-    def to_json(self) -> str:
-        """Return the :meth:`to_dict` payload as JSON text."""
-        return json.dumps(self.to_dict(), allow_nan=False)
-
-    def to_csv(self) -> str:
-        """CSV: t, H, H_hat, H_err, y_i, y_hat_i and the tip displacement w(b), ŵ(b)."""
-        cols: list[tuple[str, np.ndarray]] = [("t", self.t), ("H", self.H)]
-        if self.H_hat is not None and self.H_err is not None:
-            cols += [("H_hat", self.H_hat), ("H_err", self.H_err)]
-        for i in range(self.y.shape[1]):
-            cols.append((f"y{i + 1}", self.y[:, i]))
-        if self.y_hat is not None:
-            for i in range(self.y_hat.shape[1]):
-                cols.append((f"y_hat{i + 1}", self.y_hat[:, i]))
-        if self.w is not None:
-            cols.append(("w_tip", self.w[:, -1]))
-            if self.w_hat is not None:
-                cols.append(("w_hat_tip", self.w_hat[:, -1]))
-        buf = io.StringIO()
-        writer = csv.writer(buf, lineterminator="\n")
-        writer.writerow([c[0] for c in cols])
-        data = np.column_stack([c[1] for c in cols])
-        for row in data:
-            writer.writerow([repr(float(x)) for x in row])
-        return buf.getvalue()
-
-    def time_below(self, ratio: float) -> float | None:
-        """First sample time after which H_err / H_err(0) stays below ``ratio``.
-
-        None when it never does in this run, and None (with a
-        :class:`ResolutionWarning` that says why) when ``ratio`` is below
-        :attr:`resolved_floor`: the time would be that of unresolved modes.
-        """
-        if self.H_err is None or self.H_err[0] <= 0:
-            return None
-        if self.resolved_floor is not None and ratio < self.resolved_floor:
-            _warnings.warn(
-                f"H_err/H_err(0) = {ratio:g} is below what this discretization resolves "
-                f"({self.resolved_floor:.3g}, reached at t = {self.resolved_until:g}): "
-                "raise the resolution",
-                ResolutionWarning,
-                stacklevel=2,
-            )
-            return None
-        rel = self.H_err / self.H_err[0]
-        above = np.flatnonzero(rel >= ratio)
-        if above.size == 0:
-            return float(self.t[0])
-        k = above[-1]
-        if k + 1 >= self.t.size:
-            return None
-        # linear interpolation of log(rel) between the last sample above and the next
-        r0, r1 = np.log(rel[k]), np.log(max(rel[k + 1], 1e-300))
-        s = (np.log(ratio) - r0) / (r1 - r0) if r1 != r0 else 0.0
-        return float(self.t[k] + s * (self.t[k + 1] - self.t[k]))
 
 
 def coupled_system(
@@ -310,20 +140,13 @@ def simulate(
     C_m: np.ndarray | None = None,
     L: np.ndarray | None = None,
     *,
-    x0: Callable[[np.ndarray], np.ndarray] | None = None,
-    xhat0: Callable[[np.ndarray], np.ndarray] | None = None,
-    t_end: float | None = None,
-    samples: int | None = None,
-    method: str | None = None,
-    resolution: int | None = None,
+    x0: InitialState | None = None,
+    xhat0: InitialState | None = None,
     u: Callable[[float], np.ndarray] | None = None,
-    scheme: str | None = None,
-    z_w: np.ndarray | None = None,
+    options: SimulationOptions | None = None,
     discrete: DiscretePHS | None = None,
-    tol: float | None = None,
-    check_resolution: bool = True,
 ) -> SimulationResult:
-    """Simulate the plant, and the observer when sensors are given.
+    """Simulate the plant, and the continuous observer when sensors are given.
 
     Parameters
     ----------
@@ -333,141 +156,147 @@ def simulate(
     x0, xhat0 : callable, optional
         Initial states ``f(z) -> (m, n)`` (see
         :func:`phdesign.numeric.inputs.initial_state_function`); default zero.
-    t_end : float, optional
-        Final time (> 0); default 5.
-    samples : int, optional
-        Number of output samples on [0, t_end] (>= 2); default 501.
-    method, resolution
-        Discretization (see :func:`phdesign.numeric.discretization.registry.discretize`).
     u : callable, optional
         Plant input ``u(t) -> (N n,)``, sampled on the output grid and linear in between;
         default zero.
-    scheme : {"expm", "midpoint"}, optional
-        Exact exponential (the default), or implicit midpoint with substeps chosen so that its
-        estimated error is below ``tol`` (:mod:`phdesign.numeric.time.stepping`).
-    z_w : ndarray, optional
-        Points where the displacement is reported (default 21 uniform points).
+    options : SimulationOptions, optional
+        The output grid, discretization and time stepping
+        (:class:`~phdesign.numeric.time.options.SimulationOptions`; default its defaults).
+        Options of a sampled or noisy run are refused: ``simulate_sampled`` and
+        ``simulate_noisy`` run them.
     discrete : DiscretePHS, optional
-        A ready discretization (overrides ``method``/``resolution``).
-    tol : float, optional
-        Midpoint: largest estimated error of the states, relative to their largest
-        energy norm (default 1e-6; the defaults are those of :mod:`phdesign.core.defaults`).
-    check_resolution : bool
-        With an observer, step the error system again at ⌈1.5 p⌉ to find how far
-        H_err is resolved (module docstring); default True.
+        A ready discretization (overrides ``options.method``/``options.resolution``).
 
     Returns
     -------
     SimulationResult
+
+    Examples
+    --------
+    >>> from phdesign.models import load_builtin
+    >>> from phdesign.numeric.bridge import to_numeric
+    >>> nm = to_numeric(load_builtin("wave"))
+    >>> x0 = lambda z: np.column_stack([np.zeros_like(z), np.ones_like(z)])
+    >>> run = simulate(nm, x0=x0, options=SimulationOptions(t_end=1.0, samples=3))
+    >>> [round(float(h), 12) for h in run.H]  # a lossless string keeps its energy
+    [0.5, 0.5, 0.5]
     """
-    t_end, samples, scheme, tol = current().simulation.fill(t_end, samples, scheme, tol)
-    method = method_or_default(method)
-    check_simulate_arguments(
-        nm,
-        C_m,
-        L,
-        x0=x0,
-        xhat0=xhat0,
-        t_end=t_end,
-        samples=samples,
-        method=method,
-        resolution=resolution,
-        u=u,
-        scheme=scheme,
-        z_w=z_w,
-        discrete=discrete,
-    )
-    # t_end, samples and (C_m, L) were checked above: the scheme's name is left
-    if scheme not in SCHEMES:
-        raise NumericError(f"unknown time-stepping scheme {scheme!r}; expected one of {SCHEMES}")
-    d = discrete if discrete is not None else discretize(nm, method, resolution)
-    K = None if C_m is None or L is None else feedback_matrix(C_m, L, nm.n_ports)
-    t = np.linspace(0.0, float(t_end), int(samples))
-    zero = lambda z: np.zeros((np.atleast_1d(z).size, nm.size))  # noqa: E731
-    U = None
-    if u is not None:
-        U = input_samples(u, t, nm.n_ports)
-    midpoint_tol = tol if scheme == "midpoint" else None
+    opts = SimulationOptions.merged(options)
+    opts.require("simulate", "continuous")
+    check_simulate_arguments(nm, C_m, L, x0=x0, xhat0=xhat0, u=u, options=opts, discrete=discrete)
+    d = discrete if discrete is not None else discretize(nm, opts.method, opts.resolution)
+    step = _Stepper.of(opts)
+    U = None if u is None else input_samples(u, step.t, nm.n_ports)
+    start = x0 or _zero(nm)
+    plant = step(d.E, d.J - d.R, d.B, d.project(start), U)
+    error = None
+    if C_m is not None and L is not None:
+        K = feedback_matrix(C_m, L, nm.n_ports)
+        e0 = _difference(start, xhat0 or _zero(nm))
+        error = _error_run(nm, d, K, e0, step, opts.check_resolution)
+    return _result(nm, _Run(d, opts, step.t, U, plant, error))
 
-    def run(E: np.ndarray, A: np.ndarray, B: np.ndarray, X0: np.ndarray, inp: Any) -> Trajectory:
-        return integrate(E, A, B, X0, t, inp, scheme, tol=midpoint_tol)
 
-    plant = run(d.E, d.J - d.R, d.B, d.project(x0 or zero), U)
-    eh = plant.X
-    y = d.output(eh, U)
-    H = d.hamiltonian(eh)
-    trajectories = {"plant": plant}
+def _zero(nm: NumericModel) -> InitialState:
+    """Return the state at rest, a function of z."""
+    return lambda z: np.zeros((np.atleast_1d(z).size, nm.size))
+
+
+@dataclass(frozen=True)
+class _Stepper:
+    """The stepping of one run on its output grid ``t`` (midpoint: with its tolerance)."""
+
+    t: np.ndarray
+    scheme: str
+    tol: float | None
+
+    @classmethod
+    def of(cls, options: SimulationOptions) -> _Stepper:
+        """Return the stepping the options ask for, on their output grid."""
+        tol = options.midpoint_tol if options.scheme == "midpoint" else None
+        return cls(options.times(), options.scheme, tol)
+
+    def __call__(
+        self, E: np.ndarray, A: np.ndarray, B: np.ndarray, X0: np.ndarray, U: Any
+    ) -> Trajectory:
+        """Integrate ``E X' = A X + B u`` from ``X0`` with the inputs ``U`` on the grid."""
+        return integrate(E, A, B, X0, self.t, U, self.scheme, tol=self.tol)
+
+
+@dataclass(frozen=True)
+class _ErrorRun:
+    """The error system ẽ stepped on its own, and how far its energy is resolved."""
+
+    loop: ClosedLoop
+    trajectory: Trajectory
+    floor: float | None = None
+    until: float | None = None
+    warning: str | None = None
+
+
+def _error_run(
+    nm: NumericModel,
+    d: DiscretePHS,
+    K: np.ndarray,
+    e0: InitialState,
+    step: _Stepper,
+    check_resolution: bool,
+) -> _ErrorRun:
+    """Step the error system (module docstring), and again at ⌈1.5 p⌉ to find its floor."""
+    loop = d.close(K)
+    error = step(d.E, loop.A, np.zeros((d.dim, 0)), d.project(e0), None)
+    if not check_resolution:
+        return _ErrorRun(loop, error)
+    fine = discretize(nm, d.method, math.ceil(1.5 * d.resolution))
+    finer = step(fine.E, fine.close(K).A, np.zeros((fine.dim, 0)), fine.project(e0), None)
+    floor, until = _resolution_check(step.t, d.hamiltonian(error.X), fine.hamiltonian(finer.X))
+    if floor is None or until is None:
+        return _ErrorRun(loop, error)
+    warning = _floor_warning(floor, until, d.resolution, fine.resolution)
+    return _ErrorRun(loop, error, floor, until, warning)
+
+
+@dataclass(frozen=True)
+class _Run:
+    """What the result's stages read: discretization, options, grid, inputs, trajectories."""
+
+    d: DiscretePHS
+    options: SimulationOptions
+    t: np.ndarray
+    U: np.ndarray | None
+    plant: Trajectory
+    error: _ErrorRun | None
+
+    @property
+    def trajectories(self) -> dict[str, Trajectory]:
+        """The trajectories stepped, by the name warnings and ``info`` give them."""
+        named = {"plant": self.plant}
+        if self.error is not None:
+            named["error system"] = self.error.trajectory
+        return named
+
+
+def _result(nm: NumericModel, run: _Run) -> SimulationResult:
+    """Assemble the result: energies, outputs, displacement, audits and warnings."""
+    d, error = run.d, run.error
+    eh = run.plant.X
+    y = d.output(eh, run.U)
     H_hat = H_err = y_hat = eo = None
-    floor = until = None
-    warnings: list[str] = []
-    loop = None
-    if K is not None:
-        loop = d.close(K)
-        e0_err = d.project(_difference(x0 or zero, xhat0 or zero))
-        error = run(d.E, loop.A, np.zeros((d.dim, 0)), e0_err, None)
-        trajectories["error system"] = error
-        ee = error.X
+    if error is not None:
+        ee = error.trajectory.X
         eo = eh - ee
-        H_err = d.hamiltonian(ee)
-        H_hat = d.hamiltonian(eo)
-        y_hat = y - ee @ loop.C.T
-        if check_resolution:
-            fine = discretize(nm, d.method, math.ceil(1.5 * d.resolution))
-            fine_err = run(
-                fine.E,
-                fine.close(K).A,
-                np.zeros((fine.dim, 0)),
-                fine.project(_difference(x0 or zero, xhat0 or zero)),
-                None,
-            )
-            floor, until = _resolution_check(t, H_err, fine.hamiltonian(fine_err.X))
-            if floor is not None and until is not None:
-                warnings.append(_floor_warning(floor, until, d.resolution, fine.resolution))
-    audits: dict[str, float] = {}
-    if scheme == "expm":
-        if U is None:  # the plant is autonomous only without input
-            audits["plant"] = energy_balance_residual(d.E, d.J - d.R, eh, t)
-        if loop is not None:
-            audits["error system"] = energy_balance_residual(
-                d.E, loop.A, trajectories["error system"].X, t
-            )
-    warnings = [
-        _energy_warning(name, value, d)
-        for name, value in audits.items()
-        if not value <= ENERGY_BALANCE_RTOL
-    ] + warnings
-    for name, traj in trajectories.items():
-        if not traj.met_tolerance:
-            warnings.append(
-                f"implicit midpoint did not reach its tolerance {tol:g} on the {name} with "
-                f"{traj.substeps} substeps per output interval (estimated error "
-                f"{traj.error_estimate:.3g}): stiff high-frequency modes are excited; "
-                "use scheme 'expm' (exact in time)"
-            )
+        H_err, H_hat = d.hamiltonian(ee), d.hamiltonian(eo)
+        y_hat = y - ee @ error.loop.C.T
+    audits = _audits(run)
     w = w_hat = zw = None
     if d.displacement_basis is not None:
-        a, b = nm.interval
-        zw = np.linspace(a, b, 21) if z_w is None else np.asarray(z_w, dtype=float)
+        zw = run.options.displacement_points(nm.interval)
         Wd = d.displacement_basis(zw)
         w = eh @ Wd.T
-        if eo is not None:
-            w_hat = eo @ Wd.T
-    info: dict[str, Any] = {
-        "scheme": scheme,
-        "states": int(d.dim),
-        "spurious_removed": d.spurious_removed,
-        **({"spurious_modes": str(d.info["spurious"])} if d.spurious_removed else {}),
-        **{f"energy_balance_residual_{k.replace(' ', '_')}": v for k, v in audits.items()},
-    }
-    if scheme == "midpoint":
-        info["midpoint_tol"] = tol
-        for name, traj in trajectories.items():
-            key = name.replace(" ", "_")
-            info[f"midpoint_substeps_{key}"] = traj.substeps
-            info[f"midpoint_error_estimate_{key}"] = traj.error_estimate
+        w_hat = None if eo is None else eo @ Wd.T
     return SimulationResult(
-        t=t,
-        H=H,
+        t=run.t,
+        H=d.hamiltonian(eh),
         H_hat=H_hat,
         H_err=H_err,
         y=y,
@@ -480,17 +309,69 @@ def simulate(
         w_hat=w_hat,
         states=eh,
         states_hat=eo,
-        info=info,
-        warnings=tuple(warnings),
-        resolved_floor=floor,
-        resolved_until=until,
+        info=_info(run, audits),
+        warnings=_warnings(run, audits),
+        resolved_floor=None if error is None else error.floor,
+        resolved_until=None if error is None else error.until,
         units=dict(nm.units),
     )
 
 
-def _difference(
-    f: Callable[[np.ndarray], np.ndarray], g: Callable[[np.ndarray], np.ndarray]
-) -> Callable[[np.ndarray], np.ndarray]:
+def _audits(run: _Run) -> dict[str, float]:
+    """Energy-balance residuals of the exact stepping (module docstring of ``stepping``)."""
+    d, error = run.d, run.error
+    audits: dict[str, float] = {}
+    if run.options.scheme != "expm":
+        return audits
+    if run.U is None:  # the plant is autonomous only without input
+        audits["plant"] = energy_balance_residual(d.E, d.J - d.R, run.plant.X, run.t)
+    if error is not None:
+        audits["error system"] = energy_balance_residual(
+            d.E, error.loop.A, error.trajectory.X, run.t
+        )
+    return audits
+
+
+def _warnings(run: _Run, audits: dict[str, float]) -> tuple[str, ...]:
+    """Return the energy drifts, the error energy's floor, the midpoint's missed tolerances."""
+    warnings = [
+        _energy_warning(name, value, run.d)
+        for name, value in audits.items()
+        if not value <= ENERGY_BALANCE_RTOL
+    ]
+    if run.error is not None and run.error.warning is not None:
+        warnings.append(run.error.warning)
+    for name, traj in run.trajectories.items():
+        if not traj.met_tolerance:
+            warnings.append(
+                f"implicit midpoint did not reach its tolerance {run.options.midpoint_tol:g} "
+                f"on the {name} with {traj.substeps} substeps per output interval (estimated "
+                f"error {traj.error_estimate:.3g}): stiff high-frequency modes are excited; "
+                "use scheme 'expm' (exact in time)"
+            )
+    return tuple(warnings)
+
+
+def _info(run: _Run, audits: dict[str, float]) -> dict[str, Any]:
+    """How the run went: scheme, size, removed modes, residuals, midpoint substeps."""
+    d, options = run.d, run.options
+    info: dict[str, Any] = {
+        "scheme": options.scheme,
+        "states": int(d.dim),
+        "spurious_removed": d.spurious_removed,
+        **({"spurious_modes": str(d.info["spurious"])} if d.spurious_removed else {}),
+        **{f"energy_balance_residual_{k.replace(' ', '_')}": v for k, v in audits.items()},
+    }
+    if options.scheme == "midpoint":
+        info["midpoint_tol"] = options.midpoint_tol
+        for name, traj in run.trajectories.items():
+            key = name.replace(" ", "_")
+            info[f"midpoint_substeps_{key}"] = traj.substeps
+            info[f"midpoint_error_estimate_{key}"] = traj.error_estimate
+    return info
+
+
+def _difference(f: InitialState, g: InitialState) -> InitialState:
     """Return the initial estimation error x0 - xhat0 (the projection is linear)."""
 
     def diff(z: np.ndarray) -> np.ndarray:

@@ -47,13 +47,14 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sl
 
-from phdesign.core.checks import positive_int
 from phdesign.core.errors import NumericError, ObserverError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.noise.figures import noise_intensities
-from phdesign.numeric.time.simulation import SimulationResult, coupled_system, simulate
+from phdesign.numeric.time.options import NOISY_SCHEME, SimulationOptions
+from phdesign.numeric.time.result import SimulationResult
+from phdesign.numeric.time.simulation import coupled_system, simulate
 from phdesign.numeric.time.stepping import dissipation_integral
 
 __all__ = ["SampledNoise", "noisy_coupled_system", "sampled_noise", "simulate_noisy"]
@@ -132,34 +133,24 @@ def simulate_noisy(
     C_m: np.ndarray | None = None,
     L: np.ndarray | None = None,
     *,
-    noise_intensity: Any = None,
-    input_intensity: Any = None,
-    seed: int | None = None,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     xhat0: Callable[[np.ndarray], np.ndarray] | None = None,
-    t_end: float | None = None,
-    samples: int | None = None,
-    method: str | None = None,
-    resolution: int | None = None,
     u: Callable[[float], np.ndarray] | None = None,
-    scheme: str = "expm",
-    z_w: np.ndarray | None = None,
+    options: SimulationOptions | None = None,
     discrete: DiscretePHS | None = None,
 ) -> SimulationResult:
     """One sample path of plant and observer with sensor and input noise.
 
     Parameters
     ----------
-    nm, C_m, L, x0, xhat0, t_end, samples, method, resolution, u, z_w, discrete
-        As for :func:`phdesign.numeric.time.simulation.simulate` (the same defaults).
-    noise_intensity : float or sequence of float, optional
-        Sensor noise intensities σᵢ² (one per sensor or one for all; needs sensors).
-    input_intensity : float or sequence of float, optional
-        Plant input noise intensities (one per input or one for all).
-    seed : int, optional
-        Seed of the noise (the same seed gives the same path).
-    scheme : {"expm"}
-        The stepping is exact; implicit midpoint does not apply to a noisy run.
+    nm, C_m, L, x0, xhat0, u, discrete
+        As for :func:`phdesign.numeric.time.simulation.simulate`.
+    options : SimulationOptions, optional
+        As for ``simulate``, with the noise: ``noise_intensity`` (sensor intensities
+        σᵢ², one per sensor or one for all; needs sensors), ``input_intensity`` (plant
+        input intensities, one per input or one for all) and ``seed`` (the same seed gives
+        the same path).  The stepping is exact (``scheme="expm"``): implicit midpoint does
+        not apply to a noisy run.
 
     Returns
     -------
@@ -167,31 +158,60 @@ def simulate_noisy(
         As :func:`~phdesign.numeric.time.simulation.simulate`'s, with the noise description in
         ``info``.
     """
-    if scheme != "expm":
-        raise NumericError(
-            "a noisy simulation steps exactly (Van Loan sampling of the noise); the "
-            f"{scheme!r} scheme does not apply"
-        )
-    if noise_intensity is not None and C_m is None:
+    opts = SimulationOptions.merged(options)
+    opts.require("simulate_noisy", "noisy", "continuous")
+    if opts.scheme != "expm":
+        raise NumericError(NOISY_SCHEME.format(scheme=opts.scheme))
+    if opts.noise_intensity is not None and C_m is None:
         raise ObserverError("sensor noise needs an observer: give the sensors C_m and gain L")
-    if seed is not None:
-        positive_int(seed, "seed", minimum=0)  # numpy's own message is a traceback
     q = 0 if C_m is None else np.atleast_2d(C_m).shape[0]
-    sigma, w_in = noise_intensities(nm, q, noise_intensity, input_intensity, default=0.0)
-    d = discrete if discrete is not None else discretize(nm, method, resolution)
-    base = simulate(
-        nm, C_m, L, x0=x0, xhat0=xhat0, t_end=t_end, samples=samples, u=u, z_w=z_w, discrete=d
-    )
+    sigma, w_in = noise_intensities(nm, q, opts.noise_intensity, opts.input_intensity, default=0.0)
+    d = discrete if discrete is not None else discretize(nm, opts.method, opts.resolution)
+    base = simulate(nm, C_m, L, x0=x0, xhat0=xhat0, u=u, options=opts.deterministic(), discrete=d)
+    extra = _noise_paths(d, C_m, L, sigma, w_in, base.t, opts.seed)
+    U = None if u is None else input_samples(u, base.t, d.n_ports)
+    described = []
+    if opts.noise_intensity is not None:
+        described.append(f"sensor intensity {', '.join(f'{s:g}' for s in sigma)}")
+    if w_in is not None:
+        described.append(f"input intensity {', '.join(f'{s:g}' for s in w_in)}")
+    info = {
+        **base.info,
+        "scheme": "expm (exact; Van Loan sampled noise)",
+        "noise": "; ".join(described) or "none",
+        "seed": -1 if opts.seed is None else int(opts.seed),
+    }
+    return replace(base, info=info, **_noisy_series(d, C_m, L, base, extra, U))
+
+
+def _noise_paths(
+    d: DiscretePHS,
+    C_m: np.ndarray | None,
+    L: np.ndarray | None,
+    sigma: np.ndarray,
+    w_in: np.ndarray | None,
+    t: np.ndarray,
+    seed: int | None,
+) -> np.ndarray:
+    """Return one path of the response to the noise from zero, sampled exactly on ``t``."""
     E2, A2, _, N2 = noisy_coupled_system(d, C_m, L, sigma, w_in)
-    t = base.t
+    if not (N2.shape[1] and t.size > 1):
+        return np.zeros((t.size, E2.shape[0]))
+    sampler = sampled_noise(E2, A2, N2, float(t[1] - t[0]))
+    return sampler.paths(t.size - 1, 1, seed)[:, :, 0]
+
+
+def _noisy_series(
+    d: DiscretePHS,
+    C_m: np.ndarray | None,
+    L: np.ndarray | None,
+    base: SimulationResult,
+    extra: np.ndarray,
+    U: np.ndarray | None,
+) -> dict[str, Any]:
+    """Return the series of the noise-free run ``base`` with the noise's response added."""
     n = d.dim
-    if N2.shape[1] and t.size > 1:
-        sampler = sampled_noise(E2, A2, N2, float(t[1] - t[0]))
-        extra = sampler.paths(t.size - 1, 1, seed)[:, :, 0]
-    else:
-        extra = np.zeros((t.size, E2.shape[0]))
     eh = np.asarray(base.states) + extra[:, :n]
-    U = None if u is None else input_samples(u, t, d.n_ports)
     changes: dict[str, Any] = {"states": eh, "H": d.hamiltonian(eh), "y": d.output(eh, U)}
     if C_m is not None and L is not None:
         eo = np.asarray(base.states_hat) + extra[:, n:]
@@ -208,15 +228,4 @@ def simulate_noisy(
         changes["w"] = eh @ Wd.T
         if "states_hat" in changes:
             changes["w_hat"] = changes["states_hat"] @ Wd.T
-    described = []
-    if noise_intensity is not None:
-        described.append(f"sensor intensity {', '.join(f'{s:g}' for s in sigma)}")
-    if w_in is not None:
-        described.append(f"input intensity {', '.join(f'{s:g}' for s in w_in)}")
-    info = {
-        **base.info,
-        "scheme": "expm (exact; Van Loan sampled noise)",
-        "noise": "; ".join(described) or "none",
-        "seed": -1 if seed is None else int(seed),
-    }
-    return replace(base, info=info, **changes)
+    return changes

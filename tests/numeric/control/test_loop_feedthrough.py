@@ -18,6 +18,7 @@ from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.control.assembly import NumericLoop, assemble
 from phdesign.numeric.control.simulation import simulate_loop
 from phdesign.numeric.discretization.registry import discretize
+from phdesign.numeric.time.options import SimulationOptions
 
 # both sensors and a non-scalar L: (I + K_o D)⁻¹ differs from I in every block.  One
 # actuated input checks the free input's map P = M S_rᵀ (there M K_a = K_a: K_a D is
@@ -73,11 +74,8 @@ def test_the_simulated_loop_reports_outputs_that_solve_the_loop(actuated):
         nm,
         loop,
         x0=x0,
-        t_end=0.5,
-        samples=6,
-        method="fd",
-        resolution=RESOLUTION,
         u=(lambda t: np.array([0.0, np.sin(2 * t)])) if free else None,
+        options=SimulationOptions(t_end=0.5, samples=6, method="fd", resolution=RESOLUTION),
     )
     y_plant = run.states @ d.B + run.u @ d.D.T
     assert _close(run.y, y_plant)

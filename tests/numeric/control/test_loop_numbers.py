@@ -28,6 +28,7 @@ from phdesign.numeric.control.tuning import tune_loop
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import initial_state_function
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 from phdesign.symbolic.closing import close_inputs
 
@@ -253,15 +254,15 @@ def test_the_loop_reproduces_the_controlled_plant_and_the_observer_error():
     nm = to_numeric(BEAM)
     x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=BEAM)
     C_m, L, K = np.eye(4)[[2, 3]], np.diag([0.1, 1.0]), np.array([[2.0]])
-    options = {"t_end": 1.0, "samples": 21, "resolution": 16}
-    measured = simulate_loop(nm, NumericLoop((2,), K, C_m, L, "measured"), x0=x0, **options)
+    options = SimulationOptions(t_end=1.0, samples=21, resolution=16)
+    measured = simulate_loop(nm, NumericLoop((2,), K, C_m, L, "measured"), x0=x0, options=options)
     closed_model = close_inputs(BEAM, [3], [[2]])
     closed = to_numeric(closed_model)
     x0_closed = initial_state_function("x1: 0, x2: z - 0.9", closed, model=closed_model)
-    plant = simulate(closed, x0=x0_closed, **options)
+    plant = simulate(closed, x0=x0_closed, options=options)
     np.testing.assert_allclose(measured.H, plant.H, rtol=1e-10)
-    estimated = simulate_loop(nm, NumericLoop((2,), K, C_m, L), x0=x0, **options)
-    observer = simulate(nm, C_m, L, x0=x0, **options)
+    estimated = simulate_loop(nm, NumericLoop((2,), K, C_m, L), x0=x0, options=options)
+    observer = simulate(nm, C_m, L, x0=x0, options=options)
     # the error system does not see u (the observer knows it): the same error energy
     np.testing.assert_allclose(estimated.H_err, observer.H_err, rtol=1e-9)
     assert not np.allclose(estimated.H, plant.H)  # the estimate is not the measurement

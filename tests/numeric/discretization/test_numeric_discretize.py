@@ -11,7 +11,8 @@ from scipy.optimize import brentq
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize
-from phdesign.numeric.time.simulation import step_lti
+from phdesign.numeric.time.options import SimulationOptions
+from phdesign.numeric.time.stepping import step_lti
 
 FD_MODELS = ("wave", "timoshenko", "euler-bernoulli")
 CASES = [(name, "galerkin", 24) for name in BUILTINS] + [(n, "fd", 30) for n in FD_MODELS]
@@ -166,6 +167,18 @@ def test_fd_feedthrough_from_port_change_and_observer_loop():
         return np.column_stack([np.sin(np.pi * z), 0 * z])
 
     C, L = np.array([[0.0, 1.0]]), np.array([[0.5]])
-    a = simulate(nm, C, L, x0=x0, t_end=2.0, samples=101, method="fd", resolution=200)
-    b = simulate(nm, C, L, x0=x0, t_end=2.0, samples=101, method="galerkin", resolution=60)
+    a = simulate(
+        nm,
+        C,
+        L,
+        x0=x0,
+        options=SimulationOptions(t_end=2.0, samples=101, method="fd", resolution=200),
+    )
+    b = simulate(
+        nm,
+        C,
+        L,
+        x0=x0,
+        options=SimulationOptions(t_end=2.0, samples=101, method="galerkin", resolution=60),
+    )
     assert np.max(np.abs(a.H_err - b.H_err)) < 1e-4 * b.H_err[0]

@@ -42,6 +42,7 @@ from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.noise.figures import error_statistics, noise, noise_input, peak_gain
 from phdesign.numeric.noise.lyapunov import hamiltonian_hinf_norm, triangularize
 from phdesign.numeric.noise.settle import settle
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.stochastic import noisy_coupled_system, sampled_noise
 from phdesign.symbolic.model import BCPHS
 
@@ -378,6 +379,9 @@ def test_the_sampled_noise_covariance_is_linear_in_a_huge_intensity(scale):
     unit = covariances[0]
     assert np.max(np.abs(covariances[1] - unit)) <= 1e-12 * np.max(np.abs(unit))
     run = simulate_noisy(
-        numeric("wave"), SENSOR_2, L, noise_intensity=scale, seed=1, resolution=6, samples=5
+        numeric("wave"),
+        SENSOR_2,
+        L,
+        options=SimulationOptions(noise_intensity=scale, seed=1, resolution=6, samples=5),
     )
     assert np.all(run.H_err[1:] > 1e-3 * scale)  # the noise is there, at its own scale

@@ -24,6 +24,7 @@ from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize, feedback_matrix
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.statespace import error_statespace, observer_statespace, plant_statespace
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 from phdesign.symbolic.model import BCPHS
 
@@ -112,7 +113,14 @@ def test_observer_outputs_are_physical_estimates():
     ]  # fmt: skip
     obs_w = observer_statespace(d, PAPER_SENSORS, L, quantity="displacement", z=[0.5, 1.0])
     assert obs_w.output_labels[4:] == ["w_hat(z=0p5)", "w_hat(z=1)"]
-    r = simulate(nm, PAPER_SENSORS, L, x0=x0, t_end=1.0, samples=101, discrete=d, z_w=[0.5, 1.0])
+    r = simulate(
+        nm,
+        PAPER_SENSORS,
+        L,
+        x0=x0,
+        discrete=d,
+        options=SimulationOptions(t_end=1.0, samples=101, z_w=[0.5, 1.0]),
+    )
     P = plant_statespace(d)
     S = control.ss([], [], [], PAPER_SENSORS, inputs=P.output_labels, outputs=["y_m1", "y_m2"])
     with warnings.catch_warnings():

@@ -23,15 +23,16 @@ from phdesign.codegen import render_c, write_directory
 from phdesign.core.errors import NumericError, OutputFileError
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
+from phdesign.numeric.checks import check_sampling
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.sampled.export import SampledObserver, export_observer
 from phdesign.numeric.sampled.samplers import (
     ContinuousObserver,
-    check_sampling,
     hold_discretization,
     sample_plant,
 )
 from phdesign.numeric.statespace import observer_statespace
+from phdesign.numeric.time.options import SimulationOptions
 
 BEAM_SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
 BEAM_GAIN = np.diag([0.1, 1.0])
@@ -341,6 +342,6 @@ def test_a_sampling_period_is_at_most_the_run_and_the_periods_are_bounded():
     with pytest.raises(NumericError, match=r"^t_end / dt = 5e\+300 sampling periods"):
         export_observer(nm, *design, dt=1e-300, order=6, verify=True)
     with pytest.raises(NumericError, match=r"^dt = 10 s is longer than t_end = 5 s"):
-        simulate_sampled(nm, *design, dt=10.0, resolution=6)
+        simulate_sampled(nm, *design, options=SimulationOptions(dt=10.0, resolution=6))
     with pytest.raises(NumericError, match=r"^t_end / dt = 5e\+300 sampling periods"):
-        simulate_sampled(nm, *design, dt=1e-300, resolution=6)
+        simulate_sampled(nm, *design, options=SimulationOptions(dt=1e-300, resolution=6))

@@ -9,12 +9,15 @@ values are written from these definitions, never from ``DiscretePHS.close()``.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from numeric_models import FEEDTHROUGH, observer_loop_residual
 
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 from phdesign.numeric.time.stochastic import noisy_coupled_system, simulate_noisy
 
@@ -37,14 +40,12 @@ def _setup():
 def test_the_observer_output_solves_its_implicit_input(noisy):
     nm, d = _setup()
     x0 = lambda z: np.column_stack([np.sin(np.pi * z), z])  # noqa: E731
-    options = {"x0": x0, "t_end": 0.5, "samples": 6, "method": "fd", "resolution": RESOLUTION}
-    options["u"] = _inputs
+    options = SimulationOptions(t_end=0.5, samples=6, method="fd", resolution=RESOLUTION)
     if noisy:
-        run = simulate_noisy(
-            nm, C_M, GAIN, noise_intensity=0.1, input_intensity=[0.2, 0.3], seed=1, **options
-        )
+        noise = replace(options, noise_intensity=0.1, input_intensity=[0.2, 0.3], seed=1)
+        run = simulate_noisy(nm, C_M, GAIN, x0=x0, u=_inputs, options=noise)
     else:
-        run = simulate(nm, C_M, GAIN, **options)
+        run = simulate(nm, C_M, GAIN, x0=x0, u=_inputs, options=options)
     U = np.array([_inputs(t) for t in run.t])
     y_plant = run.states @ d.B + U @ d.D.T
     assert np.max(np.abs(run.y - y_plant)) < 1e-12 * np.max(np.abs(y_plant))

@@ -17,6 +17,7 @@ from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.spectrum.converged import spectrum
 from phdesign.numeric.statespace import error_statespace, observer_statespace, plant_statespace
+from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.simulation import simulate
 
 
@@ -37,10 +38,7 @@ def test_initial_energy_and_tip_deflection_of_the_paper_initial_state():
             PAPER_SENSORS,
             np.diag([0.1, 1]),
             x0=x0,
-            t_end=0.1,
-            samples=2,
-            method=method,
-            resolution=res,
+            options=SimulationOptions(t_end=0.1, samples=2, method=method, resolution=res),
         )
         assert abs(r.H[0] - 0.73 / 6) < tol
         assert abs(r.H_err[0] - r.H[0]) < 1e-15  # observer starts from zero
@@ -59,7 +57,11 @@ def test_table_I_decay_times_agree_between_fd140_and_galerkin(l1, l2):
     times = {}
     for method, res in (("fd", 70), ("galerkin", 45)):
         r = simulate(
-            nm, PAPER_SENSORS, L, x0=x0, t_end=8.0, samples=1601, method=method, resolution=res
+            nm,
+            PAPER_SENSORS,
+            L,
+            x0=x0,
+            options=SimulationOptions(t_end=8.0, samples=1601, method=method, resolution=res),
         )
         assert r.info["states"] == (140 if method == "fd" else 92)
         # H_err decays: every 1 s window ends lower than it starts
@@ -83,7 +85,13 @@ def test_table_I_ranking_matches_the_spectral_abscissa():
     alphas = []
     for l1, l2 in TABLE_I:
         L = np.diag([l1, l2])
-        r = simulate(nm, PAPER_SENSORS, L, x0=x0, t_end=6.0, samples=601, resolution=30)
+        r = simulate(
+            nm,
+            PAPER_SENSORS,
+            L,
+            x0=x0,
+            options=SimulationOptions(t_end=6.0, samples=601, resolution=30),
+        )
         t2.append(r.time_below(1e-2))
         alphas.append(spectrum(nm, PAPER_SENSORS, L).spectral_abscissa)
     assert np.argsort(t2).tolist() == [1, 2, 0]
@@ -96,8 +104,12 @@ def test_expm_and_midpoint_agree_and_plant_only_mode(rng):
     # initial state the energies agree to ~1e-6 (midpoint error ~ dt^2 * omega^3 t).
     nm = numeric("wave")
     x0 = initial_state_function("x1: sin(pi*z), x2: 0", nm, model=load_builtin("wave"))
-    a = simulate(nm, x0=x0, t_end=1.0, samples=1001, resolution=16)
-    b = simulate(nm, x0=x0, t_end=1.0, samples=1001, resolution=16, scheme="midpoint")
+    a = simulate(nm, x0=x0, options=SimulationOptions(t_end=1.0, samples=1001, resolution=16))
+    b = simulate(
+        nm,
+        x0=x0,
+        options=SimulationOptions(t_end=1.0, samples=1001, resolution=16, scheme="midpoint"),
+    )
     assert a.H_hat is None
     assert a.H_err is None
     np.testing.assert_allclose(a.H, b.H, rtol=1e-5)
@@ -109,8 +121,8 @@ def test_input_is_piecewise_linear_exact(rng):
     # With u linear in time the FOH exponential step is exact: halving dt changes nothing.
     nm = numeric("wave")
     u = lambda t: np.array([0.1 * t, 0.0])  # noqa: E731
-    a = simulate(nm, t_end=1.0, samples=11, resolution=12, u=u)
-    b = simulate(nm, t_end=1.0, samples=21, resolution=12, u=u)
+    a = simulate(nm, u=u, options=SimulationOptions(t_end=1.0, samples=11, resolution=12))
+    b = simulate(nm, u=u, options=SimulationOptions(t_end=1.0, samples=21, resolution=12))
     np.testing.assert_allclose(a.states, b.states[::2], atol=1e-12)
 
 
@@ -123,7 +135,9 @@ def test_exported_statespace_reproduces_the_simulation(method, res):
     nm, x0 = _paper_x0()
     L = np.diag([0.1, 1.0])
     d = discretize(nm, method, res)
-    r = simulate(nm, PAPER_SENSORS, L, x0=x0, t_end=2.0, samples=201, discrete=d)
+    r = simulate(
+        nm, PAPER_SENSORS, L, x0=x0, discrete=d, options=SimulationOptions(t_end=2.0, samples=201)
+    )
     P = plant_statespace(d)
     obs = observer_statespace(d, PAPER_SENSORS, L)
     E = error_statespace(d, PAPER_SENSORS, L)
@@ -150,7 +164,13 @@ def test_exported_statespace_reproduces_the_simulation(method, res):
 
 def test_csv_and_json_formats():
     nm, x0 = _paper_x0()
-    r = simulate(nm, PAPER_SENSORS, np.diag([0.1, 1]), x0=x0, t_end=0.5, samples=6, resolution=12)
+    r = simulate(
+        nm,
+        PAPER_SENSORS,
+        np.diag([0.1, 1]),
+        x0=x0,
+        options=SimulationOptions(t_end=0.5, samples=6, resolution=12),
+    )
     rows = list(csv.reader(io.StringIO(r.to_csv())))
     assert rows[0][:4] == ["t", "H", "H_hat", "H_err"]
     assert rows[0][-2:] == ["w_tip", "w_hat_tip"]
@@ -183,11 +203,11 @@ def test_initial_state_syntax_errors():
 def test_bad_simulation_requests():
     nm = numeric("wave")
     with pytest.raises(NumericError, match="t_end"):
-        simulate(nm, t_end=-1.0)
+        simulate(nm, options=SimulationOptions(t_end=-1.0))
     with pytest.raises(NumericError, match="samples"):
-        simulate(nm, samples=1)
+        simulate(nm, options=SimulationOptions(samples=1))
     with pytest.raises(NumericError, match="scheme"):
-        simulate(nm, scheme="rk4", resolution=8)
+        simulate(nm, options=SimulationOptions(scheme="rk4", resolution=8))
 
 
 def _nan_after(t0: float):
@@ -204,11 +224,18 @@ def test_a_nan_input_signal_is_refused_naming_the_input_and_time(front):
     nm = numeric("wave")
     design = (np.array([[0.0, 1.0]]), np.array([[1.0]]))
     runs = {
-        "simulate": lambda u: simulate(nm, *design, u=u, resolution=6, samples=5),
-        "noisy": lambda u: simulate_noisy(
-            nm, *design, noise_intensity=1.0, seed=1, u=u, resolution=6, samples=5
+        "simulate": lambda u: simulate(
+            nm, *design, u=u, options=SimulationOptions(resolution=6, samples=5)
         ),
-        "sampled": lambda u: simulate_sampled(nm, *design, u=u, dt=1.25, resolution=6),
+        "noisy": lambda u: simulate_noisy(
+            nm,
+            *design,
+            u=u,
+            options=SimulationOptions(noise_intensity=1.0, seed=1, resolution=6, samples=5),
+        ),
+        "sampled": lambda u: simulate_sampled(
+            nm, *design, u=u, options=SimulationOptions(dt=1.25, resolution=6)
+        ),
         "loop": lambda u: phd.Loop(
             phd.Observer(phd.load("wave"), sensors=[2], gain=1, resolution=6), actuate=2
         ).simulate(u=lambda t: np.array([u(t)[0], 0.0]), samples=5),

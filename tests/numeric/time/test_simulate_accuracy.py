@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from dataclasses import replace
 
 import mpmath
 import numpy as np
@@ -20,7 +21,9 @@ from numeric_models import PAPER_SENSORS, numeric
 from phdesign.models import load_builtin
 from phdesign.numeric.discretization.registry import discretize, feedback_matrix
 from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.time.simulation import ResolutionWarning, coupled_system, simulate
+from phdesign.numeric.time.options import SimulationOptions
+from phdesign.numeric.time.result import ResolutionWarning
+from phdesign.numeric.time.simulation import coupled_system, simulate
 from phdesign.numeric.time.stepping import integrate
 
 TIMOSHENKO_SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
@@ -45,7 +48,13 @@ def test_error_energy_is_resolved_only_down_to_its_floor():
     assert abs(alpha + 0.7791193346988254) < 1e-9
     model = load_builtin("timoshenko")
     x0 = initial_state_function("x2: sin(pi*z)**6, x3: sin(pi*z)**4", nm, model=model)
-    r = simulate(nm, TIMOSHENKO_SENSORS, np.eye(2), x0=x0, t_end=20.0, samples=201, resolution=20)
+    r = simulate(
+        nm,
+        TIMOSHENKO_SENSORS,
+        np.eye(2),
+        x0=x0,
+        options=SimulationOptions(t_end=20.0, samples=201, resolution=20),
+    )
     assert 1e-11 < r.resolved_floor < 1e-8
     assert 10.0 < r.resolved_until < 18.0
     assert any("resolved only down to" in w for w in r.warnings)
@@ -72,7 +81,9 @@ def test_error_energy_comes_from_the_error_state():
     L = np.diag([0.1, 1.0])
     d = discretize(nm, "galerkin", 40)
     t = np.linspace(0.0, 4.5, 46)
-    r = simulate(nm, PAPER_SENSORS, L, x0=x0, t_end=4.5, samples=46, discrete=d)
+    r = simulate(
+        nm, PAPER_SENSORS, L, x0=x0, discrete=d, options=SimulationOptions(t_end=4.5, samples=46)
+    )
     ref = control.initial_response(error_statespace(d, PAPER_SENSORS, L), T=t, X0=d.project(x0))
     H_ref = d.hamiltonian(ref.states.T)
     assert H_ref[-1] / H_ref[0] < 1e-10
@@ -90,9 +101,10 @@ def test_midpoint_controls_its_step_against_the_exact_solution():
     # ~1e-9 of H_err(0).  The plant's incompatible initial state (x2(1) = 0.1 at a free
     # end) excites top modes that no affordable midpoint step resolves: it says so.
     nm, x0 = _paper_beam()
-    kw = {"x0": x0, "t_end": 2.0, "samples": 201, "check_resolution": False}
-    exact = simulate(nm, PAPER_SENSORS, np.diag([0.1, 1.0]), **kw)
-    mid = simulate(nm, PAPER_SENSORS, np.diag([0.1, 1.0]), scheme="midpoint", **kw)
+    options = SimulationOptions(t_end=2.0, samples=201, check_resolution=False)
+    exact = simulate(nm, PAPER_SENSORS, np.diag([0.1, 1.0]), x0=x0, options=options)
+    midpoint = replace(options, scheme="midpoint")
+    mid = simulate(nm, PAPER_SENSORS, np.diag([0.1, 1.0]), x0=x0, options=midpoint)
     assert np.max(np.abs(mid.H_err - exact.H_err)) < 1e-6 * exact.H_err[0]
     assert abs(mid.H_err[-1] / exact.H_err[-1] - 1) < 1e-4
     assert mid.info["midpoint_error_estimate_error_system"] <= 1e-6
@@ -128,20 +140,25 @@ def test_the_drift_warning_points_to_what_helps():
     airy = load_builtin("airy")
     nm = numeric("airy")
     x0 = initial_state_function("x1: sin(pi*z)", nm, model=airy)
-    kw = {"x0": x0, "t_end": 1.0, "samples": 101, "check_resolution": False}
-    reference = simulate(nm, np.eye(3), np.eye(3), resolution=16, **kw)
-    drift = simulate(nm, np.eye(3), np.eye(3), resolution=40, **kw)
+    options = SimulationOptions(t_end=1.0, samples=101, check_resolution=False)
+    reference = simulate(nm, np.eye(3), np.eye(3), x0=x0, options=replace(options, resolution=16))
+    drift = simulate(nm, np.eye(3), np.eye(3), x0=x0, options=replace(options, resolution=40))
     warning = next(w for w in drift.warnings if "energy balance drifts" in w)
     assert "scheme 'midpoint'" in warning
     assert np.max(np.abs(drift.H_err - reference.H_err)) > 1e-4 * reference.H_err[0]
-    fixed = simulate(nm, np.eye(3), np.eye(3), resolution=40, scheme="midpoint", **kw)
+    midpoint = replace(options, resolution=40, scheme="midpoint")
+    fixed = simulate(nm, np.eye(3), np.eye(3), x0=x0, options=midpoint)
     assert np.max(np.abs(fixed.H_err - reference.H_err)) < 2e-5 * reference.H_err[0]
 
 
 def test_simulation_result_prints_as_the_command_line():
     nm, x0 = _paper_beam()
     r = simulate(
-        nm, PAPER_SENSORS, np.diag([0.1, 1.0]), x0=x0, t_end=0.2, samples=5, resolution=12
+        nm,
+        PAPER_SENSORS,
+        np.diag([0.1, 1.0]),
+        x0=x0,
+        options=SimulationOptions(t_end=0.2, samples=5, resolution=12),
     )
     assert str(r) == r.to_csv()
     assert len(repr(r)) <= 300
