@@ -301,13 +301,13 @@ def test_tune_seed_reaches_the_random_grid(monkeypatch):
 
     import phdesign.numeric.tuning.search as tune_module
 
-    original, seeds = tune_module._grid, []
+    original, seeds = tune_module.grid_points, []
 
     def recording(search, log_range, seed):
         seeds.append(seed)
         return original(search, log_range, seed)
 
-    monkeypatch.setattr(tune_module, "_grid", recording)
+    monkeypatch.setattr(tune_module, "grid_points", recording)
     run.__wrapped__(f"{T4} --seed 7")
     run.__wrapped__("loop tune euler-bernoulli --actuate 4 --sensors 4 --starts 1 --seed 5 --json")
     assert seeds == [7, 5, 5]  # loop tune: K on the controlled plant, then L

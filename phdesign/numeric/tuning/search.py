@@ -12,23 +12,29 @@ The gain is searched in the problem's own units: :math:`L = \operatorname{diag}(
 with g the natural gain of each sensor (:mod:`phdesign.numeric.scales`: for the string
 with the damper at its end, its impedance), or, with ``full=True``,
 :math:`L = G^{1/2} (e^{S} + W) G^{1/2}` with S symmetric and W skew (so that
-:math:`L + L^\top \succ 0`).  The stages:
+:math:`L + L^\top \succ 0`) (:mod:`phdesign.numeric.tuning.objective`).  The search is a
+list of named stages, each a function from what was found so far to what it finds, run in
+order (the progress display names them):
 
 1. **grid** of x over ``log_range`` (11 points per gain for one or two gains, 7 for three,
    5 beyond, a seeded random sample past 625 points) at a *search pair* of low resolution
    that reproduces the nominal gain's abscissa to 1e-6 (the rightmost modes of the
    boundary-damped systems are resolved at low degree);
-2. **local searches**: Nelder-Mead from the ``starts`` best grid points, then from the
-   best of them at the *verification pair* (the pair at which the spectrum of the
-   nominal gain converged);
-3. **coalescence**: the abscissa of a boundary damper is typically minimized where
+2. **local searches**: Nelder-Mead from the ``starts`` best grid points;
+3. **continuation**: restarts of the best search when its iteration limit stopped it;
+4. **refinement at the verification pair** (the pair at which the spectrum of the
+   nominal gain converged), from the best point;
+5. **coalescence**: the abscissa of a boundary damper is typically minimized where
    q + 1 eigenvalues coalesce (q gains; the paper's beam: three real eigenvalues at
    -5.83335), where the abscissa is not Lipschitz and a direct search stalls; Newton's
    method on the cluster's central moments locates the point to round-off
    (:mod:`phdesign.numeric.spectrum.coalescence`);
-4. **verification**: :func:`~phdesign.numeric.spectrum.converged.spectrum` at the
-   returned gain, and the **robustness figure**, the worst abscissa over a ±5 % box of
-   gains around it (:mod:`phdesign.numeric.tuning.robustness`).
+6. **full gain** (``full=True``), from the diagonal optimum.
+
+A gain with an empty spectrum ends the stages at that gain.  Then the **verification**,
+:func:`~phdesign.numeric.spectrum.converged.spectrum` at the returned gain, gives the
+status, and the **robustness figure** is the worst abscissa over a ±5 % box of gains
+around it (:mod:`phdesign.numeric.tuning.robustness`).
 
 Questions without an optimum get an answer that says so: when the search meets an empty
 spectrum (finite-time extinction, the string with the matched damper k = √(ρT)), the
@@ -50,10 +56,10 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 
 import numpy as np
-import scipy.linalg as sl
-from scipy.optimize import minimize
+from scipy.optimize import OptimizeResult, minimize
 
 from phdesign.core.defaults import method_or_default
 from phdesign.core.errors import NumericError, ObserverError
@@ -65,6 +71,13 @@ from phdesign.numeric.spectrum.coalescence import Coalescence, polish_coalescenc
 from phdesign.numeric.spectrum.converged import default_resolutions, spectrum
 from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
 from phdesign.numeric.threads import small_dense_threads
+from phdesign.numeric.tuning.objective import (
+    Extinct,
+    GainSearch,
+    bounded,
+    grid_points,
+    search_pair,
+)
 from phdesign.numeric.tuning.result import LocalSearch, TuneResult
 from phdesign.numeric.tuning.robustness import Robustness, worst_in_box
 
@@ -79,144 +92,8 @@ CONTINUATION_GAIN = 1e-6
 _DECADE = math.log(10.0)
 
 
-class _Extinct(Exception):
-    """Raised inside the search when a gain gives an empty spectrum."""
-
-    def __init__(self, L: np.ndarray) -> None:
-        super().__init__("empty spectrum")
-        self.L = L
-
-
-def _grid_size(q: int) -> int:
-    return {1: 11, 2: 11, 3: 7}.get(q, 5)
-
-
-class _Search:
-    """The gain parametrization and the objective of one tuning run."""
-
-    def __init__(
-        self,
-        C: np.ndarray,
-        scale: np.ndarray,
-        full: bool,
-        robust: float | None,
-        progress: Callable[[str], None] | None,
-    ) -> None:
-        self.C, self.q, self.full, self.robust = C, C.shape[0], full, robust
-        self.root = np.sqrt(scale)
-        self.scale = scale
-        self.progress = progress
-        self.best = math.inf
-        self.evaluations = 0
-        self._last_report = time.perf_counter()
-        self.stage = ""
-
-    @property
-    def n_params(self) -> int:
-        q = self.q
-        return q if not self.full else q * q
-
-    def gain(self, x: np.ndarray) -> np.ndarray:
-        """L for the parameters x (module docstring)."""
-        q = self.q
-        if not self.full:
-            return np.diag(self.scale * np.exp(np.clip(x, -60.0, 60.0)))
-        S = np.zeros((q, q))
-        iu = np.triu_indices(q)
-        S[iu] = x[: iu[0].size]
-        S = S + np.triu(S, 1).T
-        W = np.zeros((q, q))
-        iw = np.triu_indices(q, 1)
-        W[iw] = x[iu[0].size :]
-        core = sl.expm(np.clip(S, -60.0, 60.0)) + W - W.T
-        return self.root[:, None] * core * self.root[None, :]
-
-    def diagonal_params(self, d: np.ndarray) -> np.ndarray:
-        """Parameters of the diagonal gain diag(scale e^d)."""
-        if not self.full:
-            return np.asarray(d, dtype=float)
-        x = np.zeros(self.n_params)
-        S = np.diag(d)
-        x[: self.q * (self.q + 1) // 2] = S[np.triu_indices(self.q)]
-        return x
-
-    def value(self, ev: AbscissaEvaluator, x: np.ndarray) -> float:
-        """Return the objective at x: the abscissa, or its worst case over the box."""
-        L = self.gain(x)
-        if self.robust is None:
-            v = ev(L)
-            if v == -math.inf:
-                raise _Extinct(L)
-        else:
-            v = _nan_as_inf(worst_in_box(ev, L, self.robust, refine=False).worst_abscissa)
-        self.evaluations += 1
-        v = math.inf if math.isnan(v) else v
-        self.best = min(self.best, v)
-        self._tell()
-        return v
-
-    def _tell(self, force: bool = False) -> None:
-        now = time.perf_counter()
-        if self.progress is not None and (force or now - self._last_report > 0.2):
-            self._last_report = now
-            best = "—" if not math.isfinite(self.best) else f"{self.best:.6g}"
-            self.progress(f"tune: {self.stage}, {self.evaluations} evaluations, best {best}")
-
-
-def _nan_as_inf(x: float | None) -> float:
-    return math.inf if x is None or math.isnan(x) else x
-
-
-def _bounded(v: float, penalty: float) -> float:
-    """Return a finite objective for Nelder-Mead: unresolved gains get a penalty."""
-    return v if math.isfinite(v) else penalty
-
-
-def _search_pair(
-    nm: NumericModel, C: np.ndarray, L0: np.ndarray, verify: int, method: str
-) -> tuple[AbscissaEvaluator, AbscissaEvaluator]:
-    """Return the cheapest search evaluator that agrees with the verification one, and it.
-
-    A pair whose band stops below the onset of the principal part while the verification
-    pair's does not (:mod:`phdesign.numeric.spectrum.branches`) is not a search pair, whatever it
-    gives at the starting gain: a branch may start above its band.
-    """
-    ev_verify = AbscissaEvaluator(nm, C, verify, method=method)
-    target = ev_verify(L0)
-    seen = ev_verify.abscissa(L0).kind != "lower bound"
-    for fraction in (0.5, 0.6, 0.75):
-        p = max(nm.order + 2, math.ceil(fraction * verify))
-        if p >= verify:
-            break
-        ev = AbscissaEvaluator(nm, C, p, method=method)
-        if seen and ev.abscissa(L0).kind == "lower bound":
-            continue  # its band stops below a branch the verification pair sees
-        v = ev(L0)
-        same = (math.isnan(v) and math.isnan(target)) or v == target
-        scale = max(ev.scales.rate, abs(target)) if math.isfinite(target) else 1.0
-        if same or (
-            math.isfinite(v) and math.isfinite(target) and abs(v - target) <= 1e-6 * scale
-        ):
-            return ev, ev_verify
-    return ev_verify, ev_verify
-
-
-def _grid(search: _Search, log_range: tuple[float, float], seed: int) -> np.ndarray:
-    q = search.q
-    n = _grid_size(q)
-    axis = np.linspace(log_range[0], log_range[1], n)
-    if n**q <= 625:
-        mesh = np.meshgrid(*([axis] * q), indexing="ij")
-        points = np.stack([m.ravel() for m in mesh], axis=1)
-    else:
-        rng = np.random.default_rng(seed)
-        points = rng.uniform(log_range[0], log_range[1], size=(256, q))
-        points = np.concatenate([np.zeros((1, q)), points])
-    return points
-
-
 def _continue(
-    search: _Search,
+    search: GainSearch,
     ev: AbscissaEvaluator,
     x: np.ndarray,
     f: float,
@@ -236,7 +113,7 @@ def _continue(
     """
     for _ in range(CONTINUATIONS):
         res = minimize(
-            lambda y: _bounded(search.value(ev, y), penalty),
+            lambda y: bounded(search.value(ev, y), penalty),
             x,
             method="Nelder-Mead",
             options=options,
@@ -250,7 +127,7 @@ def _continue(
 
 
 def _polish(
-    search: _Search, ev: AbscissaEvaluator, x: np.ndarray
+    search: GainSearch, ev: AbscissaEvaluator, x: np.ndarray
 ) -> tuple[np.ndarray, Coalescence] | None:
     """Newton on the coalescence of q + 1 eigenvalues at the rightmost (diagonal gains)."""
     if search.robust is not None:
@@ -347,39 +224,57 @@ def tune(
         raise NumericError(f"robust must be a fraction in (0, 1); found {robust}")
     start_time = time.perf_counter()
     with small_dense_threads():
-        return _tune(
-            nm,
-            C,
-            full,
-            starts,
-            seed,
-            log_range,
-            resolution,
-            maxiter,
-            robust,
-            method,
-            progress,
-            start_time,
+        run = _setup(nm, C, full, robust, resolution, method, progress)
+        found = _search(
+            run, _Found(np.zeros(run.search.n_params)), starts, seed, log_range, maxiter
         )
+        return _verify(run, found, start_time)
 
 
-def _tune(
+@dataclass(frozen=True)
+class _Run:
+    """One tuning run's fixed parts, which every stage reads."""
+
+    nm: NumericModel
+    C: np.ndarray
+    search: GainSearch
+    ev_search: AbscissaEvaluator
+    ev_verify: AbscissaEvaluator
+    penalty: float
+    rate: float
+    full: bool
+    method: str
+    # the local searches, appended as they finish (an extinction keeps those done)
+    records: list[LocalSearch] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _Found:
+    """What the search stages found so far: parameters, abscissa, how the search ended."""
+
+    x: np.ndarray
+    f: float = math.inf
+    settled: bool = True
+    starts: tuple[np.ndarray, ...] = ()
+    descending: bool = False
+    polished: Coalescence | None = None
+    gain: np.ndarray | None = None
+    extinct: np.ndarray | None = None
+
+
+def _setup(
     nm: NumericModel,
     C: np.ndarray,
     full: bool,
-    starts: int,
-    seed: int,
-    log_range: tuple[float, float],
-    resolution: int | None,
-    maxiter: int,
     robust: float | None,
+    resolution: int | None,
     method: str,
     progress: Callable[[str], None] | None,
-    start_time: float,
-) -> TuneResult:
+) -> _Run:
+    """Fix the verification pair (where the natural gain's spectrum converges) and the search's."""
     scales = problem_scales(nm)
     # the diagonal search always runs first; a full gain only starts from its optimum
-    search = _Search(C, scales.gain_scale(C), False, robust, progress)
+    search = GainSearch(C, scales.gain_scale(C), False, robust, progress)
     L0 = search.gain(np.zeros(search.n_params))
     if resolution is None:
         nominal = spectrum(nm, C, L0, method=method)
@@ -388,111 +283,169 @@ def _tune(
         )
     else:
         verify = int(resolution)
-    ev_search, ev_verify = _search_pair(nm, C, L0, verify, method)
-    penalty = 1e6 * scales.rate
-    records: list[LocalSearch] = []
-    extinct: np.ndarray | None = None
-    descending = False
-    descent = ""
-    x_best = np.zeros(search.n_params)
-    L_best = L0
-    polished: Coalescence | None = None
-    try:
-        search.stage = "grid"
-        grid = _grid(search, log_range, seed)
-        values = np.array([search.value(ev_search, search.diagonal_params(d)) for d in grid])
-        order = np.argsort(values, kind="stable")
-        search.stage = "local searches"
-        npar = search.n_params
-        # stop on the size of the simplex alone: at an optimum at a coalescence (a cusp of
-        # the abscissa, like |x|^(1/3)) the values never settle, and the coalescence stage
-        # locates that point exactly
-        options = {"maxiter": maxiter * npar, "xatol": 1e-5, "fatol": math.inf}
-        best_f = math.inf
-        best_settled = True
-        for i in order[: max(1, starts)]:
-            x0 = search.diagonal_params(grid[i])
-            before = search.evaluations
-            res = minimize(
-                lambda x: _bounded(search.value(ev_search, x), penalty),
-                x0,
-                method="Nelder-Mead",
-                options=options,
+    ev_search, ev_verify = search_pair(nm, C, L0, verify, method)
+    return _Run(nm, C, search, ev_search, ev_verify, 1e6 * scales.rate, scales.rate, full, method)
+
+
+def _nelder_mead(
+    run: _Run, search: GainSearch, ev: AbscissaEvaluator, x0: np.ndarray, maxiter: int
+) -> OptimizeResult:
+    """Nelder-Mead on the bounded objective, stopped on the size of the simplex alone.
+
+    At an optimum at a coalescence (a cusp of the abscissa, like |x|^(1/3)) the values never
+    settle, and the coalescence stage locates that point exactly.
+    """
+    return minimize(
+        lambda x: bounded(search.value(ev, x), run.penalty),
+        x0,
+        method="Nelder-Mead",
+        options={"maxiter": maxiter, "xatol": 1e-5, "fatol": math.inf},
+    )
+
+
+def _search(
+    run: _Run,
+    found: _Found,
+    starts: int,
+    seed: int,
+    log_range: tuple[float, float],
+    maxiter: int,
+) -> _Found:
+    """Run the search stages in order; an empty spectrum ends them at its gain."""
+    npar = run.search.n_params
+    stages: tuple[tuple[str, Callable[[_Found], _Found]], ...] = (
+        ("grid", lambda f: _grid(run, f, starts, seed, log_range)),
+        ("local searches", lambda f: _local_searches(run, f, maxiter * npar)),
+        ("continuation", lambda f: _continuation(run, f, maxiter * npar)),
+        ("refinement at the verification pair", lambda f: _refinement(run, f, 50 * npar)),
+        ("coalescence", lambda f: _coalescence(run, f)),
+        ("full gain", lambda f: _full_gain(run, f, maxiter)),
+    )
+    for name, stage in stages:
+        run.search.stage = name
+        try:
+            found = stage(found)
+        except Extinct as stop:
+            return replace(found, extinct=stop.L)
+    return found
+
+
+def _grid(
+    run: _Run, found: _Found, starts: int, seed: int, log_range: tuple[float, float]
+) -> _Found:
+    """Evaluate the grid at the search pair; its ``starts`` best points start the searches."""
+    search = run.search
+    grid = grid_points(search, log_range, seed)
+    values = np.array([search.value(run.ev_search, search.diagonal_params(d)) for d in grid])
+    order = np.argsort(values, kind="stable")
+    return replace(found, starts=tuple(grid[i] for i in order[: max(1, starts)]))
+
+
+def _local_searches(run: _Run, found: _Found, maxiter: int) -> _Found:
+    """Nelder-Mead from each start at the search pair; keep the best."""
+    search = run.search
+    for start in found.starts:
+        x0 = search.diagonal_params(start)
+        before = search.evaluations
+        res = _nelder_mead(run, search, run.ev_search, x0, maxiter)
+        run.records.append(
+            LocalSearch(
+                start=search.gain(x0),
+                gain=search.gain(res.x),
+                spectral_abscissa=float(res.fun) if res.fun < run.penalty else None,
+                evaluations=search.evaluations - before,
+                settled=bool(res.success),
             )
-            records.append(
-                LocalSearch(
-                    start=search.gain(x0),
-                    gain=search.gain(res.x),
-                    spectral_abscissa=float(res.fun) if res.fun < penalty else None,
-                    evaluations=search.evaluations - before,
-                    settled=bool(res.success),
-                )
-            )
-            if res.fun < best_f:
-                best_f, x_best, best_settled = float(res.fun), np.asarray(res.x), res.success
-        if not best_settled:
-            search.stage = "continuation"
-            x_best, best_f, descending = _continue(
-                search, ev_search, x_best, best_f, penalty, options, scales.rate
-            )
-        if ev_verify is not ev_search:
-            search.stage = "refinement at the verification pair"
-            res = minimize(
-                lambda x: _bounded(search.value(ev_verify, x), penalty),
-                x_best,
-                method="Nelder-Mead",
-                options={**options, "maxiter": 50 * npar},
-            )
-            x_best = np.asarray(res.x)
-        search.stage = "coalescence"
-        found = None if descending else _polish(search, ev_search, x_best)
-        if found is not None:
-            x_best, polished = found
-        L_best = search.gain(x_best)
-        if full:
-            wide = _Search(C, search.scale, True, robust, progress)
-            wide.stage = "full gain"
-            res = minimize(
-                lambda x: _bounded(wide.value(ev_verify, x), penalty),
-                wide.diagonal_params(x_best),
-                method="Nelder-Mead",
-                options={**options, "maxiter": maxiter * wide.n_params},
-            )
-            diagonal = search.value(ev_verify, x_best)
-            # only a clear gain over the diagonal optimum counts: near a coalescence the
-            # evaluated abscissa is noisy at the 1e-4 level
-            if res.fun < diagonal - 1e-3 * max(scales.rate, abs(diagonal)):
-                L_best, polished = wide.gain(res.x), None
-    except _Extinct as stop:
-        extinct = stop.L
+        )
+        if res.fun < found.f:
+            found = replace(found, x=np.asarray(res.x), f=float(res.fun), settled=res.success)
+    return found
+
+
+def _continuation(run: _Run, found: _Found, maxiter: int) -> _Found:
+    """Restart a best search that its iteration limit stopped (:func:`_continue`)."""
+    if found.settled:
+        return found
+    options = {"maxiter": maxiter, "xatol": 1e-5, "fatol": math.inf}
+    x, f, descending = _continue(
+        run.search, run.ev_search, found.x, found.f, run.penalty, options, run.rate
+    )
+    return replace(found, x=x, f=f, descending=descending)
+
+
+def _refinement(run: _Run, found: _Found, maxiter: int) -> _Found:
+    """Go on from the best point at the verification pair (when it is not the search's)."""
+    if run.ev_verify is run.ev_search:
+        return found
+    res = _nelder_mead(run, run.search, run.ev_verify, found.x, maxiter)
+    return replace(found, x=np.asarray(res.x))
+
+
+def _coalescence(run: _Run, found: _Found) -> _Found:
+    """Locate the coalescence the abscissa is minimized at (:func:`_polish`)."""
+    polished = None if found.descending else _polish(run.search, run.ev_search, found.x)
+    if polished is not None:
+        found = replace(found, x=polished[0], polished=polished[1])
+    return replace(found, gain=run.search.gain(found.x))
+
+
+def _full_gain(run: _Run, found: _Found, maxiter: int) -> _Found:
+    """From the diagonal optimum, search full gains; keep one only for a clear gain."""
+    if not run.full:
+        return found
+    search = run.search
+    wide = GainSearch(run.C, search.scale, True, search.robust, search.progress)
+    wide.stage = "full gain"
+    res = _nelder_mead(
+        run, wide, run.ev_verify, wide.diagonal_params(found.x), maxiter * wide.n_params
+    )
+    diagonal = search.value(run.ev_verify, found.x)
+    # only a clear gain over the diagonal optimum counts: near a coalescence the evaluated
+    # abscissa is noisy at the 1e-4 level
+    if res.fun < diagonal - 1e-3 * max(run.rate, abs(diagonal)):
+        return replace(found, gain=wide.gain(res.x), polished=None)
+    return found
+
+
+def _verify(run: _Run, found: _Found, start_time: float) -> TuneResult:
+    """Verify the gain found (its converged spectrum, a status) and measure its robustness."""
+    search = run.search
     search.stage = "verification"
-    search._tell(force=True)
-    L = extinct if extinct is not None else L_best
-    report = spectrum(nm, C, L, method=method)
-    status = "optimum"
-    if extinct is not None and report.unbounded_below:
+    search.tell(force=True)
+    if found.extinct is not None:
+        L = found.extinct
+    elif found.gain is not None:
+        L = found.gain
+    else:
+        L = search.gain(np.zeros(search.n_params))
+    report = spectrum(run.nm, run.C, L, method=run.method)
+    status, descent = "optimum", ""
+    if found.extinct is not None and report.unbounded_below:
         status = "extinction"
-    elif extinct is not None or descending:
+    elif found.extinct is not None or found.descending:
         # still improving when stopped, or stopped at an empty spectrum of the search pair
         # that the verification refutes: in neither case was an optimum located
         status = "descending"
-        descent = "empty spectrum" if extinct is not None else "restarts"
+        descent = "empty spectrum" if found.extinct is not None else "restarts"
     elif report.no_decay:
         status = "no decay"
     search.stage = "robustness"
-    search._tell(force=True)
-    box = robust if robust is not None else ROBUSTNESS_BOX
-    robustness: Robustness = worst_in_box(ev_verify, L, box)
+    search.tell(force=True)
+    robust = search.robust
+    robustness: Robustness = worst_in_box(
+        run.ev_verify, L, robust if robust is not None else ROBUSTNESS_BOX
+    )
+    ev_search, ev_verify = run.ev_search, run.ev_verify
     return TuneResult.from_report(
-        model=nm.name,
+        model=run.nm.name,
         gain=L,
         report=report,
         status=status,
-        starts=records,
+        starts=run.records,
         evaluations=ev_search.evaluations
         + (ev_verify.evaluations if ev_verify is not ev_search else 0),
         robustness=robustness,
-        coalescence=polished,
+        coalescence=found.polished,
         search_resolutions=ev_search.resolutions,
         robust=robust,
         seconds=time.perf_counter() - start_time,
