@@ -25,7 +25,8 @@ import scipy.linalg as sl
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize
-from phdesign.numeric.noise.figures import noise, noise_input
+from phdesign.numeric.noise.figures import noise
+from phdesign.numeric.noise.statistics import noise_input
 from phdesign.numeric.noise.tradeoff import tradeoff
 
 SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])

@@ -29,7 +29,8 @@ import numpy as np
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize
-from phdesign.numeric.noise.figures import error_statistics, noise
+from phdesign.numeric.noise.figures import noise
+from phdesign.numeric.noise.statistics import error_statistics
 from phdesign.numeric.noise.tradeoff import tradeoff
 from phdesign.numeric.spectrum.converged import spectrum
 from phdesign.numeric.time.stochastic import noisy_coupled_system, sampled_noise

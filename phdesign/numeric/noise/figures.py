@@ -59,12 +59,11 @@ The discretization's own supremum over all frequencies is reported beside it.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, MutableMapping, Sequence
-from dataclasses import dataclass, replace
+from collections.abc import MutableMapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from phdesign.core import limits
 from phdesign.core.checks import positive_int, positive_number
@@ -74,27 +73,20 @@ from phdesign.core.limits import check_noise_intensity
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
-from phdesign.numeric.noise.lyapunov import TriangularPencil, triangularize
+from phdesign.numeric.noise.gain import discrete_sup, gain_pair
 from phdesign.numeric.noise.report import GainEstimate, NoiseReport
 from phdesign.numeric.noise.settle import Estimate, settle
+from phdesign.numeric.noise.statistics import ErrorStatistics, error_statistics
 from phdesign.numeric.spectrum.converged import default_resolutions
-from phdesign.numeric.spectrum.drift import match_resolved
 
 __all__ = [
-    "ErrorStatistics",
     "GainEstimate",
     "NoiseReport",
     "check_intensity",
-    "error_statistics",
     "noise",
-    "noise_input",
     "noise_intensities",
-    "peak_gain",
     "sensor_rows",
 ]
-
-#: Grid maxima this far (relative) below the largest peak are not refined as its ties.
-_TIE_SCREEN = 1e-2
 
 
 def check_intensity(values: Any, count: int, name: str) -> np.ndarray:
@@ -150,185 +142,6 @@ def sensor_rows(C_m: Any, what: str) -> np.ndarray:
     if C.size == 0:
         raise ObserverError(f"{what}: sensors needed; give C_m with at least one row")
     return C
-
-
-def noise_input(
-    d: DiscretePHS,
-    C_m: np.ndarray,
-    L: np.ndarray,
-    intensity: np.ndarray,
-    input_intensity: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
-    r"""Return ``(A, G, labels)``: :math:`E \dot{\tilde e} = A \tilde e + G n`, n unit white.
-
-    The columns of G are the sensor channels :math:`-B(I+KD)^{-1} C_m^\top L \sigma_i`
-    and the input channels :math:`B (I+KD)^{-1} e_j \sqrt{w_j}` (module docstring);
-    channels of zero intensity are left out.
-    """
-    C = np.atleast_2d(np.asarray(C_m, dtype=float))
-    Lm = np.atleast_2d(np.asarray(L, dtype=float))
-    loop = d.close(feedback_matrix(C, Lm, d.n_ports))
-    A, BM = loop.A, loop.B  # B M = B (I + K D)⁻¹
-    columns = [-BM @ C.T @ Lm @ np.diag(np.sqrt(intensity))]
-    labels = [f"nu{i + 1}" for i in range(C.shape[0])]
-    keep = [bool(s > 0) for s in intensity]
-    if input_intensity is not None:
-        columns.append(BM @ np.diag(np.sqrt(input_intensity)))
-        labels += [f"w{j + 1}" for j in range(d.n_ports)]
-        keep += [bool(s > 0) for s in input_intensity]
-    G = np.hstack(columns)[:, keep]
-    return A, G, tuple(label for label, k in zip(labels, keep, strict=True) if k)
-
-
-@dataclass(frozen=True)
-class ErrorStatistics:
-    """Stationary statistics of the noise-driven error system at one resolution.
-
-    Attributes
-    ----------
-    discrete : DiscretePHS
-    pencil : TriangularPencil
-    covariance : ndarray or None
-        Stationary covariance of ẽ (None when the error system is not exponentially stable).
-    """
-
-    discrete: DiscretePHS
-    pencil: TriangularPencil
-    covariance: np.ndarray | None
-
-    @property
-    def resolution(self) -> int:
-        """The discretization's resolution."""
-        return self.discrete.resolution
-
-    @property
-    def eigenvalues(self) -> np.ndarray:
-        """Eigenvalues of the error system."""
-        return self.pencil.eigenvalues
-
-    @property
-    def stable(self) -> bool:
-        """Whether every eigenvalue lies strictly left of the imaginary axis."""
-        return self.covariance is not None
-
-    def variance(self, row: np.ndarray) -> float:
-        """Stationary variance of ``row @ ẽ`` (``inf`` without a steady state)."""
-        if self.covariance is None:
-            return math.inf
-        return float(max(row @ self.covariance @ row, 0.0))
-
-    def energy(self) -> float:
-        """Return the expected error energy ½ tr(E P) (``inf`` without a steady state)."""
-        if self.covariance is None:
-            return math.inf
-        return 0.5 * float(np.sum(self.discrete.E * self.covariance))
-
-
-def error_statistics(
-    d: DiscretePHS,
-    C_m: np.ndarray,
-    L: np.ndarray,
-    intensity: np.ndarray,
-    input_intensity: np.ndarray | None = None,
-    triangularization: str = "auto",
-) -> ErrorStatistics:
-    """Triangularize the noise-driven error system of ``d`` and solve its Lyapunov equation."""
-    A, G, _ = noise_input(d, C_m, L, intensity, input_intensity)
-    pencil = triangularize(A, d.E, G, triangularization)
-    lam = pencil.eigenvalues
-    stable = bool(np.all(lam.real < -1e-12 * np.maximum(1.0, np.abs(lam))))
-    return ErrorStatistics(d, pencil, pencil.covariance() if stable else None)
-
-
-def peak_gain(
-    response: Callable[[np.ndarray], np.ndarray],
-    response_at: Callable[[float], float],
-    upper: float,
-    eigenvalues: np.ndarray,
-    refine: int = 3,
-    rtol: float = 1e-7,
-    ties: float = 0.0,
-) -> tuple[float, float]:
-    """Return ``(gain, frequency)``: the largest ``response`` over ``0 <= omega <= upper``.
-
-    A sweep over 0, the eigenfrequencies in range and their half-power neighbours
-    (ω ± |Re λ|), and log- and linearly spaced points, then a bounded scalar refinement
-    (Brent, to ``rtol`` in ω: the peak value is then exact to about ``rtol``²
-    relative to the peak's width) of the ``refine`` highest local maxima between their
-    grid neighbours.
-
-    With ``ties > 0``, peaks within ``ties`` (relative) of the largest are equal: the
-    lowest-frequency one is returned, with its own value.  A PDE whose response has equal
-    peaks at infinitely many frequencies (the damped wave: one per resonance) attains its
-    supremum at the first; a discretization resolves that one best, while the highest it
-    happens to find may lie at the edge of what it resolves.
-    """
-    lam = eigenvalues[np.isfinite(eigenvalues)]
-    freqs = np.abs(lam.imag)
-    inside = freqs <= upper
-    width = np.abs(lam.real[inside])
-    hints = np.concatenate([freqs[inside], freqs[inside] + width, freqs[inside] - width])
-    grid = np.concatenate(
-        [
-            [0.0, upper],
-            hints,
-            np.geomspace(max(upper * 1e-6, 1e-12), upper, 100) if upper > 0 else [],
-            np.linspace(0.0, upper, 40),
-        ]
-    )
-    grid = np.unique(grid[(grid >= 0) & (grid <= upper)])
-    # conjugate eigenvalues give frequencies equal to round-off: one grid point each, or a
-    # local maximum would be bracketed by its own twin
-    grid = grid[np.r_[True, np.diff(grid) > 1e-12 * np.maximum(1.0, grid[1:])]]
-    values = response(grid)
-    interior = np.r_[True, values[1:] >= values[:-1]] & np.r_[values[:-1] >= values[1:], True]
-    maxima = np.flatnonzero(interior)
-
-    def refined(k: int) -> tuple[float, float]:
-        """Return the local maximum bracketed by the grid neighbours of point ``k``."""
-        point = (float(values[k]), float(grid[k]))
-        lo, hi = float(grid[max(k - 1, 0)]), float(grid[min(k + 1, grid.size - 1)])
-        if hi <= lo:
-            return point
-        found = minimize_scalar(
-            lambda w: -response_at(float(w)),
-            bounds=(lo, hi),
-            method="bounded",
-            options={"xatol": rtol * max(1.0, hi)},
-        )
-        return max(point, (-float(found.fun), float(found.x)))
-
-    highest = maxima[np.argsort(-values[maxima])[:refine]]
-    peaks = {int(k): refined(int(k)) for k in highest}
-    best = max(peaks.values())
-    if ties <= 0:
-        return best
-    # the lowest-frequency peak within `ties` of the largest; grid values are lower
-    # bounds of their peaks, so a grid maximum below the threshold can still reach it
-    threshold = (1.0 - ties) * best[0]
-    for k in (int(k) for k in maxima):
-        if grid[k] >= best[1]:
-            break
-        if values[k] < (1.0 - _TIE_SCREEN) * best[0]:
-            continue
-        peak = peaks.get(k) or refined(k)
-        if peak[0] >= threshold:
-            return peak
-    return best
-
-
-def _sup(
-    stats: ErrorStatistics, upper: float, refine: int = 3, ties: float = 0.0
-) -> tuple[float, float]:
-    pencil = stats.pencil
-    return peak_gain(
-        pencil.response, pencil.response_at, upper, stats.eigenvalues, refine, ties=ties
-    )
-
-
-def _resolved_band(fine: ErrorStatistics, coarse: ErrorStatistics, rtol: float) -> float | None:
-    idx, _ = match_resolved(fine.eigenvalues, coarse.eigenvalues, rtol)
-    return float(np.max(np.abs(fine.eigenvalues[idx]))) if idx.size else None
 
 
 def noise(
@@ -425,39 +238,6 @@ def noise(
     return run.report(nm, C, Lm, sigma, w_in, method)
 
 
-def _gain_pair(
-    coarse: ErrorStatistics, fine: ErrorStatistics, rtol: float, tol: float
-) -> dict[str, Any]:
-    r"""Return the fine member's peak over the pair's resolved band, and its check.
-
-    The band :math:`|\omega| \le \Omega` is where the two members' eigenvalues agree, so
-    :math:`\Omega` is the edge of what the *coarse* member resolves, while the fine member
-    is there only about :math:`p_c / p_f` of the way to its own edge.  The coarse member
-    is therefore compared on the trimmed band :math:`|\omega| \le (p_c/p_f)\,\Omega`,
-    where it is as far inside its resolution as the fine member is at :math:`\Omega`
-    (near the edge its response lags its eigenvalues: the tails of the unresolved
-    resonances just above).  Peaks within ``tol`` of the largest count as equal and the
-    lowest-frequency one is taken (:func:`peak_gain`): the figure cannot tell them apart,
-    and the first is the one both members resolve best.
-    """
-    out: dict[str, Any] = {"resolution": fine.resolution, "band": None}
-    if not (coarse.stable and fine.stable):
-        return out
-    band = _resolved_band(fine, coarse, rtol)
-    out["band"] = band
-    if band is not None:
-        out["fine"] = _sup(fine, band, ties=tol)
-        out["coarse"] = _sup(coarse, band * coarse.resolution / fine.resolution, ties=tol)
-    return out
-
-
-def _discrete_sup(stats: ErrorStatistics) -> tuple[float, float]:
-    """Supremum of the discretization's response over all frequencies (a diagnostic)."""
-    lam = stats.eigenvalues
-    top = float(np.max(np.abs(lam[np.isfinite(lam)]))) if lam.size else 1.0
-    return _sup(stats, 2.0 * top, refine=1)
-
-
 class _Refinement:
     """The figures at each resolution so far, and their verdicts."""
 
@@ -472,9 +252,9 @@ class _Refinement:
     def add(self, stats: ErrorStatistics, rows: list[np.ndarray], rtol: float) -> None:
         self.stats.append(stats)
         self.variances.append([stats.variance(r) for r in rows])
-        self.sups.append(_discrete_sup(stats) if stats.stable else (math.inf, math.nan))
+        self.sups.append(discrete_sup(stats) if stats.stable else (math.inf, math.nan))
         if len(self.stats) >= 2:
-            self.pairs.append(_gain_pair(self.stats[-2], stats, rtol, self.tol))
+            self.pairs.append(gain_pair(self.stats[-2], stats, rtol, self.tol))
 
     @property
     def steady(self) -> bool:

@@ -33,7 +33,7 @@ from phdesign.numeric.discretization.registry import DiscretePHS, feedback_matri
 from phdesign.numeric.noise.figures import noise, sensor_rows
 from phdesign.numeric.noise.report import NoiseReport, describe_gain, describe_sensors, html_table
 from phdesign.numeric.noise.settle import finite_or_none
-from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.numeric.spectrum.converged import SpectrumReport, spectrum
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.figure import Figure
@@ -380,10 +380,34 @@ def tradeoff(
             discretizations=cache,
         )
         rows.append((L, s, spec, rep))
+    points = _points(rows)
+    warnings = []
+    missing = sum(1 for point in points if point.noise.rms() is None)
+    if missing:
+        warnings.append(
+            f"{missing} of {len(points)} gains have no converged RMS of {functionals[0].name}: "
+            "they take no part in the Pareto comparison"
+        )
+    return Tradeoff(
+        model=nm.name,
+        sensors=C,
+        family="grid" if grid is not None else "ray",
+        direction=L0,
+        points=points,
+        performance=functionals[0].name,
+        intensity=points[0].noise.intensity,
+        output_labels=nm.output_labels,
+        warnings=tuple(warnings),
+    )
+
+
+def _points(
+    rows: list[tuple[np.ndarray, float | None, SpectrumReport, NoiseReport]],
+) -> tuple[TradeoffPoint, ...]:
+    """Return each gain's figures as a point, the Pareto-optimal ones marked."""
     decay = [None if r[2].spectral_abscissa is None else -r[2].spectral_abscissa for r in rows]
-    rms = [r[3].rms() for r in rows]
-    mask = pareto_mask(decay, rms)
-    points = tuple(
+    mask = pareto_mask(decay, [r[3].rms() for r in rows])
+    return tuple(
         TradeoffPoint(
             gain=L,
             scale=s,
@@ -394,22 +418,4 @@ def tradeoff(
             pareto=m,
         )
         for (L, s, spec, rep), m in zip(rows, mask, strict=True)
-    )
-    warnings = []
-    missing = sum(1 for r in rms if r is None)
-    if missing:
-        warnings.append(
-            f"{missing} of {len(rows)} gains have no converged RMS of {functionals[0].name}: "
-            "they take no part in the Pareto comparison"
-        )
-    return Tradeoff(
-        model=nm.name,
-        sensors=C,
-        family="grid" if grid is not None else "ray",
-        direction=L0,
-        points=points,
-        performance=functionals[0].name,
-        intensity=rows[0][3].intensity,
-        output_labels=nm.output_labels,
-        warnings=tuple(warnings),
     )

@@ -37,14 +37,15 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 
-from phdesign.core.defaults import current
+from phdesign.core.defaults import OrderDefaults, current
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
-from phdesign.numeric.discretization.registry import discretize, feedback_matrix
-from phdesign.numeric.noise.figures import error_statistics, noise, noise_intensities, sensor_rows
+from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
+from phdesign.numeric.noise.figures import noise, noise_intensities, sensor_rows
 from phdesign.numeric.noise.report import NoiseReport, describe_gain, html_table
 from phdesign.numeric.noise.settle import finite_or_none
+from phdesign.numeric.noise.statistics import error_statistics
 from phdesign.numeric.spectrum.abscissa import estimate_abscissa
 from phdesign.numeric.spectrum.converged import eigen, spectrum
 from phdesign.numeric.spectrum.drift import pair_spectrum
@@ -216,27 +217,74 @@ def tune_noise(
             f"noise-aware tuning needs a performance output and the model {nm.name!r} defines "
             "no displacement: give one (a trace like e1(1) or an integral like 'x2: 1')"
         )
-    start = noise(nm, C, np.eye(q), intensity=sigma, input_intensity=w_in, performance=functionals)
-    first = spectrum(nm, C, np.eye(q))
-    row = current().discretization(first.method, nm.order)
-    p_lo = first.resolutions[0] if first.converged else row.tune_fallback
-    # the agreement the starting figures were judged with: the method's noise tolerance
-    p_rms = max(_first_agreeing(e, row.noise_tol) or row.tune_fallback for e in start.performance)
-    # the variance is solved at the coarse member of the abscissa pair when it has converged
-    # there (one triangularization then gives both), else at its own resolution
-    p_lo = p_rms if p_rms <= p_lo else p_lo
-    pair = [discretize(nm, first.method, p) for p in (p_lo, math.ceil(1.5 * p_lo))]
-    d_rms = pair[0] if p_rms <= p_lo else discretize(nm, first.method, p_rms)
-    rows = [f.row(d_rms) for f in functionals]
-    count = [0]
+    problem = _Problem(nm, C, sigma, w_in, tuple(functionals), objective, bound)
+    merit = _Merit(problem, _Figures.at_converged_resolutions(problem))
+    best = _search(merit, q, log_range, maxiter)
+    return _verified(problem, best, merit.evaluations, maxiter)
 
-    def figures(x: np.ndarray) -> tuple[float | None, float]:
-        count[0] += 1
+
+@dataclass(frozen=True)
+class _Problem:
+    """What is tuned: sensors, noise, performance outputs, objective and its bound."""
+
+    nm: NumericModel
+    C: np.ndarray
+    sigma: np.ndarray
+    w_in: np.ndarray | None
+    functionals: tuple[Functional, ...]
+    objective: str
+    bound: float
+
+    def report(self, L: np.ndarray) -> NoiseReport:
+        """Return the noise figures at ``L``, refined (:func:`~.figures.noise`)."""
+        return noise(
+            self.nm,
+            self.C,
+            L,
+            intensity=self.sigma,
+            input_intensity=self.w_in,
+            performance=list(self.functionals),
+        )
+
+
+@dataclass(frozen=True)
+class _Figures:
+    """The search's abscissa (one resolution pair) and largest RMS (one resolution)."""
+
+    problem: _Problem
+    row: OrderDefaults  # the method's tolerances (the table's row)
+    pair: tuple[DiscretePHS, DiscretePHS]
+    d_rms: DiscretePHS
+    rows: tuple[np.ndarray, ...]
+
+    @classmethod
+    def at_converged_resolutions(cls, problem: _Problem) -> _Figures:
+        """Fix the resolutions where the figures converged for the starting gain L = I."""
+        nm, C, q = problem.nm, problem.C, problem.C.shape[0]
+        start = problem.report(np.eye(q))
+        first = spectrum(nm, C, np.eye(q))
+        row = current().discretization(first.method, nm.order)
+        p_lo = first.resolutions[0] if first.converged else row.tune_fallback
+        # the agreement the starting figures were judged with: the method's noise tolerance
+        p_rms = max(
+            _first_agreeing(e, row.noise_tol) or row.tune_fallback for e in start.performance
+        )
+        # the variance is solved at the coarse member of the abscissa pair when it has
+        # converged there (one triangularization then gives both), else at its own resolution
+        p_lo = p_rms if p_rms <= p_lo else p_lo
+        coarse, fine = (discretize(nm, first.method, p) for p in (p_lo, math.ceil(1.5 * p_lo)))
+        d_rms = coarse if p_rms <= p_lo else discretize(nm, first.method, p_rms)
+        rows = tuple(f.row(d_rms) for f in problem.functionals)
+        return cls(problem, row, (coarse, fine), d_rms, rows)
+
+    def __call__(self, x: np.ndarray) -> tuple[float | None, float]:
+        """Return the resolved abscissa and the largest RMS at L = diag(e^x)."""
+        p, row = self.problem, self.row
         L = np.diag(np.exp(np.clip(x, -30.0, 30.0)))
-        K = feedback_matrix(C, L, nm.n_ports)
-        stats = error_statistics(d_rms, C, L, sigma, w_in)
-        coarse = stats.eigenvalues if d_rms is pair[0] else eigen(pair[0], K)[0]
-        fine, kappa = eigen(pair[1], K, condition=True)
+        K = feedback_matrix(p.C, L, p.nm.n_ports)
+        stats = error_statistics(self.d_rms, p.C, L, p.sigma, p.w_in)
+        coarse = stats.eigenvalues if self.d_rms is self.pair[0] else eigen(self.pair[0], K)[0]
+        fine, kappa = eigen(self.pair[1], K, condition=True)
         drift = pair_spectrum(
             fine,
             coarse,
@@ -247,21 +295,43 @@ def tune_noise(
             dissipative=True,
         )
         alpha = estimate_abscissa(drift, row.abscissa_tol).value
-        return alpha, math.sqrt(max(stats.variance(r) for r in rows))
+        return alpha, math.sqrt(max(stats.variance(r) for r in self.rows))
 
-    def merit(x: np.ndarray) -> float:
-        alpha, rms = figures(x)
+
+class _Merit:
+    """The exact penalty f + μ max(0, g) of the normalized constraint g (module docstring)."""
+
+    def __init__(self, problem: _Problem, figures: _Figures) -> None:
+        self.problem, self.figures = problem, figures
+        self.evaluations = 0
+
+    def __call__(self, x: np.ndarray) -> float:
+        """Return the merit at L = diag(e^x), counting the evaluation."""
+        self.evaluations += 1
+        alpha, rms = self.figures(x)
         if alpha is None:  # nothing resolved: leave the region
             return 1e6
-        if objective == "abscissa":
+        bound = self.problem.bound
+        if self.problem.objective == "abscissa":
             return alpha + _PENALTY * max(1.0, abs(alpha)) * max(0.0, rms / bound - 1.0)
         return rms + _PENALTY * max(rms, 1e-300) * max(0.0, (alpha + bound) / bound)
 
+
+@dataclass(frozen=True)
+class _Best:
+    """The best point of the search, its merit, and whether its search was cut short."""
+
+    x: np.ndarray
+    merit: float
+    unsettled: bool = False
+
+
+def _search(merit: _Merit, q: int, log_range: tuple[float, float], maxiter: int) -> _Best:
+    """Grid of starts, then Brent (one gain) or Nelder-Mead from the two best starts."""
     grid = _start_grid(q, log_range)
     scores = [merit(x) for x in grid]
     order = np.argsort(scores)
-    best_x, best_f = grid[int(order[0])], float(scores[int(order[0])])
-    unsettled = False  # the best point came from a search stopped by its iteration limit
+    best = _Best(grid[int(order[0])], float(scores[int(order[0])]))
     if q == 1:  # Brent between the grid neighbours of the best start
         k = int(order[0])
         lo, hi = grid[max(k - 1, 0)][0], grid[min(k + 1, len(grid) - 1)][0]
@@ -271,24 +341,29 @@ def tune_noise(
             method="bounded",
             options={"xatol": 1e-6},
         )
-        if found.fun < best_f:
-            best_x, best_f = np.array([found.x]), float(found.fun)
-    else:
-        for i in order[:2]:
-            found = minimize(
-                merit,
-                grid[int(i)],
-                method="Nelder-Mead",
-                options={"maxiter": maxiter * q, "xatol": 1e-5, "fatol": 1e-9},
-            )
-            if found.fun < best_f:
-                best_x, best_f, unsettled = found.x, float(found.fun), not found.success
-    L = np.diag(np.exp(best_x))
-    spec = spectrum(nm, C, L)
-    report = noise(nm, C, L, intensity=sigma, input_intensity=w_in, performance=functionals)
+        if found.fun < best.merit:
+            best = _Best(np.array([found.x]), float(found.fun))
+        return best
+    for i in order[:2]:
+        found = minimize(
+            merit,
+            grid[int(i)],
+            method="Nelder-Mead",
+            options={"maxiter": maxiter * q, "xatol": 1e-5, "fatol": 1e-9},
+        )
+        if found.fun < best.merit:  # unsettled: stopped by its iteration limit
+            best = _Best(found.x, float(found.fun), not found.success)
+    return best
+
+
+def _verified(problem: _Problem, best: _Best, evaluations: int, maxiter: int) -> NoiseTuneResult:
+    """Verify the best gain with the adaptive spectrum and noise figures; say what failed."""
+    L = np.diag(np.exp(best.x))
+    spec = spectrum(problem.nm, problem.C, L)
+    report = problem.report(L)
     rms = _max_rms(report)
-    alpha = spec.spectral_abscissa
-    if objective == "abscissa":
+    alpha, bound = spec.spectral_abscissa, problem.bound
+    if problem.objective == "abscissa":
         feasible = rms is not None and rms <= bound * (1 + 1e-6)
     else:
         feasible = spec.unbounded_below or (alpha is not None and alpha <= -bound * (1 - 1e-6))
@@ -296,19 +371,20 @@ def tune_noise(
     if not feasible:
         warnings.append(
             "no gain found meets the constraint "
-            + (f"rms <= {bound:g}" if objective == "abscissa" else f"alpha <= {-bound:g}")
-            + f"; the best compromise found is reported (merit {best_f:.6g})"
+            + (f"rms <= {bound:g}" if problem.objective == "abscissa" else f"alpha <= {-bound:g}")
+            + f"; the best compromise found is reported (merit {best.merit:.6g})"
         )
     if rms is None:
         warnings.append("the error variance did not converge at the tuned gain")
-    if unsettled:
+    if best.unsettled:
+        q = problem.C.shape[0]
         warnings.append(
             f"the local search stopped at its iteration limit ({maxiter * q} steps) while "
             "still moving: the gain is the best found, possibly not a local optimum; raise "
             "maxiter"
         )
     return NoiseTuneResult(
-        objective=objective,
+        objective=problem.objective,
         bound=bound,
         gain=L,
         spectral_abscissa=alpha,
@@ -316,7 +392,7 @@ def tune_noise(
         feasible=bool(feasible),
         spectrum=spec,
         noise=report,
-        evaluations=count[0],
+        evaluations=evaluations,
         warnings=tuple(warnings),
     )
 

@@ -39,9 +39,11 @@ from phdesign.core.errors import NumericError, ObserverError
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize
-from phdesign.numeric.noise.figures import error_statistics, noise, noise_input, peak_gain
+from phdesign.numeric.noise.figures import noise
+from phdesign.numeric.noise.gain import peak_gain
 from phdesign.numeric.noise.lyapunov import hamiltonian_hinf_norm, triangularize
 from phdesign.numeric.noise.settle import settle
+from phdesign.numeric.noise.statistics import error_statistics, noise_input
 from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.stochastic import noisy_coupled_system, sampled_noise
 from phdesign.symbolic.model import BCPHS
