@@ -48,7 +48,7 @@ from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import initial_state_function
 from phdesign.numeric.sampled.export import export_observer, verify_observer
-from phdesign.numeric.sampled.order import balanced_truncation
+from phdesign.numeric.sampled.reduction import balanced_truncation
 from phdesign.numeric.sampled.samplers import ContinuousObserver
 from phdesign.numeric.sampled.simulation import simulate_sampled
 from phdesign.numeric.time.options import SimulationOptions
@@ -134,7 +134,7 @@ assert runs["average, 10 ms"].ratio < 10
 # recursion (the averaged observer's own state matrix).
 
 # %%
-from phdesign.numeric.sampled.samplers import run_against_continuous
+from phdesign.numeric.sampled.runs import run_against_continuous
 
 exact = ContinuousObserver.from_discretization(plant, C_m, L, (1.0,))
 _, _, (own, own_continuous), _ = run_against_continuous(
@@ -196,7 +196,8 @@ assert max(floors["average"][:4]) < 2 * continuous.continuous_floor  # up to 1 m
 # mean, zero error is not even invariant, and the error energy rises from step to step.
 
 # %%
-from phdesign.numeric.sampled.samplers import hold_discretization, run_loop, sample_plant
+from phdesign.numeric.sampled.runs import run_loop
+from phdesign.numeric.sampled.samplers import hold_discretization, sample_plant
 
 model16 = observer16.discrete  # plant = the observer's own model
 start = model16.project(x0)

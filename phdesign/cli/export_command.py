@@ -149,7 +149,8 @@ def _export(args: argparse.Namespace) -> int:
     from phdesign.core.limits import check_periods
     from phdesign.numeric.checks import check_sampling
     from phdesign.numeric.inputs import initial_state_function
-    from phdesign.numeric.sampled.export import export_observer, verification_plant_degree
+    from phdesign.numeric.sampled.export import export_observer
+    from phdesign.numeric.sampled.plant_resolution import verification_plant_degree
 
     dt = check_sampling(args.dt, args.sampler, dt_name="--dt")
     _finite_positive("--t-end", args.t_end)

@@ -238,14 +238,11 @@ class Observer:
         u : str or callable, optional
             Plant inputs: text such as ``"u2: sin(2*t)"`` or a function ``u(t)``.
         options : SimulationOptions, optional
-            How to run (:class:`~phdesign.numeric.time.options.SimulationOptions`).
+            How to run (:class:`~phdesign.numeric.time.options.SimulationOptions`: the
+            grid, the stepping, a sampled observer, noise); the discretization is the plant's.
         **settings
-            Its fields by name, over ``options``: ``t_end``, ``samples``, ``scheme``,
-            ``tol``, ``z_w``; ``dt``, ``sampler``, ``observer_resolution`` (a sampled or
-            lower-order observer, :func:`~phdesign.numeric.sampled.simulation.simulate_sampled`);
-            ``noise_intensity``, ``input_intensity``, ``seed`` (a noisy run,
-            :func:`~phdesign.numeric.time.stochastic.simulate_noisy`).  A name that is not
-            an option is refused; the discretization is the plant's.
+            Its fields by name, over ``options`` (``t_end=2``, ``dt=1e-3``,
+            ``noise_intensity=0.1`` ...); a name that is not a field is refused.
 
         Examples
         --------

@@ -23,7 +23,7 @@ which block holds each eigenvalue.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
@@ -403,29 +403,7 @@ def _report(
         design=design,
     )
     if a.value is None or a.uncertainty is None or a.attained is None:
-        extinct = extinct_twice(trail)
-        q = pair.resolutions[1]
-        warnings.append(
-            f"loop: no eigenvalue converges up to resolution {q}"
-            + (
-                ", and every eigenvalue runs off from the origin: the spectrum is empty, its "
-                "spectral abscissa unbounded below"
-                if extinct
-                else ": the loop's spectrum is not resolved at these resolutions"
-            )
-        )
-        return report(
-            spectral_abscissa=None,
-            converged=False,
-            digits=None,
-            rightmost=[],
-            condition_numbers=[],
-            origin=[],
-            n_resolved=0,
-            separation_gap=None,
-            unbounded_below=extinct,
-            warnings=warnings,
-        )
+        return _unresolved(trail, pair.resolutions[1], report, warnings)
     own, ill, no_decay = report_warnings(chosen, a.value, a.uncertainty, a.attained, tol)
     value, uncertainty = reported_value(a.value, a.uncertainty, no_decay)
     warnings += [f"loop: {w}" for w in notes + own]
@@ -433,21 +411,7 @@ def _report(
     top = rightmost_indices(chosen, count)
     kappa = pair.condition if pair.condition is not None else np.ones(lam.shape)
     rightmost = [complex(z) for z in lam[top]]
-    slower = max(
-        (r for r in (plant, error) if r.spectral_abscissa is not None),
-        key=lambda r: r.spectral_abscissa or -math.inf,
-        default=None,
-    )
-    gap = None
-    if slower is not None and slower.spectral_abscissa is not None:
-        gap = value - slower.spectral_abscissa
-        scale = max(pair.scale, abs(value))
-        allowed = max(10.0 * (uncertainty + (slower.uncertainty or 0.0)), 1e-8 * scale)
-        if abs(gap) > allowed:
-            warnings.append(
-                f"the loop's abscissa differs from max(plant, error) by {gap:.2g}, beyond its "
-                "resolved digits: the separation structure is not reproduced (report this)"
-            )
+    gap = _separation_gap(value, uncertainty, pair.scale, plant, error, warnings)
     return report(
         spectral_abscissa=value,
         converged=chosen.converged,
@@ -461,3 +425,65 @@ def _report(
         warnings=warnings,
         uncertainty=uncertainty,
     )
+
+
+def _unresolved(
+    trail: list[PairResult],
+    resolution: int,
+    report: Callable[..., LoopSpectrum],
+    warnings: list[str],
+) -> LoopSpectrum:
+    """Return the report of a loop whose spectrum no pair resolved (or which is empty)."""
+    extinct = extinct_twice(trail)
+    warnings.append(
+        f"loop: no eigenvalue converges up to resolution {resolution}"
+        + (
+            ", and every eigenvalue runs off from the origin: the spectrum is empty, its "
+            "spectral abscissa unbounded below"
+            if extinct
+            else ": the loop's spectrum is not resolved at these resolutions"
+        )
+    )
+    return report(
+        spectral_abscissa=None,
+        converged=False,
+        digits=None,
+        rightmost=[],
+        condition_numbers=[],
+        origin=[],
+        n_resolved=0,
+        separation_gap=None,
+        unbounded_below=extinct,
+        warnings=warnings,
+    )
+
+
+def _separation_gap(
+    value: float,
+    uncertainty: float,
+    scale: float,
+    plant: SpectrumReport,
+    error: SpectrumReport,
+    warnings: list[str],
+) -> float | None:
+    """Return the loop's abscissa minus the slower block's; warn beyond the resolved digits.
+
+    By separation the loop's spectrum is the union of the blocks' (module docstring).
+    """
+    slower = max(
+        (r for r in (plant, error) if r.spectral_abscissa is not None),
+        key=lambda r: r.spectral_abscissa or -math.inf,
+        default=None,
+    )
+    if slower is None or slower.spectral_abscissa is None:
+        return None
+    gap = value - slower.spectral_abscissa
+    allowed = max(
+        10.0 * (uncertainty + (slower.uncertainty or 0.0)), 1e-8 * max(scale, abs(value))
+    )
+    if abs(gap) > allowed:
+        warnings.append(
+            f"the loop's abscissa differs from max(plant, error) by {gap:.2g}, beyond its "
+            "resolved digits: the separation structure is not reproduced (report this)"
+        )
+    return gap

@@ -44,12 +44,16 @@ from phdesign.core.errors import ArgumentError, NumericError
 from phdesign.core.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_initial_state, check_sampling
-from phdesign.numeric.sampled.order import REDUCTIONS, OrderSelection, check_order, select_order
+from phdesign.numeric.discretization.phs import DiscretePHS
+from phdesign.numeric.discretization.registry import discretize
+from phdesign.numeric.sampled.order import REDUCTIONS, select_order
+from phdesign.numeric.sampled.plant_resolution import verification_plant_degree
 from phdesign.numeric.sampled.samplers import (
     ContinuousObserver,
     default_initial_state,
     displacement_label,
 )
+from phdesign.numeric.sampled.selection import OrderSelection
 from phdesign.numeric.sampled.verification import (
     Verification,
     plant_gap,
@@ -64,7 +68,6 @@ __all__ = [
     "Verification",
     "displacement_points",
     "export_observer",
-    "verification_plant_degree",
     "verify_observer",
 ]
 
@@ -253,51 +256,6 @@ class SampledObserver:
         return self.verification.plot(ax)
 
 
-def verification_plant_degree(
-    nm: NumericModel, order: int | None, plant_resolution: int | None, reduction: str = "none"
-) -> int:
-    """Degree of the verification plant: given, or the export's default raised to 2x the order.
-
-    Checks the whole request first (:func:`phdesign.numeric.sampled.order.check_order`), so that a
-    command refuses it before any computation.
-    """
-    degree = _plant_degree(nm, order, plant_resolution)
-    check_order(
-        order,
-        nm.size * (degree + 1),
-        degree,
-        reduction=reduction,
-        size=nm.size,
-        smallest=nm.size * (nm.order + 2),
-    )
-    return degree
-
-
-def _plant_degree(nm: NumericModel, order: int | None, plant_resolution: int | None) -> int:
-    if plant_resolution is not None:
-        if isinstance(plant_resolution, bool) or not isinstance(plant_resolution, int):
-            raise NumericError(f"plant_resolution must be an integer; found {plant_resolution!r}")
-        if plant_resolution < nm.order + 1:
-            raise NumericError(
-                f"plant_resolution must be at least N + 1 = {nm.order + 1}; found "
-                f"{plant_resolution}"
-            )
-        return plant_resolution
-    if order is None or isinstance(order, bool) or not isinstance(order, int) or order < 1:
-        return current().export.plant_degree
-    from phdesign.numeric.spectrum.converged import default_resolutions
-
-    needed = -(-2 * order // nm.size) - 1
-    largest = default_resolutions(nm, "galerkin")[1]
-    if needed > largest:
-        raise NumericError(
-            f"order {order} needs a verification plant of at least {2 * order} states; the "
-            f"largest for this model has {nm.size * (largest + 1)} (Galerkin degree "
-            f"{largest}): lower the order"
-        )
-    return max(current().export.plant_degree, needed)
-
-
 def displacement_points(nm: NumericModel, points: Any, name: str = "points") -> tuple[float, ...]:
     """Return the points of the outputs ``w(z)``: numbers of [a, b] (default: b, if any).
 
@@ -399,57 +357,30 @@ def export_observer(
     >>> obs.order, obs.inputs, obs.outputs
     (12, ('u1', 'u2', 'y2'), ('yhat1', 'yhat2'))
     """
-    from phdesign.numeric.discretization.registry import discretize
-
     sampler, tol, output_tol, t_end = current().export.fill(sampler, tol, output_tol, t_end)
-    dt = check_sampling(dt, sampler)
-    if reduction not in REDUCTIONS:
-        raise NumericError(f"unknown reduction {reduction!r}; expected one of {REDUCTIONS}")
-    if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):
-        raise NumericError(f"t_end must be a finite positive number; found {t_end!r}")
-    if not isinstance(verify, bool):
-        raise ArgumentError(f"verify must be True or False; found {verify!r}")
-    check_periods(dt, float(t_end), stepped=verify)
-    positive_number(tol, "tol")
-    positive_number(output_tol, "output_tol")
-    check_initial_state(x0, nm, "x0")
-    plant_degree = verification_plant_degree(nm, order, plant_resolution, reduction)
+    dt = _checked_request(nm, dt, sampler, reduction, t_end, verify, tol, output_tol, x0)
+    plant = discretize(
+        nm, "galerkin", verification_plant_degree(nm, order, plant_resolution, reduction)
+    )
     points = displacement_points(nm, points)
-    plant = discretize(nm, "galerkin", plant_degree)
     initial = default_initial_state(nm.size, nm.interval) if x0 is None else x0
     text = x0_text or ("x_i = (z - a)/(b - a) - 0.9 for every component" if x0 is None else "x0")
     e0 = plant.project(initial)
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
     Lm = np.atleast_2d(np.asarray(L, dtype=float))
     selection, continuous = select_order(
-        nm,
-        C,
-        Lm,
-        plant=plant,
-        x0=e0,
-        t_end=float(t_end),
-        points=tuple(points),
-        order=order,
-        reduction=reduction,
-        tol=tol,
-        output_tol=output_tol,
-    )
+        nm, C, Lm, plant=plant, x0=e0, t_end=float(t_end), points=tuple(points), order=order,
+        reduction=reduction, tol=tol, output_tol=output_tol,
+    )  # fmt: skip
     discrete = continuous.sampled(dt, sampler)
     verification = None
-    missed = selection.floor > selection.output_tol  # is it the plant's own resolution?
     if verify:
         verification = verify_observer(
             plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=float(t_end), x0_text=text
         )
-    if verification is not None or missed:
-        # one finer plant serves both checks, on the verification's records when there are any
-        samples = current().simulation.samples
-        t = np.linspace(0.0, float(t_end), samples) if verification is None else verification.t
-        found = plant_gap(nm, plant, continuous, initial, t)
-        if verification is not None:
-            verification = with_plant_gap(verification, found, plant.resolution)
-        if missed:
-            selection = with_target_check(selection, found, plant.resolution, text)
+    selection, verification = _plant_checks(
+        nm, plant, continuous, initial, float(t_end), text, selection, verification
+    )
     return SampledObserver(
         model=model_name or nm.name,
         dt=dt,
@@ -465,3 +396,56 @@ def export_observer(
         verification=verification,
         continuous=continuous,
     )
+
+
+def _checked_request(
+    nm: NumericModel,
+    dt: Any,
+    sampler: str,
+    reduction: str,
+    t_end: Any,
+    verify: Any,
+    tol: Any,
+    output_tol: Any,
+    x0: Any,
+) -> float:
+    """Refuse a bad request before any work; return the sampling period."""
+    period = check_sampling(dt, sampler)
+    if reduction not in REDUCTIONS:
+        raise NumericError(f"unknown reduction {reduction!r}; expected one of {REDUCTIONS}")
+    if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):
+        raise NumericError(f"t_end must be a finite positive number; found {t_end!r}")
+    if not isinstance(verify, bool):
+        raise ArgumentError(f"verify must be True or False; found {verify!r}")
+    check_periods(period, float(t_end), stepped=verify)
+    positive_number(tol, "tol")
+    positive_number(output_tol, "output_tol")
+    check_initial_state(x0, nm, "x0")
+    return period
+
+
+def _plant_checks(
+    nm: NumericModel,
+    plant: DiscretePHS,
+    continuous: ContinuousObserver,
+    initial: Callable[[np.ndarray], np.ndarray],
+    t_end: float,
+    text: str,
+    selection: OrderSelection,
+    verification: Verification | None,
+) -> tuple[OrderSelection, Verification | None]:
+    """Check the verification and a missed target against a finer plant (its own resolution?).
+
+    One finer plant serves both checks, on the verification's records when there are any.
+    """
+    missed = selection.floor > selection.output_tol  # is it the plant's own resolution?
+    if verification is None and not missed:
+        return selection, verification
+    samples = current().simulation.samples
+    t = np.linspace(0.0, t_end, samples) if verification is None else verification.t
+    found = plant_gap(nm, plant, continuous, initial, t)
+    if verification is not None:
+        verification = with_plant_gap(verification, found, plant.resolution)
+    if missed:
+        selection = with_target_check(selection, found, plant.resolution, text)
+    return selection, verification

@@ -1,4 +1,8 @@
-r"""Whether the verification plant resolves its own performance outputs from the initial state.
+r"""The verification plant: its degree, and whether it resolves its own outputs.
+
+:func:`verification_plant_degree` is the Galerkin degree of the plant an exported observer
+is measured against: given, or the export's default (:mod:`phdesign.core.defaults`)
+raised to twice the observer's order.
 
 The verification (:func:`phdesign.numeric.sampled.verification.verify_observer`) measures the
 observer
@@ -33,10 +37,68 @@ from collections.abc import Callable
 import numpy as np
 import scipy.linalg as sl
 
+from phdesign.core.defaults import current
+from phdesign.core.errors import NumericError
+from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.phs import DiscretePHS
-from phdesign.numeric.sampled.samplers import FLOOR_WINDOW, ContinuousObserver, plant_targets
+from phdesign.numeric.discretization.registry import discretize
+from phdesign.numeric.sampled.order import check_order
+from phdesign.numeric.sampled.runs import FLOOR_WINDOW, plant_targets
+from phdesign.numeric.sampled.samplers import ContinuousObserver
+from phdesign.numeric.spectrum.converged import default_resolutions
 
-__all__ = ["GAP_RATIO", "free_outputs", "gap_warning", "plant_resolution_gap", "target_warning"]
+__all__ = [
+    "GAP_RATIO",
+    "free_outputs",
+    "gap_warning",
+    "plant_resolution_gap",
+    "target_warning",
+    "verification_plant_degree",
+]
+
+
+def verification_plant_degree(
+    nm: NumericModel, order: int | None, plant_resolution: int | None, reduction: str = "none"
+) -> int:
+    """Degree of the verification plant: given, or the export's default raised to 2x the order.
+
+    Checks the whole request first (:func:`phdesign.numeric.sampled.order.check_order`), so that a
+    command refuses it before any computation.
+    """
+    degree = _plant_degree(nm, order, plant_resolution)
+    check_order(
+        order,
+        nm.size * (degree + 1),
+        degree,
+        reduction=reduction,
+        size=nm.size,
+        smallest=nm.size * (nm.order + 2),
+    )
+    return degree
+
+
+def _plant_degree(nm: NumericModel, order: int | None, plant_resolution: int | None) -> int:
+    if plant_resolution is not None:
+        if isinstance(plant_resolution, bool) or not isinstance(plant_resolution, int):
+            raise NumericError(f"plant_resolution must be an integer; found {plant_resolution!r}")
+        if plant_resolution < nm.order + 1:
+            raise NumericError(
+                f"plant_resolution must be at least N + 1 = {nm.order + 1}; found "
+                f"{plant_resolution}"
+            )
+        return plant_resolution
+    if order is None or isinstance(order, bool) or not isinstance(order, int) or order < 1:
+        return current().export.plant_degree
+    needed = -(-2 * order // nm.size) - 1
+    largest = default_resolutions(nm, "galerkin")[1]
+    if needed > largest:
+        raise NumericError(
+            f"order {order} needs a verification plant of at least {2 * order} states; the "
+            f"largest for this model has {nm.size * (largest + 1)} (Galerkin degree "
+            f"{largest}): lower the order"
+        )
+    return max(current().export.plant_degree, needed)
+
 
 #: The plant's own resolution gap, relative to the continuous floor, above which it is said.
 GAP_RATIO = 0.5
@@ -70,8 +132,6 @@ def plant_resolution_gap(
     ``largest`` bounds the finer degree (the model's largest Galerkin resolution); None when
     the plant is already there and no finer plant exists.
     """
-    from phdesign.numeric.discretization.registry import discretize
-
     finer_degree = min(-(-3 * plant.resolution // 2), largest)
     if finer_degree <= plant.resolution:
         return None

@@ -5,7 +5,7 @@ implementation questions: the observer may have its own Galerkin degree (lower t
 plant's, as on a controller) and may be sampled at a period Δt by a declared sampler
 (:mod:`phdesign.numeric.sampled.samplers`), so that continuous, averaged and point-sampled
 observers can be compared on the same plant. Everything is stepped exactly
-(:func:`phdesign.numeric.sampled.samplers.run_loop`); plant inputs are held over each period.
+(:func:`phdesign.numeric.sampled.runs.run_loop`); plant inputs are held over each period.
 
 Energies: :math:`H = \tfrac12 \hat e^\top E \hat e` (plant),
 :math:`\hat H = \tfrac12 \hat x^\top Q \hat x` (observer) and
@@ -28,12 +28,8 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import input_samples
-from phdesign.numeric.sampled.samplers import (
-    ContinuousObserver,
-    LoopRun,
-    run_against_continuous,
-    run_loop,
-)
+from phdesign.numeric.sampled.runs import LoopRun, run_against_continuous, run_loop
+from phdesign.numeric.sampled.samplers import ContinuousObserver
 from phdesign.numeric.time.options import SAMPLED_SCHEME, SimulationOptions
 from phdesign.numeric.time.result import SimulationResult
 

@@ -20,11 +20,10 @@ from phdesign.core.defaults import current
 from phdesign.core.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_sampling
-from phdesign.numeric.sampled.order import OrderSelection, check_order
-from phdesign.numeric.sampled.samplers import (
-    ContinuousObserver,
-    run_against_continuous,
-)
+from phdesign.numeric.sampled.order import check_order
+from phdesign.numeric.sampled.runs import run_against_continuous
+from phdesign.numeric.sampled.samplers import ContinuousObserver
+from phdesign.numeric.sampled.selection import OrderSelection
 
 __all__ = ["Verification", "plant_gap", "verify_observer", "with_plant_gap", "with_target_check"]
 
@@ -159,7 +158,7 @@ def verify_observer(
 ) -> Verification:
     """Run the sampled and the continuous observer against ``plant`` from ``x0``.
 
-    Both are stepped exactly (:func:`phdesign.numeric.sampled.samplers.run_loop`) over
+    Both are stepped exactly (:func:`phdesign.numeric.sampled.runs.run_loop`) over
     round(t_end / dt) periods, the sampler applied to the plant's outputs, and recorded
     on the same instants (every ``stride`` periods, about ``samples`` records; default
     the simulations', :mod:`phdesign.core.defaults`).

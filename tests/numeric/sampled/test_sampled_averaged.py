@@ -19,7 +19,8 @@ from scipy.integrate import solve_ivp
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize
-from phdesign.numeric.sampled.samplers import ContinuousObserver, run_loop
+from phdesign.numeric.sampled.runs import run_loop
+from phdesign.numeric.sampled.samplers import ContinuousObserver
 
 BEAM_SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
 BEAM_GAIN = np.diag([0.1, 1.0])

@@ -20,10 +20,12 @@ from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.sampled import order as order_module
+from phdesign.numeric.sampled import reduction as reduction_module
 from phdesign.numeric.sampled.export import export_observer, verify_observer
-from phdesign.numeric.sampled.order import balanced_truncation, select_order
-from phdesign.numeric.sampled.samplers import ContinuousObserver, run_against_continuous
+from phdesign.numeric.sampled.order import select_order
+from phdesign.numeric.sampled.reduction import balanced_truncation
+from phdesign.numeric.sampled.runs import run_against_continuous
+from phdesign.numeric.sampled.samplers import ContinuousObserver
 
 SENSORS = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
 GAIN = np.diag([0.1, 1.0])
@@ -258,7 +260,7 @@ def test_balanced_truncation_obeys_the_twice_the_tail_bound(wave):
 def test_balanced_truncation_without_slycot_says_how_to_get_it(wave, monkeypatch):
     nm, C_m, L, *_ = wave
     observer = ContinuousObserver.from_discretization(discretize(nm, "galerkin", 6), C_m, L)
-    monkeypatch.setattr(order_module, "_slycot_available", lambda: False)
+    monkeypatch.setattr(reduction_module, "_slycot_available", lambda: False)
     with pytest.raises(NumericError, match=r"needs slycot .* pip install slycot"):
         balanced_truncation(observer)
 
