@@ -15,6 +15,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.model import BCPHS
 
 __all__ = [
+    "add_discretization_arguments",
     "add_json_argument",
     "add_method_argument",
     "add_model_argument",
@@ -63,6 +64,22 @@ def add_json_argument(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="print JSON instead of text (keys: see the command-line reference)",
     )
+
+
+def add_discretization_arguments(
+    parser: argparse.ArgumentParser, resolution_default: str | None = None
+) -> None:
+    """Add ``--method`` (:func:`add_method_argument`) and, unless ``None``, ``--resolution``.
+
+    ``resolution_default`` says what the command uses without ``--resolution`` (empty: not
+    stated).
+    """
+    add_method_argument(parser)
+    if resolution_default is not None:
+        hint = f" ({resolution_default})" if resolution_default else ""
+        parser.add_argument(
+            "--resolution", type=int, metavar="N", help=f"degree / nodes per group{hint}"
+        )
 
 
 def parse_parameter_overrides(items: list[str]) -> dict[str, str]:

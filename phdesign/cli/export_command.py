@@ -24,13 +24,11 @@ from phdesign.cli.common import (
     load_model,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
+from phdesign.core.checks import EXPORT_FORMATS, REDUCTIONS, SAMPLERS
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError, ObserverError, OutputFileError
 
 __all__ = ["add_sampling_arguments", "register", "sampling_options"]
-
-SAMPLER_CHOICES = ("average", "point")  # phdesign.numeric.checks.SAMPLERS, without numpy
-FORMAT_CHOICES = ("json", "c", "npz", "statespace")  # phdesign.codegen.FORMATS
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
@@ -46,7 +44,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     ex.add_argument("--dt", type=float, required=True, metavar="DT", help="sampling period (s)")
     ex.add_argument(
         "--sampler",
-        choices=SAMPLER_CHOICES,
+        choices=SAMPLERS,
         default=export.sampler,
         help="the controller's front end: mean of the outputs over each period (default) "
         "or point samples",
@@ -56,7 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     ex.add_argument(
         "--reduce",
-        choices=("none", "modal", "balanced"),
+        choices=REDUCTIONS,
         default="none",
         help="drop the unresolved modes (modal) or balance and truncate (balanced, needs "
         "slycot); default none",
@@ -75,7 +73,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "%(default)g)",
     )
     ex.add_argument(
-        "--format", choices=FORMAT_CHOICES, required=True, help="what to write to -o PATH"
+        "--format", choices=EXPORT_FORMATS, required=True, help="what to write to -o PATH"
     )
     ex.add_argument(
         "--output", "-o", required=True, metavar="PATH", help="file (a folder for --format c)"
@@ -207,7 +205,7 @@ def add_sampling_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--sampler",
-        choices=SAMPLER_CHOICES,
+        choices=SAMPLERS,
         help="front end of the sampled observer: mean over each period (default) or point",
     )
     parser.add_argument(

@@ -12,8 +12,8 @@ import argparse
 from typing import Any
 
 from phdesign.cli.common import (
+    add_discretization_arguments,
     add_json_argument,
-    add_method_argument,
     add_model_argument,
     check_finite_series,
     check_positive,
@@ -84,7 +84,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
 
     sp = sub.add_parser("spectrum", help="converged spectrum of the assembled loop")
     _loop_arguments(sp)
-    _numeric_arguments(sp)
+    add_discretization_arguments(sp, "")
     sp.add_argument("--tol", type=float, help="required agreement of the abscissa")
     sp.add_argument(
         "--count",
@@ -97,7 +97,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
 
     sim = sub.add_parser("simulate", help="simulate plant, observer and feedback together")
     _loop_arguments(sim)
-    _numeric_arguments(sim)
+    add_discretization_arguments(sim, "")
     sim.add_argument("--x0", metavar="EXPRS", help="plant initial state, e.g. 'x1: 0, x2: z'")
     sim.add_argument("--xhat0", metavar="EXPRS", help="observer initial state (default zero)")
     sim.add_argument(
@@ -128,11 +128,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     tn.add_argument("--seed", type=int, default=0, help="seed of the random starts")
     add_json_argument(tn)
     tn.set_defaults(handler=_tune)
-
-
-def _numeric_arguments(parser: argparse.ArgumentParser) -> None:
-    add_method_argument(parser)
-    parser.add_argument("--resolution", type=int, metavar="N", help="degree / nodes per group")
 
 
 def _loop(args: argparse.Namespace, numeric: bool = True) -> Any:

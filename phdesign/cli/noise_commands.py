@@ -26,8 +26,8 @@ import math
 from typing import Any
 
 from phdesign.cli.common import (
+    add_discretization_arguments,
     add_json_argument,
-    add_method_argument,
     add_model_argument,
     check_positive,
     emit_result,
@@ -89,8 +89,6 @@ def _add_performance_arguments(parser: argparse.ArgumentParser) -> None:
 
 def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """Add the ``noise`` and ``tradeoff`` commands."""
-    from phdesign.cli.numeric_commands import _add_discretization
-
     nz = subparsers.add_parser(
         "noise",
         help="what a gain costs in sensor noise: error variances, L2-gain, error energy",
@@ -98,7 +96,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     add_model_argument(nz)
     add_observer_arguments(nz)
     add_noise_arguments(nz)
-    _add_discretization(nz, "first of the refinement")
+    add_discretization_arguments(nz, "first of the refinement")
     nz.add_argument("--tol", type=float, help="relative agreement of a converged figure")
     add_json_argument(nz)
     nz.add_argument("--plot", metavar="FILE", help="draw the frequency response to FILE")
@@ -126,7 +124,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "--scales", metavar="LO:HI:N", help="scales s of the ray, log-spaced (default 0.1:10:12)"
     )
     add_noise_arguments(tr)
-    add_method_argument(tr)
+    add_discretization_arguments(tr)
     fmt = tr.add_mutually_exclusive_group()
     fmt.add_argument("--csv", action="store_true", help="CSV table")
     fmt.add_argument("--json", action="store_true", help="JSON output")

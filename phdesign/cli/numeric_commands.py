@@ -18,8 +18,8 @@ import sys
 from typing import Any
 
 from phdesign.cli.common import (
+    add_discretization_arguments,
     add_json_argument,
-    add_method_argument,
     add_model_argument,
     check_finite_series,
     check_positive,
@@ -47,13 +47,6 @@ __all__ = ["register"]
 TUNE_STARTS = 2
 
 
-def _add_discretization(parser: argparse.ArgumentParser, default_hint: str) -> None:
-    add_method_argument(parser)
-    parser.add_argument(
-        "--resolution", type=int, metavar="N", help=f"degree / nodes per group ({default_hint})"
-    )
-
-
 def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """Add the numeric commands."""
     sp = subparsers.add_parser(
@@ -63,7 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     add_model_argument(sp)
     add_observer_arguments(sp, required=True)
     table = current()
-    _add_discretization(sp, "default: the first of the refinement pairs")
+    add_discretization_arguments(sp, "default: the first of the refinement pairs")
     sp.add_argument(
         "--max-resolution",
         type=int,
@@ -91,7 +84,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     add_model_argument(sim)
     add_observer_arguments(sim)
-    _add_discretization(sim, f"default: {table.describe('resolution')}")
+    add_discretization_arguments(sim, f"default: {table.describe('resolution')}")
     sim.add_argument(
         "--x0",
         metavar="EXPRS",

@@ -25,6 +25,9 @@ from collections.abc import Sequence
 from phdesign.core.errors import ArgumentError, NumericError, PhdesignError
 
 __all__ = [
+    "EXPORT_FORMATS",
+    "REDUCTIONS",
+    "SAMPLERS",
     "choice",
     "found_text",
     "not_bytes",
@@ -32,6 +35,19 @@ __all__ = [
     "positive_number",
     "require_path",
 ]
+
+
+#: The samplers a controller's front end may have; the first is the default
+#: (:mod:`phdesign.numeric.sampled.samplers`).  Here, with the export formats, so that the
+#: command line offers them as choices without loading the numeric layer.
+SAMPLERS = ("average", "point")
+
+#: How an exported observer's order is reduced
+#: (:func:`phdesign.numeric.sampled.order.select_order`).
+REDUCTIONS = ("none", "modal", "balanced")
+
+#: The formats an exported observer is written in (:func:`phdesign.codegen.write_observer`).
+EXPORT_FORMATS = ("json", "c", "npz", "statespace")
 
 
 def found_text(value: object) -> str:

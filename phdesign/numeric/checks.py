@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core import limits
-from phdesign.core.checks import choice, positive_int, positive_number
+from phdesign.core.checks import SAMPLERS, choice, positive_int, positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError, ObserverError
 from phdesign.numeric.bridge import require_numeric_model
@@ -45,10 +45,6 @@ __all__ = [
     "check_spectrum_arguments",
     "check_tune_arguments",
 ]
-
-
-#: The samplers a controller's front end may have; the first is the default.
-SAMPLERS = ("average", "point")
 
 
 def check_sampling(dt: object, sampler: object, *, dt_name: str = "dt") -> float:

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.core.checks import positive_number
+from phdesign.core.checks import EXPORT_FORMATS, positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError
 from phdesign.core.limits import check_periods
@@ -72,7 +72,7 @@ __all__ = [
 ]
 
 #: Export formats of :meth:`SampledObserver.write`.
-FORMATS = ("json", "c", "npz", "statespace")
+FORMATS = EXPORT_FORMATS
 
 
 def _matrix(a: np.ndarray) -> list[list[float]]:
@@ -337,7 +337,8 @@ def export_observer(
     t_end : float, optional
         Length of those runs (5 s).
     plant_resolution : int, optional
-        Galerkin degree of the verification plant (default 48, raised to twice the order).
+        Galerkin degree of the verification plant (default the table's
+        ``export.plant_degree``, raised to twice the order: :mod:`phdesign.core.defaults`).
     points : float or sequence of float, optional
         Displacement points of the outputs ``w(z)``; default (b,) for a model with a
         displacement, none otherwise.

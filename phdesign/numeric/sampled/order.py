@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from phdesign.core.checks import REDUCTIONS
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
@@ -65,7 +66,6 @@ __all__ = [
     "select_order",
 ]
 
-REDUCTIONS = ("none", "modal", "balanced")
 #: Records of the continuous run that measures a candidate's performance floor.
 FLOOR_RECORDS = 500
 
