@@ -13,7 +13,8 @@ dependencies (dask, xarray, zarr) are imported only when a sweep runs: install t
 the ``sweep`` extra, ``pip install "phdesign[sweep]"``.
 
 Modules: :mod:`~phdesign.sweep.grids` (axes), :mod:`~phdesign.sweep.jobs` (the job
-registry), :mod:`~phdesign.sweep.description` (what a sweep computes),
+registry), :mod:`~phdesign.sweep.description` (what a sweep computes, its stored fields
+checked by :mod:`~phdesign.sweep.fields`),
 :mod:`~phdesign.sweep.plan` (chunks), :mod:`~phdesign.sweep.schedulers` (where they run),
 :mod:`~phdesign.sweep.execute` (running them), :mod:`~phdesign.sweep.store` (Zarr),
 :mod:`~phdesign.sweep.export` (CSV, NetCDF), :mod:`~phdesign.sweep.summary` (the printed

@@ -42,6 +42,7 @@ from typing import Any
 
 from phdesign.core.errors import ParameterError, PhdesignError, SweepError
 from phdesign.core.limits import MAX_STORE_METADATA_BYTES, check_sweep_points
+from phdesign.sweep.fields import description_fields
 from phdesign.sweep.grids import Axis, parse_axis, parse_sensor_sets, sensor_set_indices
 from phdesign.sweep.jobs import Job, get_job
 
@@ -185,10 +186,8 @@ class SweepDescription:
         SweepError
             A field missing, unknown, of the wrong kind or out of range (named), a job or
             an option the registry does not know, or more points than a sweep may have
-            (:func:`phdesign.sweep.schema.description_fields`).
+            (:func:`phdesign.sweep.fields.description_fields`).
         """
-        from phdesign.sweep.schema import description_fields
-
         return cls(**description_fields(data))
 
     @classmethod
@@ -283,7 +282,7 @@ def _fixed_gain(gain: str | Sequence[float] | float, count: int, per: str) -> tu
     for i, v in enumerate(values):
         if not v > 0:
             raise ObserverError(
-                f"--gain: entry {i + 1} must be a finite positive number (L + Lᵀ ≻ 0); found {v!r}"
+                f"gain: entry {i + 1} must be a finite positive number (L + Lᵀ ≻ 0); found {v!r}"
             )
     return values
 
@@ -362,71 +361,12 @@ def describe(
 
     spec = get_job(job)
     n_outputs = int(model.order * model.size)
-    if sensors is not None and sensor_sets is not None:
-        raise SweepError("give either sensors (one set) or sensor_sets (an axis), not both")
-    fixed_sensors = None
-    if sensors is not None:
-        fixed_sensors = _sensor_indices(sensors, n_outputs)
-    set_axis = None if sensor_sets is None else parse_sensor_sets(sensor_sets, n_outputs)
-    has_sensors = fixed_sensors is not None or set_axis is not None
-    if spec.needs_sensors and not has_sensors:
-        raise SweepError(f"job {job} needs sensors: give sensors or sensor_sets")
-
-    if fixed_sensors is not None:
-        sizes = [len(fixed_sensors)]
-    elif set_axis is not None:
-        sizes = [len(sensor_set_indices(v)) for v in set_axis.values]
-    else:
-        sizes = []
-    fixed_gain = None
-    if gain is not None:
-        if not has_sensors:
-            raise SweepError("a gain needs sensors: give sensors or sensor_sets")
-        if set_axis is not None:
-            if isinstance(gain, str) and "," in gain:
-                raise SweepError(
-                    "with sensor sets the fixed gain is one value for every sensor; "
-                    f"found {gain!r}"
-                )
-            fixed_gain = _fixed_gain(gain, 1, "sensor of every set")
-        else:
-            assert fixed_sensors is not None  # has_sensors without a set axis
-            fixed_gain = _fixed_gain(gain, len(fixed_sensors), "sensor")
-
+    fixed_sensors, set_axis = _sensor_axes(spec, sensors, sensor_sets, n_outputs)
+    fixed_gain = _fixed_gains(gain, fixed_sensors, set_axis)
     known = tuple(sorted(str(s) for s in model.parameter_names))
-    for name in grid or {}:
-        if name in known:
-            raise SweepError(
-                f"grid {name}: {name} is a model parameter, not a gain; give it as a "
-                f"parameter axis (param_grid, --param-grid {name}=...)"
-            )
-    gain_axes = [parse_axis(name, text, "gain") for name, text in (grid or {}).items()]
-    if gain_axes and not has_sensors:
-        raise SweepError("gain axes need sensors: give sensors or sensor_sets")
-    names = [a.name for a in gain_axes]
-    if "l" in names and len(names) > 1:
-        raise SweepError(
-            "gain axis l sets every entry of L; it cannot be combined with l1, l2, ..."
-        )
-    q_min = min(sizes) if sizes else 0
-    for a in gain_axes:
-        if a.name != "l" and int(a.name[1:]) > q_min:
-            what = "the sensors" if fixed_sensors else "the smallest sensor set"
-            count = f"{q_min} sensor{'s' if q_min > 1 else ''}"
-            raise SweepError(
-                f"gain axis {a.name} is beyond {what} ({count}); expected l1..l{q_min} "
-                "(or l for every entry)"
-            )
-
+    gain_axes = _gain_axes(grid or {}, known, fixed_sensors, set_axis)
     param_axes = [_parameter_axis(name, text, known) for name, text in (param_grid or {}).items()]
-    axes = tuple(([set_axis] if set_axis else []) + param_axes + gain_axes)
-    if not axes:
-        raise SweepError(
-            "a sweep needs at least one axis: a gain grid, a parameter grid or sensor sets"
-        )
-    if len({a.name for a in axes}) != len(axes):
-        raise SweepError("an axis is given twice")
-    check_sweep_points(math.prod(a.size for a in axes), "the sweep")
+    axes = _checked_axes(([set_axis] if set_axis else []) + param_axes + gain_axes)
     for axis in param_axes:
         _check_parameter_values(model, axis)
     option_values = spec.option_values(options)
@@ -443,3 +383,85 @@ def describe(
         gain=fixed_gain,
         version=__version__,
     )
+
+
+def _sensor_axes(
+    spec: Job, sensors: Any, sensor_sets: Any, n_outputs: int
+) -> tuple[tuple[int, ...] | None, Axis | None]:
+    """Return the fixed sensor set or the axis of sensor sets (at most one of them)."""
+    if sensors is not None and sensor_sets is not None:
+        raise SweepError("give either sensors (one set) or sensor_sets (an axis), not both")
+    fixed = None if sensors is None else _sensor_indices(sensors, n_outputs)
+    set_axis = None if sensor_sets is None else parse_sensor_sets(sensor_sets, n_outputs)
+    if spec.needs_sensors and fixed is None and set_axis is None:
+        raise SweepError(f"job {spec.name} needs sensors: give sensors or sensor_sets")
+    return fixed, set_axis
+
+
+def _set_sizes(fixed: tuple[int, ...] | None, set_axis: Axis | None) -> list[int]:
+    """Return the number of sensors of the fixed set, or of each set of the axis."""
+    if fixed is not None:
+        return [len(fixed)]
+    if set_axis is not None:
+        return [len(sensor_set_indices(v)) for v in set_axis.values]
+    return []
+
+
+def _fixed_gains(
+    gain: Any, fixed: tuple[int, ...] | None, set_axis: Axis | None
+) -> tuple[float, ...] | None:
+    """Return the fixed diagonal of L (``None``: 1 on every sensor; one with sensor sets)."""
+    if gain is None:
+        return None
+    if set_axis is not None:
+        if isinstance(gain, str) and "," in gain:
+            raise SweepError(
+                f"with sensor sets the fixed gain is one value for every sensor; found {gain!r}"
+            )
+        return _fixed_gain(gain, 1, "sensor of every set")
+    if fixed is None:
+        raise SweepError("a gain needs sensors: give sensors or sensor_sets")
+    return _fixed_gain(gain, len(fixed), "sensor")
+
+
+def _gain_axes(
+    grid: GridSpec, known: tuple[str, ...], fixed: tuple[int, ...] | None, set_axis: Axis | None
+) -> list[Axis]:
+    """Return the gain axes ``l1``, ``l2``, ... or ``l``, within the smallest sensor set."""
+    for name in grid:
+        if name in known:
+            raise SweepError(
+                f"grid {name}: {name} is a model parameter, not a gain; give it as a "
+                f"parameter axis (param_grid={{{name!r}: ...}})"
+            )
+    gain_axes = [parse_axis(name, text, "gain") for name, text in grid.items()]
+    if gain_axes and fixed is None and set_axis is None:
+        raise SweepError("gain axes need sensors: give sensors or sensor_sets")
+    names = [a.name for a in gain_axes]
+    if "l" in names and len(names) > 1:
+        raise SweepError(
+            "gain axis l sets every entry of L; it cannot be combined with l1, l2, ..."
+        )
+    sizes = _set_sizes(fixed, set_axis)
+    q_min = min(sizes) if sizes else 0
+    for a in gain_axes:
+        if a.name != "l" and int(a.name[1:]) > q_min:
+            what = "the sensors" if fixed else "the smallest sensor set"
+            count = f"{q_min} sensor{'s' if q_min > 1 else ''}"
+            raise SweepError(
+                f"gain axis {a.name} is beyond {what} ({count}); expected l1..l{q_min} "
+                "(or l for every entry)"
+            )
+    return gain_axes
+
+
+def _checked_axes(axes: list[Axis]) -> tuple[Axis, ...]:
+    """Return the axes: at least one, of distinct names, within the sweep's point budget."""
+    if not axes:
+        raise SweepError(
+            "a sweep needs at least one axis: a gain grid, a parameter grid or sensor sets"
+        )
+    if len({a.name for a in axes}) != len(axes):
+        raise SweepError("an axis is given twice")
+    check_sweep_points(math.prod(a.size for a in axes), "the sweep")
+    return tuple(axes)
