@@ -100,6 +100,7 @@ def cli_page() -> str:
     ]
     helps = {a.dest: a.help for a in subparsers._choices_actions}
     for name, sub in subparsers.choices.items():
+        sub.complete()  # the options a command adds when it is first used (sweep's jobs)
         title = f"phdesign {name}"
         lines += [title, "-" * len(title), ""]
         lines += [_escape(sub.description or helps.get(name) or ""), ""]

@@ -3,6 +3,9 @@
 Each command lives in a module of this package that exposes ``register(subparsers)``;
 the heavy numeric imports happen inside the command handlers, so ``phdesign ports``
 and ``phdesign classify`` start without numpy-heavy backends, control or matplotlib.
+What a command's options need from a package of its own (the sweep's job registry) is
+added when that command is parsed or its help is shown (:meth:`_Parser.defer`), so
+building the parser imports no command's package.
 
 Exit status: 0 on success, 2 on bad input with exactly one line on stderr
 (``phdesign: error: ...``), never a traceback.  Bad input is what phdesign's own errors
@@ -15,7 +18,8 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 from phdesign.cli.design_arguments import join_negative_values
 from phdesign.core.errors import PhdesignError
@@ -35,7 +39,41 @@ COMMAND_MODULES = (
 
 
 class _Parser(argparse.ArgumentParser):
-    """An argument parser whose usage errors are one line and exit status 2."""
+    """An argument parser whose usage errors are one line and exit status 2.
+
+    Options whose definition needs a package of its own are added by :meth:`defer`, when
+    the command is parsed or its help or usage is shown, never when the parser is built.
+    Negative values are glued to their options before parsing
+    (:func:`~phdesign.cli.design_arguments.join_negative_values`).
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._deferred: list[Callable[[argparse.ArgumentParser], None]] = []
+
+    def defer(self, add: Callable[[argparse.ArgumentParser], None]) -> None:
+        """Call ``add(self)`` to add options before this parser is first used."""
+        self._deferred.append(add)
+
+    def complete(self) -> None:
+        """Add the deferred options now (the documentation's reference lists them all)."""
+        while self._deferred:
+            self._deferred.pop(0)(self)
+
+    def parse_known_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        self.complete()
+        argv = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(join_negative_values(argv, self), namespace)
+
+    def format_usage(self) -> str:
+        self.complete()
+        return super().format_usage()
+
+    def format_help(self) -> str:
+        self.complete()
+        return super().format_help()
 
     def error(self, message: str) -> None:  # type: ignore[override]
         command = self.prog.removeprefix("phdesign").strip()
@@ -81,9 +119,7 @@ def main(argv: Sequence[str] | None = None, *, reraise: bool = False) -> int:
     """
     try:
         parser = build_parser()
-        args = parser.parse_args(
-            join_negative_values(list(sys.argv[1:] if argv is None else argv), parser)
-        )
+        args = parser.parse_args(None if argv is None else list(argv))
         return int(args.handler(args) or 0)
     except _UsageError as error:
         return _fail(str(error))

@@ -3,7 +3,9 @@
 Argument parsing and printing only: the sweep lives in :mod:`phdesign.sweep`, imported in
 the handlers (dask, xarray and zarr only when a sweep runs).  The job options are the
 flags of the registered jobs (:data:`phdesign.sweep.jobs.JOBS`): a new job's options
-become flags here without a change to this module.
+become flags here without a change to this module.  They are added when ``sweep`` is
+parsed or its help shown (the registry is in the sweep package, which no other command
+imports).
 """
 
 from __future__ import annotations
@@ -20,7 +22,6 @@ from phdesign.cli.common import (
     load_model,
 )
 from phdesign.core.errors import SweepError
-from phdesign.sweep.jobs import JOBS
 
 __all__ = ["register"]
 
@@ -29,6 +30,8 @@ _TYPES = {"int": int, "float": float, "choice": str}
 
 def _job_options() -> dict[str, Any]:
     """Every option of every registered job, by name (the first definition wins)."""
+    from phdesign.sweep.jobs import JOBS
+
     options: dict[str, Any] = {}
     for job in JOBS.values():
         for option in job.options:
@@ -77,21 +80,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         help="model parameter axis (repeatable), e.g. d=0:0.4:9",
     )
     sp.add_argument(
-        "--job",
-        choices=sorted(JOBS),
-        default="spectrum",
-        help="what to compute (default spectrum)",
-    )
-    for name, (option, job) in _job_options().items():
-        flag = "--" + name.replace("_", "-")
-        kwargs: dict[str, Any] = {"help": f"{option.help} (job {job})"}
-        if option.kind == "choice":
-            kwargs["choices"] = option.allowed
-        else:
-            kwargs["type"] = _TYPES[option.kind]
-            kwargs["metavar"] = "N" if option.kind == "int" else "X"
-        sp.add_argument(flag, dest=f"option_{name}", **kwargs)
-    sp.add_argument(
         "-o",
         "--output",
         required=True,
@@ -116,6 +104,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "--no-progress", action="store_true", help="no progress bar (shown on a terminal)"
     )
     add_json_argument(sp)
+    sp.defer(_add_job_arguments)  # type: ignore[attr-defined]
     sp.set_defaults(handler=_sweep)
 
     pl = subparsers.add_parser(
@@ -136,6 +125,27 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     pl.add_argument("--force", action="store_true", help="overwrite an existing image")
     add_json_argument(pl)
     pl.set_defaults(handler=_plot)
+
+
+def _add_job_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``--job`` and the options of the registered jobs (on first use of ``sweep``)."""
+    from phdesign.sweep.jobs import JOBS
+
+    parser.add_argument(
+        "--job",
+        choices=sorted(JOBS),
+        default="spectrum",
+        help="what to compute (default spectrum)",
+    )
+    for name, (option, job) in _job_options().items():
+        flag = "--" + name.replace("_", "-")
+        kwargs: dict[str, Any] = {"help": f"{option.help} (job {job})"}
+        if option.kind == "choice":
+            kwargs["choices"] = option.allowed
+        else:
+            kwargs["type"] = _TYPES[option.kind]
+            kwargs["metavar"] = "N" if option.kind == "int" else "X"
+        parser.add_argument(flag, dest=f"option_{name}", **kwargs)
 
 
 def _named(items: list[str], flag: str, example: str = "l1=0.01:3:40:log") -> dict[str, str]:

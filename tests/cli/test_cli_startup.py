@@ -1,0 +1,39 @@
+"""Start-up of the command line: what building the parser and the light commands import."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from phdesign.cli import build_parser
+
+# Packages that ``ports`` and ``classify`` never need: the sweep (its job registry gives
+# ``sweep`` its options only when that command is parsed), the figures, generated code
+# and the numeric layer (benchmarks/cli_startup.py times the same commands).
+NOT_IMPORTED = ("phdesign.sweep", "phdesign.plots", "phdesign.codegen", "phdesign.numeric")
+
+
+def test_ports_and_classify_import_no_sweep_plots_or_numeric_package():
+    probe = (
+        "import contextlib, io, sys\n"
+        "from phdesign.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    assert main(['ports', 'euler-bernoulli', '--json']) == 0\n"
+        "    assert main(['classify', 'wave', '--sensors', '2']) == 0\n"
+        f"packages = {NOT_IMPORTED!r}\n"
+        "print(sorted(p for p in packages if any(m == p or m.startswith(p + '.') "
+        "for m in sys.modules)))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]", out.stdout
+
+
+def test_the_sweep_options_are_added_when_sweep_is_used():
+    parser = build_parser()
+    sweep = next(a for a in parser._actions if a.dest == "command").choices["sweep"]
+    help_text = sweep.format_help()
+    assert "--max-resolution N" in help_text  # an option of the spectrum job
+    assert "--job {classify,spectrum}" in help_text
+    args = parser.parse_args(["sweep", "wave", "-o", "m.csv", "--tol", "-1e-3"])
+    assert (args.job, args.option_tol) == ("spectrum", -1e-3)  # a negative value is taken
