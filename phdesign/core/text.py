@@ -24,9 +24,11 @@ from typing import Any
 
 __all__ = [
     "REPR_LIMIT",
+    "gain_text",
     "html_table",
     "kappa_text",
     "matrix_text",
+    "measured_text",
     "number_text",
     "sensors_text",
     "shorten",
@@ -131,6 +133,46 @@ def sensors_text(C_m: Any) -> str:
             terms.append(name if c == 1 else f"-{name}" if c == -1 else f"{number_text(c)}·{name}")
         parts.append(" + ".join(terms).replace("+ -", "- "))
     return ", ".join(parts)
+
+
+def _float_rows(M: Any) -> list[list[float]]:
+    """Return a number, a vector or a matrix (numpy or nested lists) as rows of floats."""
+    value = M.tolist() if hasattr(M, "tolist") else M
+    if not isinstance(value, list | tuple):
+        return [[float(value)]]
+    if not value or not isinstance(value[0], list | tuple):
+        return [[float(x) for x in value]]
+    return [[float(x) for x in row] for row in value]
+
+
+def gain_text(L: Any) -> str:
+    """Return a numeric gain as text: ``diag(0.1, 1)`` (six digits), else its rows (eight).
+
+    Examples
+    --------
+    >>> gain_text([[0.1, 0], [0, 1]]), gain_text([[1, 0.5], [0, 1]])
+    ('diag(0.1, 1)', '[[1.0, 0.5], [0.0, 1.0]]')
+    """
+    rows = _float_rows(L)
+    size = min(len(rows), len(rows[0]) if rows else 0)
+    # diagonal: every other entry zero and the diagonal finite (x - x is NaN for inf and NaN)
+    if all((x - x if i == j else x) == 0 for i, row in enumerate(rows) for j, x in enumerate(row)):
+        return f"diag({', '.join(f'{rows[i][i]:.6g}' for i in range(size))})"
+    return str([[float(f"{x:.8g}") for x in row] for row in rows])
+
+
+def measured_text(C_m: Any) -> str:
+    """Return numeric sensors as text: ``y3, y4`` when each row picks one output, else rows.
+
+    Examples
+    --------
+    >>> measured_text([[0, 0, 1, 0], [0, 0, 0, 1]]), measured_text([[0.5, 1]])
+    ('y3, y4', 'C_m = [[0.5, 1.0]]')
+    """
+    rows = _float_rows(C_m)
+    if all([x for x in row if x != 0] == [1.0] for row in rows):
+        return sensors_text(rows)
+    return f"C_m = {rows}"
 
 
 def shorten(text: str, limit: int) -> str:

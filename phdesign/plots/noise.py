@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.numeric.noise.report import describe_gain, describe_sensors
+from phdesign.core.text import gain_text, measured_text
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.figure import Figure
@@ -91,7 +91,7 @@ def plot_tradeoff(
     labelled = {"pareto": front, "all": pts, "none": []}.get(annotate, front)
     for p in _spread(labelled):
         ax.annotate(
-            describe_gain(p.gain),
+            gain_text(p.gain),
             (p.rms, p.decay_rate),
             textcoords="offset points",
             xytext=(6, 4),
@@ -102,7 +102,7 @@ def plot_tradeoff(
         xlabel=f"RMS of the estimation error of {result.performance}",
         ylabel="decay rate −α [1/s]",
         title=literal(
-            f"{result.model}, sensors {describe_sensors(result.sensors)}: speed against noise"
+            f"{result.model}, sensors {measured_text(result.sensors)}: speed against noise"
         ),
     )
     ax.grid(True, which="both", alpha=0.3)

@@ -15,13 +15,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from phdesign.core.text import gain_text, html_table, measured_text
 from phdesign.numeric.noise.lyapunov import TriangularPencil
 from phdesign.numeric.noise.settle import Estimate, finite_or_none
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.figure import Figure
 
-__all__ = ["GainEstimate", "NoiseReport", "describe_gain", "describe_sensors", "html_table"]
+__all__ = ["GainEstimate", "NoiseReport"]
 
 
 @dataclass(frozen=True)
@@ -248,8 +249,8 @@ class NoiseReport:
         noise = f"sensor noise intensity {_numbers(self.intensity)}"
         if self.input_intensity is not None:
             noise += f", input noise intensity {_numbers(self.input_intensity)}"
-        sensors = describe_sensors(self.sensors)
-        gain = describe_gain(self.gain)
+        sensors = measured_text(self.sensors)
+        gain = gain_text(self.gain)
         return f"model: {self.model}   sensors: {sensors}   gain L = {gain}   {noise}"
 
     def __str__(self) -> str:
@@ -289,7 +290,7 @@ class NoiseReport:
         first = self.performance[0] if self.performance else None
         perf = f"{first.name}: {first.status()}" if first else "no performance output"
         text = (
-            f"NoiseReport(model={self.model!r}, gain={describe_gain(self.gain)}, {perf}, "
+            f"NoiseReport(model={self.model!r}, gain={gain_text(self.gain)}, {perf}, "
             f"l2_gain={self.l2_gain.estimate.status()}, error_energy="
             f"{self.error_energy.status()})"
         )
@@ -317,32 +318,5 @@ class NoiseReport:
         return plot_noise_report(self, path, force=force)
 
 
-def describe_sensors(C_m: np.ndarray) -> str:
-    """``y3, y4`` when C_m picks outputs, else its rows."""
-    C = np.atleast_2d(np.asarray(C_m, dtype=float))
-    picks = []
-    for row in C:
-        nz = np.flatnonzero(row)
-        if nz.size != 1 or row[nz[0]] != 1.0:
-            return f"C_m = {C.tolist()}"
-        picks.append(int(nz[0]))
-    return ", ".join(f"y{i + 1}" for i in picks)
-
-
-def describe_gain(L: np.ndarray) -> str:
-    """``diag(0.1, 1)`` for a diagonal gain, else its rows."""
-    Lm = np.atleast_2d(np.asarray(L, dtype=float))
-    if np.count_nonzero(Lm - np.diag(np.diag(Lm))) == 0:
-        return f"diag({_numbers(np.diag(Lm))})"
-    return str([[float(f"{x:.8g}") for x in row] for row in Lm])
-
-
 def _numbers(values: Sequence[float] | np.ndarray) -> str:
     return ", ".join(f"{float(v):.6g}" for v in values)
-
-
-def html_table(header: Sequence[str], rows: Sequence[Sequence[Any]], caption: str = "") -> str:
-    """Return a small HTML table (escaped) for ``_repr_html_`` (the package's one table)."""
-    from phdesign.core.text import html_table as table
-
-    return table(header, rows, caption or None)

@@ -27,11 +27,12 @@ import numpy as np
 
 from phdesign.core.errors import NumericError
 from phdesign.core.limits import check_tradeoff_gains
+from phdesign.core.text import gain_text, html_table, measured_text
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
 from phdesign.numeric.discretization.registry import DiscretePHS, feedback_matrix
 from phdesign.numeric.noise.figures import noise, sensor_rows
-from phdesign.numeric.noise.report import NoiseReport, describe_gain, describe_sensors, html_table
+from phdesign.numeric.noise.report import NoiseReport
 from phdesign.numeric.noise.settle import finite_or_none
 from phdesign.numeric.spectrum.converged import SpectrumReport, spectrum
 
@@ -191,7 +192,7 @@ class Tradeoff:
         return buf.getvalue()
 
     def __str__(self) -> str:
-        sensors = describe_sensors(self.sensors)
+        sensors = measured_text(self.sensors)
         intensity = ", ".join(f"{s:g}" for s in self.intensity)
         head = f"model: {self.model}   sensors: {sensors}   sensor noise intensity {intensity}"
         lines = [
@@ -208,7 +209,7 @@ class Tradeoff:
             rms = "—" if p.rms is None else f"{p.rms:.6g}"
             gain = "—" if p.noise.l2_gain.value is None else f"{p.noise.l2_gain.value:.5g}"
             mark = "  *" if p.pareto else ""
-            lines.append(f"  {describe_gain(p.gain):<28} {rate:>10} {rms:>12} {gain:>10}{mark}")
+            lines.append(f"  {gain_text(p.gain):<28} {rate:>10} {rms:>12} {gain:>10}{mark}")
         lines.append(
             "(* after -α: the abscissa did not converge to 1e-10, e.g. at a coalescence; "
             "— : the figure did not converge or diverges)"
@@ -225,7 +226,7 @@ class Tradeoff:
     def _repr_html_(self) -> str:
         rows = [
             (
-                describe_gain(p.gain),
+                gain_text(p.gain),
                 "—" if p.decay_rate is None else f"{p.decay_rate:.6g}",
                 "—" if p.rms is None else f"{p.rms:.6g}",
                 "—" if p.noise.l2_gain.value is None else f"{p.noise.l2_gain.value:.5g}",

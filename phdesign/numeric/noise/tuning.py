@@ -39,11 +39,12 @@ from scipy.optimize import minimize, minimize_scalar
 
 from phdesign.core.defaults import OrderDefaults, current
 from phdesign.core.errors import NumericError
+from phdesign.core.text import gain_text, html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.noise.figures import noise, noise_intensities, sensor_rows
-from phdesign.numeric.noise.report import NoiseReport, describe_gain, html_table
+from phdesign.numeric.noise.report import NoiseReport
 from phdesign.numeric.noise.settle import finite_or_none
 from phdesign.numeric.noise.statistics import error_statistics
 from phdesign.numeric.spectrum.abscissa import estimate_abscissa
@@ -126,7 +127,7 @@ class NoiseTuneResult:
         )
         lines = [
             f"model: {self.noise.model}   {goal} subject to {self.constraint}",
-            f"gain L = {describe_gain(self.gain)}",
+            f"gain L = {gain_text(self.gain)}",
             f"spectral abscissa: {alpha}",
             "error rms: " + ("not converged" if self.rms is None else f"{self.rms:.8g}"),
             f"constraint met: {self.feasible}   ({self.evaluations} evaluations)",
@@ -136,14 +137,14 @@ class NoiseTuneResult:
 
     def __repr__(self) -> str:
         return (
-            f"NoiseTuneResult(objective={self.objective!r}, gain={describe_gain(self.gain)}, "
+            f"NoiseTuneResult(objective={self.objective!r}, gain={gain_text(self.gain)}, "
             f"spectral_abscissa={self.spectral_abscissa!r}, rms={self.rms!r}, "
             f"feasible={self.feasible})"
         )[:300]
 
     def _repr_html_(self) -> str:
         rows = [
-            ("gain L", describe_gain(self.gain)),
+            ("gain L", gain_text(self.gain)),
             ("spectral abscissa", f"{self.spectral_abscissa}"),
             ("error rms", f"{self.rms}"),
             ("constraint", self.constraint),
