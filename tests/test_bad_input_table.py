@@ -176,7 +176,7 @@ COMMAND_ROWS = [
     ),
     row(
         "classify euler-bernoulli --cm [[0,0,0,0]]",
-        "C_m must have full row rank (independent measurements); expected rank 1 but found 0",
+        "--cm must have full row rank (independent measurements); expected rank 1 but found 0",
         ObserverError,
     ),
     row(
@@ -573,7 +573,7 @@ COMMAND_ROWS = [
     ),
     row(
         f"{SIM} --t-end 1.7e308",
-        "t_end must be a positive number at most 1e+12",
+        "--t-end must be a positive number at most 1e+12",
         NumericError,
         seconds=10,
     ),

@@ -116,7 +116,7 @@ def test_read_and_write_files(tmp_path):
     out = tmp_path / "copy.toml"
     write_model(beam, out)
     assert read_model(out) == beam
-    with pytest.raises(OutputFileError, match="exists; pass --force"):
+    with pytest.raises(OutputFileError, match="exists; pass `force=True`"):
         write_model(beam, out)
     write_model(beam.with_parameters({"d": 0.5}), out, force=True)
     assert read_model(out) != beam

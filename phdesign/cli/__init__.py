@@ -10,7 +10,9 @@ building the parser imports no command's package.
 Exit status: 0 on success, 2 on bad input with exactly one line on stderr
 (``phdesign: error: ...``), never a traceback.  Bad input is what phdesign's own errors
 (:class:`~phdesign.core.errors.PhdesignError`) report; any other exception is a bug and is
-not disguised as bad input.
+not disguised as bad input.  The library's messages name its arguments; every error and
+warning is printed with the running command's option names instead
+(:mod:`phdesign.cli.messages`).
 """
 
 from __future__ import annotations
@@ -21,8 +23,9 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from phdesign.cli import messages
 from phdesign.cli.design_arguments import join_negative_values
-from phdesign.core.errors import PhdesignError
+from phdesign.core.errors import ModelError, ModelFileError, PhdesignError, PortError
 
 __all__ = ["build_parser", "main", "run"]
 
@@ -117,16 +120,20 @@ def main(argv: Sequence[str] | None = None, *, reraise: bool = False) -> int:
         Let library errors propagate instead of printing them (for tests that check
         which exception the library raises behind a message).
     """
+    messages.use({})
     try:
         parser = build_parser()
         args = parser.parse_args(None if argv is None else list(argv))
+        messages.use(messages.option_table(parser, args))
         return int(args.handler(args) or 0)
     except _UsageError as error:
         return _fail(str(error))
     except PhdesignError as error:  # bad input; any other exception is a bug and surfaces
         if reraise:
             raise
-        return _fail(str(error))
+        # a model file's errors name its keys (``order must be ...``), never an option
+        leading = not isinstance(error, ModelError | ModelFileError | PortError)
+        return _fail(messages.translated(str(error), leading))
     except OSError as error:
         return _fail(
             f"{error.strerror or error}: {error.filename}" if error.filename else str(error)

@@ -22,7 +22,6 @@ from phdesign.cli.design_arguments import (
     add_observer_arguments,
     observer_from_args,
     parse_gain_text,
-    with_option_names,
 )
 from phdesign.core.errors import ObserverError
 
@@ -89,8 +88,5 @@ def _search(args: argparse.Namespace, model: Any) -> int:
     from phdesign.symbolic.search import search_sensors
 
     gain = None if args.gain is None else parse_gain_text(args.gain)
-    try:
-        found = search_sensors(model, gain=gain, progress=_progress_bar())
-    except ObserverError as error:
-        raise with_option_names(error) from None
+    found = search_sensors(model, gain=gain, progress=_progress_bar())
     return emit_result(args, found)

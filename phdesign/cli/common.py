@@ -26,6 +26,7 @@ __all__ = [
     "non_negative_int",
     "parse_parameter_overrides",
     "printable",
+    "result_text",
     "run_outputs",
     "simulation_text",
     "warn",
@@ -137,8 +138,11 @@ def emit(text: str) -> None:
 
 
 def warn(message: str) -> None:
-    """Print one ``phdesign: warning: ...`` line on stderr."""
-    print(f"phdesign: warning: {printable(' '.join(message.split()))}", file=sys.stderr)
+    """Print one ``phdesign: warning: ...`` line on stderr, in the command's option names."""
+    from phdesign.cli.messages import translated
+
+    text = printable(" ".join(translated(message).split()))
+    print(f"phdesign: warning: {text}", file=sys.stderr)
 
 
 def emit_json(value: Any) -> None:
@@ -154,6 +158,13 @@ def check_positive(option: str, value: float | int | None) -> None:
         raise NumericError(f"{option} must be positive; found {value}")
 
 
+def result_text(result: Any) -> str:
+    """Return the text a result prints itself, the arguments it names as options."""
+    from phdesign.cli.messages import translated
+
+    return translated(str(result), leading=False)
+
+
 def emit_result(args: argparse.Namespace, result: Any, model: str | None = None) -> int:
     """Print a result as JSON with ``--json``, else the text it prints itself; return 0.
 
@@ -162,7 +173,7 @@ def emit_result(args: argparse.Namespace, result: Any, model: str | None = None)
     if getattr(args, "json", False):
         emit_json({**({} if model is None else {"model": model}), **result.to_dict()})
     else:
-        emit(str(result))
+        emit(result_text(result))
     return 0
 
 

@@ -3,8 +3,8 @@
 The text of the options is read here, into plain Python (lists of indices, rows of numbers,
 ``"symbolic"``), and handed to :class:`phdesign.Observer`, whose validation every command
 shares (so ``spectrum``, ``simulate`` and ``tune`` refuse what ``classify`` refuses).  The
-library's messages name its arguments (``gain: ...``); here they are shown with the
-option the user typed (``--gain: ...``).
+library's messages name its arguments (``gain: ...``); the command line prints them with
+the option the user typed (``--gain: ...``, :mod:`phdesign.cli.messages`).
 
 Forms:
 
@@ -32,7 +32,6 @@ __all__ = [
     "parse_gain_text",
     "parse_rows_text",
     "parse_sensors_text",
-    "with_option_names",
 ]
 
 
@@ -95,22 +94,6 @@ def parse_gain_text(text: str, option: str = "--gain") -> Any:
     return [p.strip() for p in text.split(",")]
 
 
-#: Library argument names and the options that set them, for messages.
-_OPTIONS = {"sensors": "--sensors", "gain": "--gain", "C_m": "--cm"}
-
-
-def with_option_names(error: ObserverError, sensors_given: bool = False) -> ObserverError:
-    """Return the same error with the library's argument name replaced by its option."""
-    message = str(error)
-    for argument, option in _OPTIONS.items():
-        if argument == "C_m" and sensors_given:
-            option = "--sensors"
-        if message.startswith(f"{argument}: "):
-            message = option + message[len(argument) :]
-            break
-    return type(error)(message)
-
-
 def observer_from_args(
     args: argparse.Namespace,
     model: Any,
@@ -136,20 +119,17 @@ def observer_from_args(
         if gain_text is not None:
             raise ObserverError("--gain needs --sensors or --cm to say which outputs are measured")
         return None
-    try:
-        observer = Observer(
-            model,
-            sensors=None if sensors is None else parse_sensors_text(sensors),
-            C_m=None if cm is None else parse_rows_text(cm, "--cm"),
-            method=method,
-            resolution=resolution,
-        )
-        if gain_text is not None:
-            return observer.with_gain(parse_gain_text(gain_text))
-        if default_gain is not None:
-            return observer.with_gain(default_gain)
-    except ObserverError as error:
-        raise with_option_names(error, sensors is not None) from None
+    observer = Observer(
+        model,
+        sensors=None if sensors is None else parse_sensors_text(sensors),
+        C_m=None if cm is None else parse_rows_text(cm, "--cm"),
+        method=method,
+        resolution=resolution,
+    )
+    if gain_text is not None:
+        return observer.with_gain(parse_gain_text(gain_text))
+    if default_gain is not None:
+        return observer.with_gain(default_gain)
     if command:
         raise ObserverError(
             f"{command} --sensors/--cm needs --gain: the gain L of the observer, e.g. --gain 1,1"

@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import math
-import sys
 from typing import Any
 
 from phdesign.cli.common import (
@@ -22,6 +21,8 @@ from phdesign.cli.common import (
     emit,
     emit_json,
     load_model,
+    result_text,
+    warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
 from phdesign.core.checks import EXPORT_FORMATS, REDUCTIONS, SAMPLERS
@@ -192,9 +193,9 @@ def _export(args: argparse.Namespace) -> int:
     if args.json:
         emit_json({**result.to_dict(), "files": written})
         for warning in result.warnings:
-            print(f"phdesign: warning: {warning}", file=sys.stderr)
+            warn(warning)
     else:
-        emit(str(result) + "".join(f"\nwrote {path}" for path in written))
+        emit(result_text(result) + "".join(f"\nwrote {path}" for path in written))
     return 0
 
 

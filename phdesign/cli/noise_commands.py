@@ -31,6 +31,7 @@ from phdesign.cli.common import (
     add_model_argument,
     check_positive,
     emit_result,
+    result_text,
     run_outputs,
 )
 from phdesign.cli.design_arguments import add_observer_arguments
@@ -228,7 +229,7 @@ def _text(args: argparse.Namespace, result: Any) -> str:
 
     if args.json:
         return dumps_json(result.to_dict())
-    return result.to_csv() if getattr(args, "csv", False) else str(result)
+    return result.to_csv() if getattr(args, "csv", False) else result_text(result)
 
 
 def _range(text: str, flag: str) -> Any:

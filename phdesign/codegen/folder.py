@@ -35,8 +35,8 @@ MARKER = ".phdesign-export"
 #: A marker is a few hundred bytes; anything longer is not phdesign's.
 _MARKER_LIMIT = 1 << 16
 _NOTE = (
-    "written by phdesign export; --force replaces this folder only while it holds "
-    "exactly these files and this marker"
+    "written by phdesign export, which replaces this folder (when forced) only while it "
+    "holds exactly these files and this marker"
 )
 
 
@@ -153,7 +153,7 @@ def check_export_folder(path: str | os.PathLike[str], force: bool = False) -> tu
     if kind is not None:
         raise OutputFileError(
             f"output path {shown!r} is {kind}; format 'c' writes a folder, and replaces only "
-            "a folder it wrote, even with --force"
+            "a folder it wrote, even with `force=True`"
         )
     if _is_working_directory(target):
         raise OutputFileError(
@@ -164,10 +164,10 @@ def check_export_folder(path: str | os.PathLike[str], force: bool = False) -> tu
     if foreign is not None:
         raise OutputFileError(
             f"output folder {shown!r} exists and is not an export of phdesign: {foreign}; "
-            "--force replaces only a folder phdesign wrote: name a new folder"
+            "`force=True` replaces only a folder phdesign wrote: name a new folder"
         )
     if not force:
-        raise OutputFileError(f"output folder {shown!r} exists; pass --force to replace it")
+        raise OutputFileError(f"output folder {shown!r} exists; pass `force=True` to replace it")
     return target, True
 
 

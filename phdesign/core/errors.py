@@ -7,6 +7,12 @@ phdesign family or the builtin one.  Any other exception escaping phdesign is a 
 name the matrix, parameter or expression at fault and give what was expected
 against what was found.
 
+A library user has no command-line flags, so a message names an argument as Python
+spells it: at the head of the message (``tol must be a finite positive number``,
+``gain: entry 2 ...``) or as code in backquotes (```reduction='none'```, ```force=True```,
+```x0```).  The command line prints each with the option that sets it (``--tol``,
+``--reduce none``, ``--force``, ``--x0``: :mod:`phdesign.cli.messages`).
+
 Examples
 --------
 >>> import numpy as np
@@ -63,7 +69,7 @@ class NumericError(PhdesignError, ValueError):
 
 
 class OutputFileError(PhdesignError, ValueError):
-    """An output path is not writable or would overwrite a file without --force."""
+    """An output path is not writable or would overwrite a file without ``force``."""
 
 
 class ArgumentError(PhdesignError, TypeError):

@@ -101,10 +101,10 @@ def _classify(target: Path, force: bool) -> str:
         )
         raise OutputFileError(
             f"output path {shown!r} is {kind}; phdesign writes regular files only "
-            "(the null device excepted), even with --force"
+            "(the null device excepted), even with `force=True`"
         )
     if not force:
-        raise OutputFileError(f"output file {shown!r} exists; pass --force to overwrite it")
+        raise OutputFileError(f"output file {shown!r} exists; pass `force=True` to overwrite it")
     return "replace"
 
 
@@ -359,7 +359,8 @@ def _link_exclusively(temporary: Path, target: Path) -> None:
         os.link(temporary, target)
     except FileExistsError:
         raise OutputFileError(
-            f"output file {str(target)!r} exists (created meanwhile); pass --force to overwrite it"
+            f"output file {str(target)!r} exists (created meanwhile); pass `force=True` to "
+            "overwrite it"
         ) from None
     except OSError as error:
         if error.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.ENOTSUP, errno.EXDEV):
@@ -369,8 +370,8 @@ def _link_exclusively(temporary: Path, target: Path) -> None:
             os.close(os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
         except FileExistsError:
             raise OutputFileError(
-                f"output file {str(target)!r} exists (created meanwhile); pass --force to "
-                "overwrite it"
+                f"output file {str(target)!r} exists (created meanwhile); pass `force=True` "
+                "to overwrite it"
             ) from None
         os.replace(temporary, target)
         return

@@ -53,7 +53,7 @@ def numeric_matrix(M: sympy.MatrixBase, name: str, what: str) -> np.ndarray:
         names = ", ".join(sorted(map(str, M.free_symbols)))
         raise ObserverError(
             f"{what} needs numbers for {name}; {name} = {matrix_text(M)} is symbolic ({names}): "
-            "give numbers (the gain [0.1, 1], or --gain 0.1,1 on the command line) or tune "
+            "give numbers (`gain=[0.1, 1]`) or tune "
             "one; symbolic gains are for classify, which answers for all their positive values"
         )
     return np.array(M.evalf(17).tolist(), dtype=float)

@@ -261,8 +261,10 @@ def constant_H(
 
 def _free_symbols_message(what: str, symbols: set[Any]) -> str:
     names = ", ".join(sorted(str(s) for s in symbols))
+    first = min(str(s) for s in symbols)
     return (
-        f"{what} still contains free symbols after substitution: {names}; give them with --param"
+        f"{what} still contains free symbols after substitution: {names}; give them values "
+        f"(`parameters={{{first!r}: ...}}`)"
     )
 
 

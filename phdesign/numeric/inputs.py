@@ -281,7 +281,7 @@ def input_function(
 
     from phdesign.symbolic.parser import check_text, parse
 
-    check_text(text, "--u")
+    check_text(text, "`u`")
     by_name = {
         name: _exact_value(value)
         for name, value in _substituted_values(nm, model, parameters).items()
@@ -302,18 +302,18 @@ def input_function(
     for part in _split_top_level(text):
         if ":" not in part:
             raise ParameterError(
-                f"--u item {part.strip()!r}: expected 'u<i>: expression in t', e.g. 'u1: sin(2*t)'"
+                f"`u` item {part.strip()!r}: expected 'u<i>: expression in t', e.g. 'u1: sin(2*t)'"
             )
         key, body = (x.strip() for x in part.split(":", 1))
         if key not in names:
             expected = ", ".join(names) if names else "none (every input is closed)"
-            raise ParameterError(f"--u: unknown input {key!r}; the model's inputs are {expected}")
+            raise ParameterError(f"`u`: unknown input {key!r}; the model's inputs are {expected}")
         if names[key] in funcs:
-            raise ParameterError(f"--u: input {key!r} given twice")
+            raise ParameterError(f"`u`: input {key!r} given twice")
         try:
             expr = parse(body, resolve)
         except ExpressionError as error:
-            raise ExpressionError(f"--u {key}: {error}") from None
+            raise ExpressionError(f"`u` {key}: {error}") from None
         funcs[names[key]] = partial(_evaluate_at, expr, time)
 
     def u(t: float) -> np.ndarray:
@@ -324,7 +324,7 @@ def input_function(
             except (ArithmeticError, ValueError, TypeError):
                 out[i] = np.nan
             if not np.isfinite(out[i]):
-                raise NumericError(f"--u: input u{i + 1} is not finite at t = {t:g}")
+                raise NumericError(f"`u`: input u{i + 1} is not finite at t = {t:g}")
         return out
 
     return u

@@ -432,7 +432,7 @@ def _gain_axes(
         if name in known:
             raise SweepError(
                 f"grid {name}: {name} is a model parameter, not a gain; give it as a "
-                f"parameter axis (param_grid={{{name!r}: ...}})"
+                f"parameter axis (`param_grid={{{name!r}: ...}}`)"
             )
     gain_axes = [parse_axis(name, text, "gain") for name, text in grid.items()]
     if gain_axes and fixed is None and set_axis is None:

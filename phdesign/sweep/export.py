@@ -118,7 +118,7 @@ def open_sweep(path: str | Path) -> Any:
             done, total = len(store.done()), store.plan().n_chunks
             raise SweepError(
                 f"{str(target)!r} is incomplete ({done} of {total} chunks stored); "
-                "finish it with --resume"
+                "finish it with `resume=True`"
             )
         dataset = store.dataset()
     elif kind == "netcdf":

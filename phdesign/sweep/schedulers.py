@@ -116,7 +116,7 @@ def _check_reachable(address: str) -> None:
         reason = error.strerror or type(error).__name__
         raise SweepError(
             f"cannot reach the Dask scheduler at {address}: {reason}; start one with "
-            "'dask scheduler' or use --scheduler synchronous"
+            "'dask scheduler' or use `scheduler='synchronous'`"
         ) from None
 
 

@@ -158,7 +158,7 @@ class ZarrStore:
         if kind not in ("folder", "file"):
             raise OutputFileError(
                 f"output {where!r} is {kind}; a sweep writes its store only where there is "
-                "nothing, a file or a Zarr store, even with --force (name the store itself)"
+                "nothing, a file or a Zarr store, even with `force=True` (name the store itself)"
             )
         if force:
             if kind == "folder" and not self.is_zarr:
@@ -169,13 +169,13 @@ class ZarrStore:
             return "replace"
         if not resume:
             raise OutputFileError(
-                f"output {where!r} exists; resume the sweep it holds (--resume) "
-                "or replace it (--force)"
+                f"output {where!r} exists; resume the sweep it holds (`resume=True`) "
+                "or replace it (`force=True`)"
             )
         if kind != "folder":
             raise SweepError(
                 f"cannot resume {where!r}: it is not a phdesign sweep store (it is a file); "
-                "replace it with --force"
+                "replace it with `force=True`"
             )
         self._check_resumable(description, chunk_size)
         return "complete" if self.complete else "resume"
@@ -187,19 +187,19 @@ class ZarrStore:
             stored = self.stored()
         except SweepError as error:
             raise SweepError(
-                f"cannot resume {where!r}: {error}; replace it with --force"
+                f"cannot resume {where!r}: {error}; replace it with `force=True`"
             ) from None
         if stored is None:
             raise SweepError(
                 f"cannot resume {where!r}: it is not a phdesign sweep store "
-                f"(no {_MARKERS}/sweep.json); replace it with --force"
+                f"(no {_MARKERS}/sweep.json); replace it with `force=True`"
             )
         old, plan = stored
         difference = old.difference(description)
         if difference is not None:
             raise SweepError(
                 f"cannot resume {where!r}: it holds a different sweep ({difference}); "
-                "replace it with --force or choose another output"
+                "replace it with `force=True` or choose another output"
             )
         if chunk_size is not None and chunk_size != plan.chunk_size:
             raise SweepError(

@@ -254,7 +254,7 @@ def check_measured(actuate: Sequence[int], C_m: sympy.MatrixBase, model: BCPHS) 
             raise LoopError(
                 f"feedback source measured: y{a} = {name} (collocated with the actuated u{a}) "
                 "is not measured by these sensors; feed back its estimate "
-                "(--feedback-source estimate) or measure it"
+                "(`feedback_source='estimate'`) or measure it"
             )
 
 

@@ -156,7 +156,7 @@ def test_every_command_refuses_a_rank_deficient_C_m(capsys, argv):
     status, out, err = run(capsys, *argv)
     assert status == 2
     assert out == ""
-    assert "C_m must have full row rank (independent measurements); expected rank 1" in err
+    assert "--cm must have full row rank (independent measurements); expected rank 1" in err
 
 
 def test_numeric_functions_refuse_what_classify_refuses(wave):

@@ -301,7 +301,7 @@ def test_importing_plots_does_not_import_matplotlib():
 @pytest.mark.parametrize(
     ("name", "exists", "force", "match"),
     [
-        ("a.png", True, False, "exists; pass --force"),
+        ("a.png", True, False, "exists; pass `force=True`"),
         ("a.txt", False, False, "unknown image format 'txt'"),
         ("a", False, False, "unknown image format ''"),
     ],

@@ -395,5 +395,5 @@ def test_plot_select_refuses_a_value_with_no_nearest_point(value, tmp_path, caps
     argv = ["plot", str(path), "-o", str(tmp_path / "p.png"), "--select", f"rho={value}"]
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert err == f"phdesign: error: select: rho expects a finite number; found {value!r}\n"
+    assert err == f"phdesign: error: --select: rho expects a finite number; found {value!r}\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.nc"]

@@ -205,7 +205,7 @@ def _free_inputs(U: np.ndarray, system: LoopSystem) -> np.ndarray | None:
     driven = [a + 1 for a in system.loop.actuated if np.any(U[:, a])]
     if driven:
         raise LoopError(
-            f"u{driven[0]} is actuated by the feedback; --u drives only the other inputs "
+            f"u{driven[0]} is actuated by the feedback; `u` drives only the other inputs "
             f"({', '.join(f'u{j + 1}' for j in system.others) or 'none'})"
         )
     return U[:, list(system.others)] if np.any(U) else None
@@ -230,7 +230,7 @@ def _result(
     warnings = tuple(
         f"the {name}'s energy balance drifts by {value:.3g} of its largest energy "
         f"(tolerance {ENERGY_BALANCE_RTOL:g}): the time stepping lost accuracy; "
-        "lower the resolution or use --scheme midpoint"
+        "lower the resolution or use `scheme='midpoint'`"
         for name, value in audits.items()
         if not value <= ENERGY_BALANCE_RTOL
     )

@@ -108,13 +108,13 @@ def check_order(
     if reduction == "modal":
         raise NumericError(
             "an explicit order cannot be combined with the modal reduction: the converged "
-            "modes fix its order; use --reduce none or --reduce balanced"
+            "modes fix its order; use `reduction='none'` or `reduction='balanced'`"
         )
     if reduction == "none" and (order % size or order < smallest):
         raise NumericError(
             f"order {order} is not a Galerkin order of this model: n (p + 1) with its n = "
-            f"{size} efforts and degree p >= N + 1 (at least {smallest}); use --reduce "
-            "balanced for any order"
+            f"{size} efforts and degree p >= N + 1 (at least {smallest}); use "
+            "`reduction='balanced'` for any order"
         )
     return int(order)
 
@@ -391,7 +391,7 @@ def _selection_warnings(trial: _Trial, right: np.ndarray, final: Candidate) -> l
             "converged abscissa "
             f"{trial.alpha:.6g} (max Re {np.max(right.real):.3g}): unresolved high "
             "frequencies of the Galerkin basis, in which the observer's own transients decay "
-            "that slowly; --reduce modal drops them"
+            "that slowly; `reduction='modal'` drops them"
         )
     if not final.passed:
         warnings.append(

@@ -291,7 +291,7 @@ class ObserverModel:
             raise NumericError(
                 "the observer's correction loop I + C_m^T L C_m D_s is singular (condition "
                 f"number {condition:.3g}, expected at most {LOOP_CONDITION:g}): a reduced "
-                "model need not be passive; use the Galerkin observer (--reduce none)"
+                "model need not be passive; use the Galerkin observer (`reduction='none'`)"
             )
         inject = np.hstack([np.eye(m), self.C_m.T @ self.L])
         U_x = -np.linalg.solve(loop, K @ measure_x)

@@ -158,7 +158,7 @@ def target_warning(
         f"performance target: at degrees {degrees[0]} and {degrees[1]} they differ by "
         f"{gap / peak:.3g} of their peak over the last fifth (target {output_tol:g}), so no "
         "observer can be shown to meet it; give an initial state that meets the boundary "
-        "conditions (--x0) or a higher --plant-resolution"
+        "conditions (`x0`) or a higher `plant_resolution`"
     )
 
 
@@ -173,6 +173,6 @@ def gap_warning(
         f"degrees {degrees[0]} and {degrees[1]} they differ by {gap:.3g} over the last "
         f"fifth, against the continuous observer's floor {continuous_floor:.3g}, so the "
         "floors measure the plant's unresolved content as much as the observer; give an "
-        "initial state that meets the boundary conditions (--x0) or a higher "
-        "--plant-resolution"
+        "initial state that meets the boundary conditions (`x0`) or a higher "
+        "`plant_resolution`"
     )

@@ -47,7 +47,7 @@ def modal_truncation(
     if k != kept.size:
         raise NumericError(
             f"the modal reduction could not separate the {kept.size} converged poles "
-            f"(the Schur reordering kept {k}); use --reduce none"
+            f"(the Schur reordering kept {k}); use `reduction='none'`"
         )
     T11, T12, T22 = T[:k, :k], T[:k, k:], T[k:, k:]
     X = sl.solve_sylvester(T11, -T22, -T12)
@@ -81,7 +81,7 @@ def balanced_truncation(
     if not _slycot_available():
         raise NumericError(
             "balanced truncation needs slycot (python-control computes its gramians with "
-            "it): pip install slycot, or use --reduce none or --reduce modal"
+            "it): pip install slycot, or use `reduction='none'` or `reduction='modal'`"
         )
     import control
 

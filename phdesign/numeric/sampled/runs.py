@@ -283,7 +283,7 @@ def aliasing_warning(
         return None
     ratio = floor / continuous_floor if continuous_floor > 0 else math.inf
     hint = (
-        "use --sampler average (an integrate-and-dump front end) or a smaller dt"
+        "use `sampler='average'` (an integrate-and-dump front end) or a smaller `dt`"
         if sampler == "point"
         else "use a smaller dt or a higher order"
     )

@@ -235,7 +235,7 @@ def _unresolved_report(trail: list[PairResult], labels: _Labels) -> SpectrumRepo
         warning = (
             f"no eigenvalue agrees between the resolutions tried (up to {q}), yet discrete "
             "eigenvalues lie near the origin: the spectrum is not resolved at these resolutions "
-            "(raise max_resolution / --max-resolution); no number is reported"
+            "(raise `max_resolution`); no number is reported"
         )
     return SpectrumReport(
         spectral_abscissa=None,

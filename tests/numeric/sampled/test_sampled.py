@@ -323,7 +323,7 @@ def test_c_export_folder_is_all_or_nothing(tmp_path, monkeypatch):
     monkeypatch.undo()
     assert list(tmp_path.iterdir()) == []  # neither the folder nor its staging copy
     write_directory(target, {"a.h": "old"})
-    with pytest.raises(OutputFileError, match="exists; pass --force"):
+    with pytest.raises(OutputFileError, match="exists; pass `force=True`"):
         write_directory(target, {"a.h": "new"})
     write_directory(target, {"a.h": "new", "a.c": "new"}, force=True)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["obs"]

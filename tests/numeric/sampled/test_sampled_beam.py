@@ -166,7 +166,7 @@ def test_point_samples_at_1_ms_trigger_the_aliasing_warning(runs):
     assert v.floor > 100 * v.continuous_floor
     assert len(v.warnings) == 1
     assert "aliases the plant's high frequencies" in v.warnings[0]
-    assert "use --sampler average" in v.warnings[0]
+    assert "use `sampler='average'`" in v.warnings[0]
 
 
 def test_verification_needs_a_plant_twice_the_order(beam):
