@@ -389,7 +389,7 @@ COMMAND_ROWS = [
     row(f"{SIM} --dt 1e-300", r"--t-end / --dt = 5e\+300 sampling periods", NumericError),
     row(
         f"{SIM} --dt 1e-6 --u u1:sin(t) --resolution 6",
-        r"t_end / dt = 5e\+06 periods, each stepped with an input, times 28 states is "
+        r"--t-end / --dt = 5e\+06 periods, each stepped with an input, times 28 states is "
         r"1.4e\+08 values; expected at most 20,000,000",
         NumericError,
     ),

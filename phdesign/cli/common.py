@@ -29,6 +29,7 @@ __all__ = [
     "result_text",
     "run_outputs",
     "simulation_text",
+    "split_items",
     "warn",
     "write_output",
 ]
@@ -182,6 +183,11 @@ def write_output(path: str, text: str | bytes, force: bool) -> None:
     from phdesign.io import atomic_write
 
     atomic_write(path, text, force=force)
+
+
+def split_items(text: str) -> list[str]:
+    """Split a comma-separated option value (``--at 0.5,1``) into its stripped items."""
+    return [item.strip() for item in str(text).split(",")]
 
 
 def non_negative_int(text: str) -> int:

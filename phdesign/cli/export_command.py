@@ -1,17 +1,16 @@
 """Command ``export`` (the observer for a controller) and the sampled-loop flags of ``simulate``.
 
-Argument parsing and printing only: the observer comes from
-:func:`phdesign.numeric.sampled.export.export_observer`, the files from :mod:`phdesign.codegen`.
-Every check that can fail (the output path, the period, the sampler, the order against the
-verification plant, jinja2 for the rendered formats) runs before any computation, so a bad
-command writes nothing.
+Argument parsing and printing only: the observer comes from :meth:`phdesign.Observer.export`
+(which checks the period, the sampler, the order against the verification plant and the
+output points before any computation), the files from :meth:`SampledObserver.write`; the
+output path and jinja2 for the rendered formats are checked first, so a bad command
+writes nothing.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib.util
-import math
 from typing import Any
 
 from phdesign.cli.common import (
@@ -22,10 +21,11 @@ from phdesign.cli.common import (
     emit_json,
     load_model,
     result_text,
+    split_items,
     warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
-from phdesign.core.checks import EXPORT_FORMATS, REDUCTIONS, SAMPLERS
+from phdesign.core.checks import EXPORT_FORMATS, REDUCTIONS, SAMPLERS, positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError, ObserverError, OutputFileError
 
@@ -119,43 +119,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     ex.set_defaults(handler=_export)
 
 
-def _finite_positive(name: str, value: float) -> float:
-    if not (math.isfinite(value) and value > 0):
-        raise NumericError(f"{name} must be a finite positive number; found {value!r}")
-    return value
-
-
-def _points(text: str | None, nm: Any) -> tuple[float, ...] | None:
-    """Parse ``--at`` (numbers; their checks are the library's)."""
-    if text is None:
-        return None
-    from phdesign.numeric.sampled.export import displacement_points
-
-    a, b = nm.interval
-    points = []
-    for item in text.split(","):
-        try:
-            points.append(float(item))
-        except ValueError:
-            raise NumericError(
-                f"--at: expected numbers in [{a:g}, {b:g}]; found {item!r}"
-            ) from None
-    return displacement_points(nm, points, "--at")
-
-
 def _export(args: argparse.Namespace) -> int:
     from phdesign.codegen import check_export_path
-    from phdesign.core.limits import check_periods
-    from phdesign.numeric.checks import check_sampling
-    from phdesign.numeric.inputs import initial_state_function
-    from phdesign.numeric.sampled.export import export_observer
-    from phdesign.numeric.sampled.plant_resolution import verification_plant_degree
 
-    dt = check_sampling(args.dt, args.sampler, dt_name="--dt")
-    _finite_positive("--t-end", args.t_end)
-    check_periods(dt, args.t_end, stepped=args.verify, names=("--dt", "--t-end"))
-    _finite_positive("--tol", args.tol)
-    _finite_positive("--output-tol", args.output_tol)
+    # the output is checked before any work (the design checks the rest before computing)
     check_export_path(args.output, args.format, args.force)
     if args.format in ("c", "statespace") and importlib.util.find_spec("jinja2") is None:
         raise OutputFileError(
@@ -166,28 +133,18 @@ def _export(args: argparse.Namespace) -> int:
     observer = observer_from_args(args, model, command="export")
     if observer is None:
         raise ObserverError("export needs --sensors or --cm to say which outputs are measured")
-    nm = observer.plant.numeric
-    C_m, L = observer.numeric_gain("export")
-    verification_plant_degree(nm, args.order, args.plant_resolution, args.reduce)
-    points = _points(args.at, nm)
-    x0 = initial_state_function(args.x0, nm, model=model) if args.x0 else None
-    result = export_observer(
-        nm,
-        C_m,
-        L,
-        dt=dt,
+    result = observer.export(
+        dt=args.dt,
         sampler=args.sampler,
         order=args.order,
         reduction=args.reduce,
         tol=args.tol,
         output_tol=args.output_tol,
         verify=args.verify,
-        x0=x0,
-        x0_text=args.x0,
+        x0=args.x0 or None,
         t_end=args.t_end,
         plant_resolution=args.plant_resolution,
-        points=points,
-        model_name=model.name,
+        points=None if args.at is None else split_items(args.at),
     )
     written = result.write(args.output, args.format, force=args.force)
     if args.json:
@@ -236,7 +193,7 @@ def sampling_options(args: argparse.Namespace, observed: bool) -> dict[str, Any]
         raise NumericError("--sampler needs --dt, the sampling period")
     if args.dt is not None:
         dt = check_sampling(args.dt, args.sampler or "average", dt_name="--dt")
-        check_periods(dt, _finite_positive("--t-end", args.t_end), names=("--dt", "--t-end"))
+        check_periods(dt, positive_number(args.t_end, "--t-end"))
     if args.scheme != "expm":
         raise NumericError("a sampled or lower-order observer is stepped exactly: drop --scheme")
     check_positive("--observer-resolution", args.observer_resolution)

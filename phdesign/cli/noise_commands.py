@@ -1,9 +1,10 @@
 """Commands ``noise`` and ``tradeoff``, and the noise options of ``simulate`` and ``tune``.
 
-Argument parsing and printing only: the figures come from
-:mod:`phdesign.numeric.noise.figures`, :mod:`phdesign.numeric.noise.tradeoff`,
-:mod:`phdesign.numeric.noise.tuning` and :mod:`phdesign.numeric.time.stochastic`, imported inside
-the handlers.  Each command prints ``str(result)`` or ``result.to_dict()`` as JSON.
+Argument parsing and printing only: the figures come from the observer's noise
+questions (:meth:`phdesign.Observer.noise`, :meth:`~phdesign.Observer.tradeoff`,
+:meth:`~phdesign.Observer.tune_noise`), the noisy simulation from
+:mod:`phdesign.numeric.time.stochastic`.  Each command prints ``str(result)`` or
+``result.to_dict()`` as JSON.
 
 Noise options (shared):
 
@@ -31,11 +32,13 @@ from phdesign.cli.common import (
     add_model_argument,
     check_positive,
     emit_result,
+    load_model,
     result_text,
     run_outputs,
+    split_items,
 )
-from phdesign.cli.design_arguments import add_observer_arguments
-from phdesign.core.errors import NumericError, ObserverError
+from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
+from phdesign.core.errors import NumericError, ObserverError, ParameterError
 from phdesign.core.limits import check_tradeoff_gains
 
 __all__ = [
@@ -148,30 +151,26 @@ def _numbers(text: str, flag: str) -> list[float]:
     return values
 
 
-def _intensities(text: str | None, count: int, flag: str) -> Any:
-    if text is None:
-        return None
-    from phdesign.numeric.noise.figures import check_intensity
-
-    return check_intensity(_numbers(text, flag), count, flag)
+def _intensities(text: str | None, flag: str) -> list[float] | None:
+    """Return the numbers of a noise intensity option (the design checks count and signs)."""
+    return None if text is None else _numbers(text, flag)
 
 
-def _performance(args: argparse.Namespace, nm: Any, model: Any) -> list[Any] | None:
-    from phdesign.numeric.discretization import functionals as fn
-
-    items: list[Any] = []
-    if args.at is not None:
-        items += [fn.displacement_at(nm, z.strip()) for z in str(args.at).split(",")]
-    items += [fn.trace_functional(nm, t, model) for t in args.trace]
-    items += [fn.integral_functional(nm, w, model) for w in args.integral]
+def _performance(args: argparse.Namespace) -> list[str] | None:
+    """Return the performance outputs of ``--at``, ``--trace`` and ``--integral`` as text."""
+    items = [f"w({z})" for z in split_items(args.at)] if args.at is not None else []
+    items += args.trace
+    for weights in args.integral:
+        if ":" not in weights:  # a weight without its component would read as a trace
+            raise ParameterError(
+                f"--integral item {weights!r}: expected 'name: expression', e.g. 'x2: sin(pi*z)'"
+            )
+        items.append(weights)
     return items or None
 
 
-def _observer(args: argparse.Namespace, command: str) -> tuple[Any, Any, Any, Any]:
-    """Return (model, NumericModel, C_m, L); ``tradeoff`` takes no gain (L is None)."""
-    from phdesign.cli.common import load_model
-    from phdesign.cli.design_arguments import observer_from_args
-
+def _observer(args: argparse.Namespace, command: str) -> Any:
+    """Return the :class:`phdesign.Observer` of the command; ``tradeoff`` takes no gain."""
     model = load_model(args)
     family = command == "tradeoff"  # the ray or grid gives the gains
     observer = observer_from_args(
@@ -186,39 +185,25 @@ def _observer(args: argparse.Namespace, command: str) -> tuple[Any, Any, Any, An
             f"{command} needs --sensors or --cm: the noise enters through the observer's "
             "measurements"
         )
-    from phdesign.design.observer import numeric_matrix
-
-    C_m = numeric_matrix(observer.C_m, "C_m", command)
-    L = None if family else observer.numeric_gain(command)[1]
-    return model, observer.plant.numeric, C_m, L
+    return observer
 
 
-def _noise_inputs(args: argparse.Namespace, nm: Any, model: Any, q: int) -> dict[str, Any]:
+def _noise_inputs(args: argparse.Namespace) -> dict[str, Any]:
+    """Return the noise options as the design's arguments (intensities, performance)."""
     return {
-        "intensity": _intensities(args.intensity, q, "--intensity"),
-        "input_intensity": _intensities(args.input_noise, nm.n_ports, "--input-noise"),
-        "performance": _performance(args, nm, model),
-        "model": model,
+        "intensity": _intensities(args.intensity, "--intensity"),
+        "input_intensity": _intensities(args.input_noise, "--input-noise"),
+        "performance": _performance(args),
     }
 
 
 # ----------------------------------------------------------------------------- commands
 def _noise(args: argparse.Namespace) -> int:
-    from phdesign.numeric.noise.figures import noise
-
     check_positive("--resolution", args.resolution)
     check_positive("--tol", args.tol)
-    model, nm, C_m, L = _observer(args, "noise")
+    observer = _observer(args, "noise")
     with run_outputs(args) as commit:  # the plot is checked now, the text printed after it
-        report = noise(
-            nm,
-            C_m,
-            L,
-            **_noise_inputs(args, nm, model, C_m.shape[0]),
-            method=args.method,
-            resolution=args.resolution,
-            tol=args.tol,
-        )
+        report = observer.noise(**_noise_inputs(args), tol=args.tol)
         commit(_text(args, report), report)
     return 0
 
@@ -256,10 +241,8 @@ def _range(text: str, flag: str) -> Any:
 
 
 def _tradeoff(args: argparse.Namespace) -> int:
-    from phdesign.numeric.noise.tradeoff import tradeoff
-
-    model, nm, C_m, _ = _observer(args, "tradeoff")
-    q = C_m.shape[0]
+    observer = _observer(args, "tradeoff")
+    q = observer.q
     if args.grid is not None and args.scales is not None:
         raise NumericError("--scales belongs to a ray; a --grid gives its own values")
     direction = None
@@ -277,14 +260,8 @@ def _tradeoff(args: argparse.Namespace) -> int:
     scales = None if args.scales is None else _range(args.scales, "--scales")
     # the table and the picture are checked now and written together: both or neither
     with run_outputs(args) as commit:
-        result = tradeoff(
-            nm,
-            C_m,
-            direction=direction,
-            scales=scales,
-            grid=grid,
-            **_noise_inputs(args, nm, model, q),
-            method=args.method,
+        result = observer.tradeoff(
+            direction=direction, scales=scales, grid=grid, **_noise_inputs(args)
         )
         commit(_text(args, result), result)
     return 0
@@ -343,8 +320,10 @@ def _listed_intensities(text: str | None, flag: str) -> Any:
     """Intensities checked for sign and finiteness (the library checks their count)."""
     if text is None:
         return None
+    from phdesign.numeric.noise.figures import check_intensity
+
     values = _numbers(text, flag)
-    return _intensities(text, len(values), flag)
+    return check_intensity(values, len(values), flag)
 
 
 # ----------------------------------------------------------------------------- tune
@@ -410,21 +389,12 @@ def noise_tuning(args: argparse.Namespace) -> int | None:
             raise NumericError(f"{flag} must be a positive number; found {value}")
     if args.objective == "rms" and args.min_decay is None:
         raise NumericError("--objective rms needs --min-decay A (the decay rate to keep)")
-    from phdesign.cli.common import load_model
-    from phdesign.cli.design_arguments import observer_from_args
-    from phdesign.design.observer import numeric_matrix
-    from phdesign.numeric.noise.tuning import tune_noise
-
     model = load_model(args)
     observer = observer_from_args(args, model)  # argparse requires --sensors or --cm here
-    nm = observer.plant.numeric
-    C_m = numeric_matrix(observer.C_m, "C_m", "tune")
-    result = tune_noise(
-        nm,
-        C_m,
+    result = observer.tune_noise(
         objective=args.objective,
         max_rms=args.max_rms,
         min_decay=args.min_decay,
-        **_noise_inputs(args, nm, model, C_m.shape[0]),
+        **_noise_inputs(args),
     )
     return emit_result(args, result, model=model.name)

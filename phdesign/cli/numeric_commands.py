@@ -1,7 +1,8 @@
 """Commands ``spectrum``, ``simulate`` and ``tune`` (numeric backend front end).
 
-Argument parsing and printing only; the numbers come from :mod:`phdesign.numeric`,
-imported inside the handlers so that the command line starts without numpy-heavy code.
+Argument parsing and printing only; the numbers come from the design objects
+(:class:`phdesign.Observer`, :class:`phdesign.Plant`), imported inside the handlers so that
+the command line starts without numpy-heavy code.
 
 Initial states (``--x0``, ``--xhat0``) are comma-separated ``name: expression`` items:
 a state name of the model (``x1``, ``x2``, ... always work, as do the model's own state
@@ -15,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Any
 
 from phdesign.cli.common import (
     add_discretization_arguments,
@@ -159,42 +159,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     tn.set_defaults(handler=_tune)
 
 
-def _numeric_setup(args: argparse.Namespace, command: str) -> tuple[Any, Any, Any, Any]:
-    """Return (model, NumericModel, C_m, L) with C_m/L as float arrays or None.
-
-    The sensors and gain go through :class:`phdesign.Observer` (one validation for every
-    command); ``--param`` is applied by :func:`load_model`.
-    """
-    from phdesign.design.observer import Plant
-
-    model = load_model(args)
-    observer = observer_from_args(
-        args, model, command=command, method=args.method, resolution=args.resolution
-    )
-    if observer is None:
-        return model, Plant(model, method=args.method).numeric, None, None
-    C_m, L = observer.numeric_gain(command)
-    return model, observer.plant.numeric, C_m, L
-
-
 def _spectrum(args: argparse.Namespace) -> int:
-    from phdesign.numeric.spectrum.converged import spectrum
+    from phdesign.design.plant import Plant
 
     check_positive("--resolution", args.resolution)
     check_positive("--tol", args.tol)
     check_positive("--count", args.count)
     check_positive("--max-resolution", args.max_resolution)
-    _model, nm, C_m, L = _numeric_setup(args, "spectrum")
-    rep = spectrum(
-        nm,
-        C_m,
-        L,
-        method=args.method,
-        resolution=args.resolution,
-        max_resolution=args.max_resolution,
-        tol=args.tol,
-        count=args.count,
+    model = load_model(args)
+    observer = observer_from_args(
+        args, model, command="spectrum", method=args.method, resolution=args.resolution
     )
+    # the error system of the observer, or the plant with u = 0 without sensors
+    design = observer or Plant(model, method=args.method, resolution=args.resolution)
+    rep = design.spectrum(max_resolution=args.max_resolution, tol=args.tol, count=args.count)
     return emit_result(args, rep)
 
 
@@ -301,9 +279,6 @@ class _Progress:
 
 
 def _tune(args: argparse.Namespace) -> int:
-    from phdesign.design.observer import numeric_matrix
-    from phdesign.numeric.tuning.search import tune
-
     if (noisy := noise_tuning(args)) is not None:  # --max-rms / --objective rms
         return noisy
     starts = TUNE_STARTS if args.starts is None else args.starts
@@ -311,12 +286,9 @@ def _tune(args: argparse.Namespace) -> int:
     robust = _robust_fraction(args.robust)
     model = load_model(args)
     observer = observer_from_args(args, model)  # argparse requires --sensors or --cm here
-    C_m = numeric_matrix(observer.C_m, "C_m", "tune")
     progress = _Progress() if sys.stderr.isatty() else None
     try:
-        res = tune(
-            observer.plant.numeric,
-            C_m,
+        tuned = observer.tune(
             full=args.full,
             starts=starts,
             seed=0 if args.seed is None else args.seed,
@@ -326,4 +298,4 @@ def _tune(args: argparse.Namespace) -> int:
     finally:
         if progress is not None:
             progress.clear()
-    return emit_result(args, res)
+    return emit_result(args, tuned.tuning)

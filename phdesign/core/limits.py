@@ -411,7 +411,7 @@ def check_periods(
     *,
     stepped: bool = True,
     states: int = 0,
-    names: tuple[str, str] = ("dt", "t_end"),
+    names: tuple[str, str] = ("`dt`", "`t_end`"),
 ) -> None:
     """Refuse a sampling period longer than the run, or more periods than a run may step.
 
@@ -427,7 +427,8 @@ def check_periods(
         periods times states count against :data:`MAX_SIMULATION_VALUES`; 0 when the
         periods are jumped over by powers of the one-period map.
     names : (str, str)
-        How ``dt`` and ``t_end`` are called in the message (``("--dt", "--t-end")``).
+        How ``dt`` and ``t_end`` are called in the message: as code, which the command
+        line writes as its options (``--dt``, ``--t-end``).
     """
     dt_name, t_name = names
     if dt > t_end:

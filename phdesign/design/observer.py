@@ -39,6 +39,7 @@ from phdesign.core.checks import choice
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, ObserverError
 from phdesign.core.text import REPR_LIMIT, html_table, matrix_text, sensors_text, shorten
+from phdesign.design.noise import ObserverNoise
 from phdesign.design.plant import Plant, numeric_matrix
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import gain_matrix, measurement_matrix, sensor_matrix
@@ -46,8 +47,6 @@ from phdesign.symbolic.observer import gain_matrix, measurement_matrix, sensor_m
 if TYPE_CHECKING:  # pragma: no cover - typing only
     import numpy as np
 
-    from phdesign.numeric.noise.report import NoiseReport
-    from phdesign.numeric.noise.tradeoff import Tradeoff
     from phdesign.numeric.sampled.export import SampledObserver
     from phdesign.numeric.spectrum.report import SpectrumReport
     from phdesign.numeric.time.options import SimulationOptions
@@ -62,7 +61,7 @@ STATESPACE_SYSTEMS = ("plant", "observer", "error")
 
 
 @dataclass(frozen=True, init=False, repr=False)
-class Observer:
+class Observer(ObserverNoise):
     r"""A boundary observer for a model: sensors :math:`C_m` and gain :math:`L`.
 
     Parameters
@@ -257,9 +256,20 @@ class Observer:
         return self.plant.run(C, L, x0, xhat0=xhat0, u=u, options=opts, labels=self.labels())
 
     def tune(
-        self, *, full: bool = False, starts: int = 6, seed: int = 0, resolution: int | None = None
+        self,
+        *,
+        full: bool = False,
+        starts: int = 6,
+        seed: int = 0,
+        resolution: int | None = None,
+        robust: float | None = None,
+        progress: Callable[[str], None] | None = None,
     ) -> Observer:
         """Tune the gain for these sensors: minimize the error system's converged abscissa.
+
+        ``robust`` (a fraction, 0.05 for ±5 %) minimizes the worst abscissa over a box of
+        gains around each candidate instead; ``progress`` receives one line of text as the
+        search goes (:func:`phdesign.numeric.tuning.search.tune`).
 
         Returns
         -------
@@ -273,7 +283,14 @@ class Observer:
 
         C = numeric_matrix(self.C_m, "C_m", "tune")
         report = tune(
-            self.plant.numeric, C, full=full, starts=starts, seed=seed, resolution=resolution
+            self.plant.numeric,
+            C,
+            full=full,
+            starts=starts,
+            seed=seed,
+            resolution=resolution,
+            robust=robust,
+            progress=progress,
         )
         return self._copy(gain=report.gain, tuning=report)
 
@@ -294,151 +311,7 @@ class Observer:
             return export.observer_statespace(d, C, L)
         return export.error_statespace(d, C, L)
 
-    # ------------------------------------------------------------------ noise and export
-    def noise(
-        self,
-        *,
-        intensity: float | Sequence[float] | None = None,
-        input_intensity: float | Sequence[float] | None = None,
-        performance: str | Sequence[str] | None = None,
-        max_resolution: int | None = None,
-        tol: float | None = None,
-    ) -> NoiseReport:
-        r"""Return what the gain costs in sensor noise: each figure converged or flagged.
-
-        The observer receives :math:`y_m + \nu`, :math:`\mathbb E[\nu(t)\nu(s)^\top] =
-        \Sigma_\nu \delta(t - s)`, so the error system is driven at the boundary,
-
-        .. math::
-
-            \tilde u = -C_m^\top L C_m \tilde y - C_m^\top L \nu ,
-
-        and the report gives the steady-state variance of each performance output's
-        error, the L²-gain from the noise to :math:`\tilde x` (energy norm) with its
-        frequency, and the expected error energy :math:`\mathbb E[\tilde H]`, which is
-        infinite for the PDE (reported as diverging, never as a number):
-        :func:`phdesign.numeric.noise.figures.noise`.
-
-        Parameters
-        ----------
-        intensity : float or sequence of float, optional
-            Sensor noise intensities :math:`\sigma_i^2`, one per sensor or one for all
-            (default 1).
-        input_intensity : float or sequence of float, optional
-            White noise on the plant inputs, which the observer does not know (default none).
-        performance : str or sequence of str, optional
-            Outputs whose estimation-error variance is reported: ``"w(1)"`` (the
-            displacement at a point), a boundary trace such as ``"e1(1)"``, or an integral
-            ``"x2: sin(pi*z)"``; default the displacement at b when the model has one.
-        max_resolution, tol : optional
-            Largest resolution of the refinement, and the relative agreement that makes a
-            figure converged (default 1e-6 Galerkin, 1e-3 FD).
-
-        Returns
-        -------
-        NoiseReport
-            ``.performance[0].value`` (None unless converged), ``.rms()``, ``.l2_gain``,
-            ``.error_energy``; ``str()`` is what ``phdesign noise`` prints.
-
-        Examples
-        --------
-        >>> from phdesign.models import load_builtin
-        >>> string = Observer(load_builtin("wave"), sensors=[2], gain=0.5)
-        >>> report = string.noise(performance="x2: 1", intensity=0.3)
-        >>> round(report.performance[0].value, 8)  # Var = k sigma^2 / 2 for the damper k
-        0.075
-        >>> report.error_energy.diverges, round(report.l2_gain.value**2, 8)  # sigma^2 max(1, k)^2
-        (True, 0.3)
-        """
-        from phdesign.numeric.noise.figures import noise
-
-        C, L = self.numeric_gain("noise")
-        return noise(
-            self.plant.numeric,
-            C,
-            L,
-            model=self.plant.design_model,
-            intensity=intensity,
-            input_intensity=input_intensity,
-            performance=performance,
-            method=self.plant.method,
-            resolution=self.plant.resolution,
-            max_resolution=max_resolution,
-            tol=tol,
-        )
-
-    def tradeoff(
-        self,
-        *,
-        direction: Any = None,
-        scales: Sequence[float] | None = None,
-        grid: Sequence[Sequence[float]] | None = None,
-        intensity: float | Sequence[float] | None = None,
-        input_intensity: float | Sequence[float] | None = None,
-        performance: str | Sequence[str] | None = None,
-    ) -> Tradeoff:
-        r"""Decay rate against error RMS for these sensors, over a ray or a grid of gains.
-
-        Along the ray :math:`L(s) = s L_0` (or over a grid of diagonal gains) each gain
-        gets the converged spectral abscissa :math:`\alpha` of the error system (decay
-        rate :math:`-\alpha`) and the noise figures of :meth:`noise`; the gains that no
-        other beats in both decay and RMS of the first performance output are marked
-        Pareto-optimal (:func:`phdesign.numeric.noise.tradeoff.tradeoff`).
-
-        Parameters
-        ----------
-        direction : number, sequence or matrix, optional
-            :math:`L_0`; default this observer's gain (so :math:`s = 1` is this design),
-            or the identity for an observer without one.
-        scales : sequence of float, optional
-            The scales s (default 12 log-spaced from 0.1 to 10).
-        grid : sequence of sequences of float, optional
-            Per-sensor gain values, every combination a diagonal gain (instead of a ray).
-        intensity, input_intensity, performance
-            As for :meth:`noise`.
-
-        Returns
-        -------
-        Tradeoff
-            ``.points`` (gain, decay rate, rms, Pareto flag), ``.pareto_points``,
-            ``.to_csv()``, ``.plot()``; ``str()`` is what ``phdesign tradeoff`` prints.
-
-        Examples
-        --------
-        >>> from phdesign.models import load_builtin
-        >>> string = Observer(load_builtin("wave"), sensors=[2], gain=0.5)
-        >>> t = string.tradeoff(scales=[0.5, 1, 4], performance="x2: 1")
-        >>> [round(p.decay_rate, 6) for p in t.points]  # (1/2) ln|(1 + k)/(1 - k)|
-        [0.255413, 0.549306, 0.549306]
-        >>> [p.pareto for p in t.points]  # k = 2 decays as fast as k = 1/2, noisier
-        [True, True, False]
-        """
-        from phdesign.numeric.noise.tradeoff import tradeoff
-
-        C = numeric_matrix(self.C_m, "C_m", "tradeoff")
-        if direction is None and grid is None and self.L is not None:
-            direction = numeric_matrix(self.L, "L", "tradeoff (the default direction)")
-        elif direction is not None:
-            try:  # read as a gain is read (exact numbers, one per sensor or the matrix)
-                exact = gain_matrix(direction, self.q)
-            except ObserverError as error:
-                raise ObserverError(
-                    f"direction (the gain L_0 of the ray s L_0): {error}"
-                ) from None
-            direction = numeric_matrix(exact, "direction", "tradeoff")
-        return tradeoff(
-            self.plant.numeric,
-            C,
-            model=self.plant.design_model,
-            direction=direction,
-            scales=scales,
-            grid=grid,
-            intensity=intensity,
-            input_intensity=input_intensity,
-            performance=performance,
-            method=self.plant.method,
-        )
-
+    # ------------------------------------------------------------------ export
     def export(
         self,
         *,

@@ -169,7 +169,7 @@ BAD_NOISE = [
     ({"intensity": -1}, NumericError, r"^intensity: .*found -1"),
     ({"intensity": [1, 2]}, NumericError, r"^intensity: expected 1 values"),
     ({"intensity": "a"}, NumericError, r"^intensity: expected numbers; found 'a'"),
-    ({"input_intensity": float("nan")}, NumericError, r"^input intensity: "),
+    ({"input_intensity": float("nan")}, NumericError, r"^input_intensity: "),
     ({"performance": "w(2)"}, NumericError, r"^displacement point 2 is outside the interval"),
     ({"performance": "w(0.5)"}, NumericError, r"^w\(0.5\): the model 'wave' defines no"),
     ({"performance": "x9: 1"}, PhdesignError, r"unknown component 'x9'"),

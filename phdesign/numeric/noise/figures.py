@@ -132,7 +132,7 @@ def noise_intensities(
     sigma = check_intensity(default if intensity is None else intensity, q, "intensity")
     w_in = None
     if input_intensity is not None:
-        w_in = check_intensity(input_intensity, nm.n_ports, "input intensity")
+        w_in = check_intensity(input_intensity, nm.n_ports, "input_intensity")
     return sigma, w_in
 
 

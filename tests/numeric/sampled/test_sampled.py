@@ -337,11 +337,11 @@ def test_a_sampling_period_is_at_most_the_run_and_the_periods_are_bounded():
 
     nm = to_numeric(load_builtin("wave"))
     design = (np.array([[0.0, 1.0]]), np.array([[0.5]]))
-    with pytest.raises(NumericError, match=r"^dt = 1e\+300 s is longer than t_end = 5 s"):
+    with pytest.raises(NumericError, match=r"^`dt` = 1e\+300 s is longer than `t_end` = 5 s"):
         export_observer(nm, *design, dt=1e300, order=6)
-    with pytest.raises(NumericError, match=r"^t_end / dt = 5e\+300 sampling periods"):
+    with pytest.raises(NumericError, match=r"^`t_end` / `dt` = 5e\+300 sampling periods"):
         export_observer(nm, *design, dt=1e-300, order=6, verify=True)
-    with pytest.raises(NumericError, match=r"^dt = 10 s is longer than t_end = 5 s"):
+    with pytest.raises(NumericError, match=r"^`dt` = 10 s is longer than `t_end` = 5 s"):
         simulate_sampled(nm, *design, options=SimulationOptions(dt=10.0, resolution=6))
-    with pytest.raises(NumericError, match=r"^t_end / dt = 5e\+300 sampling periods"):
+    with pytest.raises(NumericError, match=r"^`t_end` / `dt` = 5e\+300 sampling periods"):
         simulate_sampled(nm, *design, options=SimulationOptions(dt=1e-300, resolution=6))
