@@ -43,6 +43,8 @@ import sympy
 from phdesign.core.checks import choice
 from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import LoopError
+from phdesign.core.text import html_table
+from phdesign.design.plant import Plant
 from phdesign.symbolic.control import (
     FEEDBACK_SOURCES,
     LoopClassification,
@@ -77,15 +79,40 @@ def _sensors(model: BCPHS, sensors: Any, C_m: Any) -> sympy.ImmutableMatrix:
     return sensor_matrix(sensors, model.n_ports)
 
 
+def _plant(
+    model: Any, parameters: Mapping[str, Any] | None, method: str | None, resolution: int | None
+) -> Plant:
+    """Return the loop's plant: the model given as a Plant, or one built from the model."""
+    if isinstance(model, Plant):
+        if parameters or method not in (None, current().method) or resolution is not None:
+            raise LoopError("give parameters, method and resolution to the Plant, not twice")
+        return model
+    if not isinstance(model, BCPHS):
+        raise LoopError(f"model must be a BCPHS; found {type(model).__name__}")
+    method = choice(method_or_default(method), "method", current().method_names, LoopError)
+    return Plant(model, {str(k): v for k, v in (parameters or {}).items()}, method, resolution)
+
+
+def _observer_plant(observer: Any, parameters: Mapping[str, Any] | None) -> Plant:
+    """Return the observer's plant, or a new one with further parameter overrides."""
+    plant: Plant = observer.plant
+    if not parameters:
+        return plant
+    overrides = {**plant.parameters, **{str(k): v for k, v in parameters.items()}}
+    return Plant(plant.model, overrides, plant.method, plant.resolution)
+
+
 @dataclass(frozen=True, init=False)
 class Loop:
     r"""An observer-based boundary control loop (module docstring).
 
     Parameters
     ----------
-    model : BCPHS or Observer
-        The plant; or an :class:`~phdesign.design.observer.Observer`, whose model, sensors, gain,
-        parameters and discretization the loop takes (``phd.Loop(obs, actuate=3)``).
+    model : BCPHS, Plant or Observer
+        The plant: a model, a :class:`~phdesign.design.plant.Plant` (its parameter
+        overrides and discretization, shared with the designs built on it), or an
+        :class:`~phdesign.design.observer.Observer`, whose plant, sensors and gain the loop
+        takes (``phd.Loop(obs, actuate=3)``).
     actuate : int or sequence of int
         1-based indices into the model's external inputs.
     feedback : number, sequence, matrix or text
@@ -108,16 +135,21 @@ class Loop:
     resolution : int, optional
         Discretization used by :meth:`simulate`, :meth:`statespace`, :meth:`assemble`, and
         the first resolution of :meth:`spectrum`'s refinement (unless it is given one).
+
+    Attributes
+    ----------
+    plant : Plant
+        The model, its overrides and discretization, and the cached numeric model.
+    model : BCPHS
+        The model with the parameter overrides as its defaults (``plant.design_model``).
     """
 
-    model: BCPHS
+    plant: Plant
     actuate: tuple[int, ...]
     K: sympy.ImmutableMatrix
     C_m: sympy.ImmutableMatrix
     L: sympy.ImmutableMatrix
     source: str
-    method: str
-    resolution: int | None
 
     def __init__(
         self,
@@ -138,40 +170,45 @@ class Loop:
         from phdesign.symbolic.observer import ObserverDesign, gain_matrix
 
         if isinstance(model, Observer):  # phd.Loop(observer, actuate=..., feedback=...)
-            observer = model
             if sensors is not None or C_m is not None:
                 raise LoopError("the observer gives the sensors: drop sensors= and C_m=")
-            if observer.L is None:
+            if model.L is None:
                 raise LoopError("the observer has no gain yet: give one (or tune it) first")
-            model, C_m, gain = observer.model, observer.C_m, observer.L
-            parameters = {**observer.plant.parameters, **dict(parameters or {})}
-            method, resolution = observer.plant.method, observer.plant.resolution
-        if not isinstance(model, BCPHS):
-            raise LoopError(f"model must be a BCPHS; found {type(model).__name__}")
-        if parameters:
-            model = model.with_parameters({str(k): v for k, v in parameters.items()})
+            plant, C_m, gain = _observer_plant(model, parameters), model.C_m, model.L
+        else:
+            plant = _plant(model, parameters, method, resolution)
+        model = plant.design_model
         acts = actuated_indices(actuate, model)
         check_collocated(acts, feedback_outputs, model)
-        if feedback_source not in FEEDBACK_SOURCES:
-            raise LoopError(
-                f"feedback_source must be one of {FEEDBACK_SOURCES}; found {feedback_source!r}"
-            )
-        method = choice(method_or_default(method), "method", current().method_names, LoopError)
+        choice(feedback_source, "feedback_source", FEEDBACK_SOURCES, LoopError)
         C = _sensors(model, sensors, C_m)
         design = ObserverDesign(model, C, gain_matrix(gain, C.rows))  # checks C_m and L
         if feedback_source == "measured":
             check_measured(acts, design.C_m, model)
         for name, value in (
-            ("model", model),
+            ("plant", plant),
             ("actuate", acts),
             ("K", feedback_gain(feedback, len(acts))),
             ("C_m", design.C_m),
             ("L", design.L),
             ("source", feedback_source),
-            ("method", method),
-            ("resolution", resolution),
         ):
             object.__setattr__(self, name, value)
+
+    @property
+    def model(self) -> BCPHS:
+        """The model with the parameter overrides as its defaults."""
+        return self.plant.design_model
+
+    @property
+    def method(self) -> str:
+        """The discretization method (the plant's, resolved when it was built)."""
+        return str(self.plant.method)
+
+    @property
+    def resolution(self) -> int | None:
+        """The discretization's resolution (the plant's)."""
+        return self.plant.resolution
 
     @classmethod
     def from_parts(
@@ -203,16 +240,14 @@ class Loop:
         )
 
     def with_gains(self, feedback: Any = None, gain: Any = None) -> Loop:
-        """Return the same loop with a new K and/or L (e.g. from :meth:`tune`)."""
-        return Loop.from_parts(
-            self.model,
-            self.C_m,
-            self.L if gain is None else gain,
-            actuate=self.actuate,
-            feedback=self.K if feedback is None else feedback,
+        """Return the same loop with a new K and/or L (e.g. from :meth:`tune`), on its plant."""
+        return Loop(
+            self.plant,
+            self.actuate,
+            self.K if feedback is None else feedback,
+            gain=self.L if gain is None else gain,
+            C_m=self.C_m,
             feedback_source=self.source,
-            method=self.method,
-            resolution=self.resolution,
         )
 
     # ------------------------------------------------------------------ symbolic
@@ -227,12 +262,10 @@ class Loop:
         )
 
     # ------------------------------------------------------------------ numeric
-    @cached_property
+    @property
     def numeric_model(self) -> NumericModel:
-        """The plant through the bridge (parameters substituted)."""
-        from phdesign.numeric.bridge import to_numeric
-
-        return to_numeric(self.model)
+        """The plant through the bridge (parameters substituted), made once by the plant."""
+        return self.plant.numeric
 
     @cached_property
     def numeric(self) -> NumericLoop:
@@ -342,9 +375,8 @@ class Loop:
     def assemble(self) -> LoopSystem:
         """Return the assembled loop matrices (:mod:`phdesign.numeric.control.assembly`)."""
         from phdesign.numeric.control.assembly import assemble
-        from phdesign.numeric.discretization.registry import discretize
 
-        return assemble(discretize(self.numeric_model, self.method, self.resolution), self.numeric)
+        return assemble(self.plant.discrete(), self.numeric)
 
     def statespace(self, name: str = "loop") -> Any:
         """Export the loop as ``control.StateSpace`` (:func:`.numeric.loop.loop_statespace`)."""
@@ -377,10 +409,5 @@ class Loop:
         return f"loop on {self.model.name}: {self.design_label()} ({self.source})"
 
     def _repr_html_(self) -> str:
-        from html import escape
-
-        rows = "".join(
-            f"<tr><td>{escape(k)}</td><td>{escape(str(v))}</td></tr>"
-            for k, v in self.to_dict().items()
-        )
-        return f"<table><caption>observer-based loop</caption>{rows}</table>"
+        rows = [[key, value] for key, value in self.to_dict().items()]
+        return html_table(["observer-based loop", ""], rows)
