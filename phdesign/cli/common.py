@@ -217,7 +217,7 @@ def run_outputs(args: argparse.Namespace) -> Iterator[Callable[[str, Any], None]
 
     with OutputFiles(args.force) as out, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        fmt = None
+        fmt = ""
         output = getattr(args, "output", None)  # noise has a --plot only
         if output:
             out.add(output)
@@ -230,11 +230,9 @@ def run_outputs(args: argparse.Namespace) -> Iterator[Callable[[str, Any], None]
 
         def commit(text: str, result: Any) -> None:
             if args.plot:
-                import io
+                from phdesign.plots import figure_bytes
 
-                picture = io.BytesIO()
-                result.plot().savefig(picture, format=fmt, dpi=110)
-                out.stage(args.plot, picture.getvalue())
+                out.stage(args.plot, figure_bytes(result.plot(), fmt))
             if output:
                 out.stage(output, text)
             out.commit()

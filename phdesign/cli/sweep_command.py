@@ -204,9 +204,9 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _plot(args: argparse.Namespace) -> int:
-    from phdesign.plots import check_plot_path
+    from phdesign.plots import check_plot_path, save_figure
+    from phdesign.plots.sweep import plot_sweep
     from phdesign.sweep import open_sweep
-    from phdesign.sweep.plot import plot_sweep, save_plot
 
     check_plot_path(args.output, args.force)
     select = _named(args.select, "--select", "d=0.2")
@@ -214,7 +214,7 @@ def _plot(args: argparse.Namespace) -> int:
     names = [str(n) for n in dataset.data_vars]
     figure = args.figure or (names[0] if names else None)
     fig = plot_sweep(dataset, figure, select=select)
-    save_plot(fig, args.output, args.force)
+    save_figure(fig, args.output, args.force)
     if args.json:
         emit_json({"input": args.input, "output": args.output, "figure": figure, "select": select})
     else:

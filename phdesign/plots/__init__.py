@@ -10,8 +10,14 @@ draw themselves with these (``result.plot()``).
 
 The modules, by subject: :mod:`~phdesign.plots.energy` (Hamiltonians),
 :mod:`~phdesign.plots.deflection` (displacement, tip, outputs),
-:mod:`~phdesign.plots.spectra` (eigenvalues, abscissa against gain, gain maps) and
-:mod:`~phdesign.plots.simulation` (the summary figure of ``simulate --plot``).
+:mod:`~phdesign.plots.spectra` (eigenvalues, a spectrum report, a loop's spectrum,
+abscissa against gain, gain maps), :mod:`~phdesign.plots.simulation` (the summary figure
+of ``simulate --plot``), :mod:`~phdesign.plots.noise` (the noise report, speed against
+noise), :mod:`~phdesign.plots.verification` (an exported observer against the continuous
+one) and :mod:`~phdesign.plots.sweep` (gain maps and studies of a sweep).  No module
+outside this package draws: a result's ``.plot()`` hands itself to one of these
+functions in one line (python-control's ``TimeResponseData.plot``), and one place makes
+the axes, titles the figure and writes the file (:func:`drawing`, :func:`save_figure`).
 matplotlib is imported inside the functions and sympy not at all, so ``import
 phdesign.plots`` stays light.  Figures are never pyplot's: in Jupyter a figure shows once,
 as the value of a cell.
@@ -41,7 +47,14 @@ Examples
 
 from __future__ import annotations
 
-from phdesign.plots._figures import literal, new_figure
+from phdesign.plots._figures import (
+    check_plot_path,
+    drawing,
+    figure_bytes,
+    literal,
+    new_figure,
+    save_figure,
+)
 from phdesign.plots.deflection import (
     plot_deflection,
     plot_deflection_panels,
@@ -50,11 +63,13 @@ from phdesign.plots.deflection import (
     plot_tip_error,
 )
 from phdesign.plots.energy import plot_error_energy, plot_hamiltonians
-from phdesign.plots.simulation import check_plot_path, plot_simulation
+from phdesign.plots.simulation import plot_simulation
 from phdesign.plots.spectra import plot_abscissa_sweep, plot_gain_map, plot_spectrum
 
 __all__ = [
     "check_plot_path",
+    "drawing",
+    "figure_bytes",
     "literal",
     "new_figure",
     "plot_abscissa_sweep",
@@ -68,4 +83,5 @@ __all__ = [
     "plot_spectrum",
     "plot_tip",
     "plot_tip_error",
+    "save_figure",
 ]

@@ -1,4 +1,11 @@
-"""Figures, axes, labels and legends shared by the plots (matplotlib imported lazily).
+"""Figures, axes, titles, files, labels and legends shared by the plots (matplotlib lazily).
+
+One place makes the axes of every figure and writes it (py-pde's ``plot_on_axes``):
+:func:`drawing` checks the output path before anything is drawn, makes the axes (or
+draws on the caller's), titles the figure literally (:func:`literal`: a model's name
+never becomes mathtext) and writes the file atomically (:func:`save_figure`, the one
+figure saver, whose bytes :func:`figure_bytes` gives a command that writes several
+files together).
 
 New figures are plain :class:`~matplotlib.figure.Figure` objects on an Agg canvas, never
 pyplot's: no display, no global state, safe in scripts, servers and tests.  In a Jupyter
@@ -10,13 +17,18 @@ none).
 
 from __future__ import annotations
 
+import io
+import os
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.core.errors import NumericError
+from phdesign.core.errors import NumericError, OutputFileError
+from phdesign.core.files import atomic_write, check_output_path
 from phdesign.symbolic.units import with_unit
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
@@ -103,6 +115,88 @@ def new_figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, A
     FigureCanvasAgg(fig)  # explicit Agg: never needs a display
     axes = fig.subplots(nrows, ncols, squeeze=True)
     return fig, axes
+
+
+def check_plot_path(path: str | os.PathLike[str], force: bool = False) -> str:
+    """Check an output image path before any work is done; return its format.
+
+    The format is the file suffix (``png``, ``pdf``, ``svg``, ...).
+
+    Raises
+    ------
+    OutputFileError
+        The file exists and ``force`` is false, or the suffix is not an image format
+        matplotlib can write.
+
+    Examples
+    --------
+    >>> check_plot_path("beam.PNG")
+    'png'
+    """
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    target = Path(path)
+    fmt = target.suffix.lstrip(".").lower()
+    supported = FigureCanvasBase.get_supported_filetypes()
+    if fmt not in supported:
+        raise OutputFileError(
+            f"plot file {str(target)!r}: unknown image format {fmt!r}; expected a suffix "
+            f"among {', '.join('.' + s for s in sorted(supported))}"
+        )
+    check_output_path(target, force)
+    return fmt
+
+
+#: Resolution of a written raster figure (dots per inch).
+DPI = 110
+
+
+def figure_bytes(fig: Figure, fmt: str) -> bytes:
+    """Return the figure as a file of format ``fmt`` (``png``, ``pdf``, ``svg``, ...)."""
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format=fmt, dpi=DPI)
+    return buffer.getvalue()
+
+
+def save_figure(fig: Figure, path: str | os.PathLike[str], force: bool = False) -> None:
+    """Write ``fig`` to ``path`` atomically, its suffix the format (``force`` to overwrite)."""
+    atomic_write(path, figure_bytes(fig, check_plot_path(path, force=force)), force=force)
+
+
+@contextmanager
+def drawing(
+    path: str | os.PathLike[str] | None = None,
+    *,
+    force: bool = False,
+    title: str | None = None,
+    title_size: float | None = None,
+    ax: Axes | None = None,
+    nrows: int = 1,
+    ncols: int = 1,
+    **figure: Any,
+) -> Iterator[tuple[Figure, Any]]:
+    r"""Yield ``(fig, axes)`` to draw on; then title the figure and write it to ``path``.
+
+    The path is checked first (an existing file without ``force``, an unknown format:
+    nothing is drawn); the axes are ``ax`` (on its figure) or new (:func:`new_figure` with
+    ``nrows``, ``ncols`` and the figure's keywords); ``title`` is the figure's, drawn
+    literally.
+
+    Examples
+    --------
+    >>> with drawing(title="$beam$", figsize=(4, 3)) as (fig, ax):
+    ...     _ = ax.plot([0, 1], [1, 0])
+    >>> fig.get_suptitle()
+    '\\$beam\\$'
+    """
+    if path is not None:
+        check_plot_path(path, force=force)
+    fig, axes = (figure_of(ax), ax) if ax is not None else new_figure(nrows, ncols, **figure)
+    yield fig, axes
+    if title:
+        fig.suptitle(literal(title), **({} if title_size is None else {"fontsize": title_size}))
+    if path is not None:
+        save_figure(fig, path, force=force)
 
 
 def figure_of(ax: Axes) -> Figure:

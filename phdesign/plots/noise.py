@@ -2,35 +2,25 @@
 
 A front end (matplotlib only, imported lazily): it draws what
 :mod:`phdesign.numeric.noise.tradeoff` and :mod:`phdesign.numeric.noise.figures` computed.  Figures
-come from :func:`phdesign.plots.new_figure` (Agg outside Jupyter, pyplot inside) and are
-written atomically when a path is given.
+come from :func:`phdesign.plots.drawing` (the one place that makes the axes and writes
+the file) and are written atomically when a path is given.
 """
 
 from __future__ import annotations
 
-import io
 import os
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from phdesign.core.text import gain_text, measured_text
+from phdesign.plots._figures import drawing, literal
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["plot_noise_report", "plot_tradeoff", "save_figure"]
-
-
-def save_figure(fig: Figure, path: str | os.PathLike[str], force: bool = False) -> None:
-    """Write ``fig`` to ``path`` atomically (format from the suffix; ``force`` to overwrite)."""
-    from phdesign.io import atomic_write
-    from phdesign.plots import check_plot_path
-
-    fmt = check_plot_path(path, force=force)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format=fmt, dpi=110)
-    atomic_write(path, buffer.getvalue(), force=force)
+__all__ = ["plot_noise_report", "plot_tradeoff"]
 
 
 def plot_tradeoff(
@@ -52,11 +42,12 @@ def plot_tradeoff(
     annotate : {"pareto", "all", "none"}
         Which points carry their gain as a label.
     """
-    from phdesign.plots import check_plot_path, literal, new_figure
+    with drawing(path, force=force, figsize=(7.5, 5.0)) as (fig, ax):
+        _draw_tradeoff(ax, result, annotate)
+    return fig
 
-    if path is not None:
-        check_plot_path(path, force=force)
-    fig, ax = new_figure(figsize=(7.5, 5.0))
+
+def _draw_tradeoff(ax: Axes, result: Any, annotate: str) -> None:
     pts = [p for p in result.points if p.rms is not None and p.decay_rate is not None]
     others = [p for p in pts if not p.pareto]
     front = sorted((p for p in pts if p.pareto), key=lambda p: p.rms)
@@ -108,9 +99,6 @@ def plot_tradeoff(
     ax.grid(True, which="both", alpha=0.3)
     if pts:
         ax.legend(loc="best")
-    if path is not None:
-        save_figure(fig, path, force=force)
-    return fig
 
 
 def _spread(points: list[Any], gap: float = 0.035) -> list[Any]:
@@ -138,11 +126,16 @@ def plot_noise_report(
     its finest value against the resolution (flat when it converges, rising when it
     diverges).
     """
-    from phdesign.plots import check_plot_path, literal, new_figure
+    frame = drawing(
+        path, force=force, title=report.header(), title_size=9, ncols=2, figsize=(11, 4.2)
+    )
+    with frame as (fig, (left, right)):
+        _draw_frequency_response(left, report)
+        _draw_refinement(right, report)
+    return fig
 
-    if path is not None:
-        check_plot_path(path, force=force)
-    fig, (left, right) = new_figure(1, 2, figsize=(11, 4.2))
+
+def _draw_frequency_response(left: Axes, report: Any) -> None:
     if report.pencils:
         omega = report.default_frequencies()
         for res, values in report.frequency_response(omega).items():
@@ -169,6 +162,9 @@ def plot_noise_report(
         ylabel="gain noise → error (energy norm)",
         title="frequency response",
     )
+
+
+def _draw_refinement(right: Axes, report: Any) -> None:
     figures = [*report.performance, report.error_energy]
     for est in figures:
         values = np.asarray(est.values, dtype=float)
@@ -177,7 +173,3 @@ def plot_noise_report(
             right.plot(est.resolutions, values / values[-1], "-o", label=label)
     right.set(xlabel="resolution", ylabel="value / finest value", title="figures under refinement")
     right.legend(loc="best", fontsize=8)
-    fig.suptitle(literal(report.header()), fontsize=9)
-    if path is not None:
-        save_figure(fig, path, force=force)
-    return fig

@@ -1,24 +1,14 @@
-"""The summary figure of one simulation (``simulate --plot``) and the check of its path."""
+"""The summary figure of one simulation (``simulate --plot``)."""
 
 from __future__ import annotations
 
-import io
 import os
 import re
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.core.errors import OutputFileError
-from phdesign.plots._figures import (
-    DESIGN_COLORS,
-    legend_in_view,
-    literal,
-    new_figure,
-    require,
-    unit_label,
-)
+from phdesign.plots._figures import DESIGN_COLORS, drawing, legend_in_view, require, unit_label
 from phdesign.plots.deflection import plot_deflection, plot_outputs, plot_tip
 from phdesign.plots.energy import plot_hamiltonians
 
@@ -26,39 +16,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["check_plot_path", "plot_simulation"]
-
-
-def check_plot_path(path: str | os.PathLike[str], force: bool = False) -> str:
-    """Check an output image path before any work is done; return its format.
-
-    The format is the file suffix (``png``, ``pdf``, ``svg``, ...).
-
-    Raises
-    ------
-    OutputFileError
-        The file exists and ``force`` is false, or the suffix is not an image format
-        matplotlib can write.
-
-    Examples
-    --------
-    >>> check_plot_path("beam.PNG")
-    'png'
-    """
-    from matplotlib.backend_bases import FigureCanvasBase
-
-    target = Path(path)
-    fmt = target.suffix.lstrip(".").lower()
-    supported = FigureCanvasBase.get_supported_filetypes()
-    if fmt not in supported:
-        raise OutputFileError(
-            f"plot file {str(target)!r}: unknown image format {fmt!r}; expected a suffix "
-            f"among {', '.join('.' + s for s in sorted(supported))}"
-        )
-    from phdesign.io import check_output_path  # lazily: io imports sympy
-
-    check_output_path(target, force)
-    return fmt
+__all__ = ["plot_simulation"]
 
 
 def plot_simulation(
@@ -96,28 +54,20 @@ def plot_simulation(
     OutputFileError
         The file exists (without ``force``), its format is unknown, or it cannot be written.
     """
-    fmt = None if path is None else check_plot_path(path, force=force)
     has_w = getattr(result, "w", None) is not None
-    fig, axes = new_figure(2, 2, figsize=(11, 7.5))
-    plot_hamiltonians(result, axes[0])
-    if has_w:
-        plot_tip(result, axes[1, 0])
-        which = "error" if getattr(result, "w_hat", None) is not None else "w"
-        plot_deflection(result, which, axes[1, 1])
-    else:
-        measured = _measured_outputs(result)
-        plot_outputs(result, axes[1, 0], outputs=measured)
-        _plot_output_error(result, axes[1, 1], measured)
     if title is None:
         title = getattr(result, "title", None)
-    if title:  # a title, never mathtext: a model named "$\frac{1}{$" must not break it
-        fig.suptitle(literal(title))
-    if path is not None:
-        from phdesign.io import atomic_write
-
-        buffer = io.BytesIO()
-        fig.savefig(buffer, format=fmt, dpi=110)
-        atomic_write(path, buffer.getvalue(), force=force)
+    frame = drawing(path, force=force, title=title, nrows=2, ncols=2, figsize=(11, 7.5))
+    with frame as (fig, axes):
+        plot_hamiltonians(result, axes[0])
+        if has_w:
+            plot_tip(result, axes[1, 0])
+            which = "error" if getattr(result, "w_hat", None) is not None else "w"
+            plot_deflection(result, which, axes[1, 1])
+        else:
+            measured = _measured_outputs(result)
+            plot_outputs(result, axes[1, 0], outputs=measured)
+            _plot_output_error(result, axes[1, 1], measured)
     return fig
 
 

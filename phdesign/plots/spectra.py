@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -13,14 +13,22 @@ from phdesign.plots._figures import (
     IM_LABEL,
     RE_LABEL,
     axes_or_new,
+    drawing,
     legend_in_view,
+    literal,
 )
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["plot_abscissa_sweep", "plot_gain_map", "plot_spectrum"]
+__all__ = [
+    "plot_abscissa_sweep",
+    "plot_gain_map",
+    "plot_loop_spectrum",
+    "plot_spectrum",
+    "plot_spectrum_report",
+]
 
 
 def plot_spectrum(
@@ -218,4 +226,62 @@ def plot_gain_map(
         ax.set_xscale("log")
         ax.set_yscale("log")
     ax.set(xlabel="gain l1", ylabel="gain l2", title="spectral abscissa over (l1, l2)")
+    return fig
+
+
+def plot_spectrum_report(
+    report: Any,
+    *,
+    ax: Axes | None = None,
+    exact: np.ndarray | None = None,
+    title: str | None = None,
+    xlim: tuple[float, float] | None = None,
+    ylim: tuple[float, float] | None = None,
+) -> Figure:
+    """Draw a converged spectrum's chosen pair: resolved eigenvalues marked, the abscissa.
+
+    The default window frames the resolved eigenvalues (the unresolved ones run far
+    off); the default title names the model and the system.  The arguments are those
+    of :func:`plot_spectrum` (:meth:`SpectrumReport.plot` hands itself here).
+    """
+    lam = report.eigenvalues
+    if xlim is None and ylim is None and report.resolved.any():
+        shown = lam[report.resolved]
+        width = max(float(np.ptp(shown.real)), abs(float(np.min(shown.real))), 1e-300)
+        height = max(float(np.max(np.abs(shown.imag))), width)
+        xlim = (
+            float(np.min(shown.real)) - 0.1 * width,
+            max(0.0, float(np.max(shown.real))) + 0.1 * width,
+        )
+        ylim = (-1.1 * height, 1.1 * height)
+    return plot_spectrum(
+        lam,
+        report.resolved,
+        ax=ax,
+        abscissa=report.spectral_abscissa,
+        exact=exact,
+        title=title if title is not None else literal(f"{report.model}: {report.system}"),
+        xlim=xlim,
+        ylim=ylim,
+    )
+
+
+def plot_loop_spectrum(result: Any, ax: Axes | None = None) -> Figure:
+    """Draw a loop's rightmost resolved eigenvalues, marked by the block they belong to.
+
+    The controlled plant's eigenvalues are circles, the error system's crosses, the loop's
+    abscissa a vertical line (:meth:`LoopSpectrum.plot` hands itself here).
+    """
+    with drawing(ax=ax, figsize=(5, 4)) as (fig, axes):
+        for kind, marker in (("plant", "o"), ("error", "x")):
+            z = np.array(
+                [w for w, o in zip(result.rightmost, result.origin, strict=True) if o == kind]
+            )
+            if z.size:
+                axes.plot(z.real, z.imag, marker, ls="none", label=f"{kind} block")
+        if result.spectral_abscissa is not None:
+            axes.axvline(result.spectral_abscissa, color="k", lw=0.8, label="loop abscissa")
+        axes.set_xlabel("Re λ")
+        axes.set_ylabel("Im λ")
+        axes.legend()
     return fig

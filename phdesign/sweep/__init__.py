@@ -18,7 +18,7 @@ checked by :mod:`~phdesign.sweep.fields`),
 :mod:`~phdesign.sweep.plan` (chunks), :mod:`~phdesign.sweep.schedulers` (where they run),
 :mod:`~phdesign.sweep.execute` (running them), :mod:`~phdesign.sweep.store` (Zarr),
 :mod:`~phdesign.sweep.export` (CSV, NetCDF), :mod:`~phdesign.sweep.summary` (the printed
-result), :mod:`~phdesign.sweep.plot` (pictures of a result); the jobs'
+result; its pictures are drawn by :mod:`phdesign.plots.sweep`); the jobs'
 evaluators live in :mod:`~phdesign.sweep.spectrum_job` and
 :mod:`~phdesign.sweep.classify_job`.
 
@@ -191,8 +191,8 @@ def summarize(dataset: Any) -> Any:
 
 
 def plot_sweep(dataset: Any, figure: str | None = None, **kwargs: Any) -> Any:
-    """Draw a sweep's Dataset; see :func:`phdesign.sweep.plot.plot_sweep`."""
-    from phdesign.sweep.plot import plot_sweep as _plot
+    """Draw a sweep's Dataset; see :func:`phdesign.plots.sweep.plot_sweep`."""
+    from phdesign.plots.sweep import plot_sweep as _plot
 
     return _plot(dataset, figure, **kwargs)
 

@@ -399,7 +399,7 @@ def test_the_package_is_the_function():
 
 # --------------------------------------------------------------------- plots
 def test_plots_mark_unconverged_points(beam_reference):
-    from phdesign.sweep.plot import plot_sweep
+    from phdesign.plots.sweep import plot_sweep
 
     one = beam_reference.isel(d=1).copy(deep=True)
     one.converged.values[1, 0] = False  # as if (l1[1], l2[0]) had not converged
@@ -426,7 +426,7 @@ def test_plots_mark_unconverged_points(beam_reference):
 
 
 def test_verdict_map_draws_categories():
-    from phdesign.sweep.plot import plot_sweep
+    from phdesign.plots.sweep import plot_sweep
 
     ds = phdesign.sweep(
         "euler-bernoulli", job="classify", sensor_sets="4;3", grid={"l": "0.5,2"}, **SYNC

@@ -265,22 +265,9 @@ class LoopSpectrum:
 
     def plot(self, ax: Any = None) -> Any:
         """Draw the rightmost resolved loop eigenvalues, marked by the block they belong to."""
-        from phdesign.plots import new_figure
+        from phdesign.plots.spectra import plot_loop_spectrum
 
-        if ax is None:
-            _, ax = new_figure(figsize=(5, 4))
-        for kind, marker in (("plant", "o"), ("error", "x")):
-            z = np.array(
-                [w for w, o in zip(self.rightmost, self.origin, strict=True) if o == kind]
-            )
-            if z.size:
-                ax.plot(z.real, z.imag, marker, ls="none", label=f"{kind} block")
-        if self.spectral_abscissa is not None:
-            ax.axvline(self.spectral_abscissa, color="k", lw=0.8, label="loop abscissa")
-        ax.set_xlabel("Re λ")
-        ax.set_ylabel("Im λ")
-        ax.legend()
-        return ax.figure
+        return plot_loop_spectrum(self, ax)
 
 
 def _finite(x: float | None) -> float | None:

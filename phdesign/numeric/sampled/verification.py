@@ -129,19 +129,10 @@ class Verification:
         )
 
     def plot(self, ax: Any = None) -> Any:
-        """Draw both errors over time (log scale); returns the axes."""
-        import matplotlib.pyplot as plt
+        """Draw both errors over time (log scale); returns the axes (:mod:`phdesign.plots`)."""
+        from phdesign.plots.verification import plot_verification
 
-        if ax is None:
-            _, ax = plt.subplots(figsize=(7, 3.5))
-        ax.semilogy(self.t, np.abs(self.continuous_error).max(axis=1), label="continuous")
-        ax.semilogy(
-            self.t, np.abs(self.error).max(axis=1), label=f"{self.sampler}, dt = {self.dt:g}"
-        )
-        ax.set_xlabel("t")
-        ax.set_ylabel("|" + ", ".join(self.outputs) + " error|")
-        ax.legend()
-        return ax
+        return plot_verification(self, ax)
 
 
 def verify_observer(

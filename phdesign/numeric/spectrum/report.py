@@ -286,25 +286,6 @@ class SpectrumReport:
         The default window frames the resolved eigenvalues (the unresolved ones run far
         off); see :func:`phdesign.plots.plot_spectrum` for the arguments.
         """
-        from phdesign.plots import literal, plot_spectrum
+        from phdesign.plots.spectra import plot_spectrum_report
 
-        lam = self.eigenvalues
-        if xlim is None and ylim is None and self.resolved.any():
-            shown = lam[self.resolved]
-            width = max(float(np.ptp(shown.real)), abs(float(np.min(shown.real))), 1e-300)
-            height = max(float(np.max(np.abs(shown.imag))), width)
-            xlim = (
-                float(np.min(shown.real)) - 0.1 * width,
-                max(0.0, float(np.max(shown.real))) + 0.1 * width,
-            )
-            ylim = (-1.1 * height, 1.1 * height)
-        return plot_spectrum(
-            lam,
-            self.resolved,
-            ax=ax,
-            abscissa=self.spectral_abscissa,
-            exact=exact,
-            title=title if title is not None else literal(f"{self.model}: {self.system}"),
-            xlim=xlim,
-            ylim=ylim,
-        )
+        return plot_spectrum_report(self, ax=ax, exact=exact, title=title, xlim=xlim, ylim=ylim)

@@ -9,7 +9,9 @@
 * a third axis of at most :data:`MAX_PANELS` values: one panel per value.
 
 Points whose spectrum did not converge (``converged`` false) are marked on every picture,
-never drawn as if they had.  matplotlib is imported only here, and only when drawing.
+never drawn as if they had.  The Dataset is read through its coordinates, attributes and
+variables only (no import of :mod:`phdesign.sweep`); matplotlib is imported only when
+drawing.
 
 Examples
 --------
@@ -26,21 +28,20 @@ Examples
 
 from __future__ import annotations
 
-import io
 import math
-import os
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from phdesign.core.errors import SweepError
+from phdesign.plots._figures import drawing
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["MAX_PANELS", "plot_sweep", "save_plot", "select_points"]
+__all__ = ["MAX_PANELS", "plot_sweep", "select_points"]
 
 MAX_PANELS = 12
 _VERDICT_COLORS = {"exponential": "tab:green", "asymptotic": "gold", "inconclusive": "0.6"}
@@ -228,8 +229,6 @@ def plot_sweep(
         An unknown figure or axis, a single point, or more than three varying axes (or a
         third with more than :data:`MAX_PANELS` values): select values first.
     """
-    from phdesign.plots import new_figure
-
     names = [str(n) for n in dataset.data_vars]
     name = figure or (names[0] if names else "")
     if name not in names:
@@ -238,7 +237,30 @@ def plot_sweep(
     dims = _varying(data[name])
     if not dims:
         raise SweepError("one point is left to plot; select fewer axes")
-    panels = [None]
+    panels = _panels(data, dims)
+    columns = min(len(panels), 3)
+    rows = math.ceil(len(panels) / columns)
+    frame = drawing(
+        title=_title(dataset, name) if title is None else title,
+        nrows=rows,
+        ncols=columns,
+        figsize=(6.2 * columns, 4.6 * rows),
+    )
+    with frame as (fig, grid):
+        axes = np.asarray(grid, dtype=object).reshape(-1)
+        for k, value in enumerate(panels):
+            ax = axes[k]
+            part = data if value is None else data.sel({dims[0]: value})
+            _draw(fig, ax, part[name], _unconverged(part, name), part)
+            if value is not None:
+                ax.set_title(f"{dims[0]} = {value}", fontsize="medium")
+        for ax in axes[len(panels) :]:
+            ax.set_visible(False)
+    return fig
+
+
+def _panels(data: Any, dims: list[str]) -> list[Any]:
+    """Return the values of the axis drawn one panel each (``[None]``: one panel)."""
     if len(dims) >= 3 or (len(dims) == 2 and all(data[d].dtype.kind in "US" for d in dims)):
         outer = dims[0]
         if len(dims) > 3 or data.sizes[outer] > MAX_PANELS:
@@ -246,36 +268,13 @@ def plot_sweep(
                 f"{len(dims)} axes vary ({', '.join(dims)}); select values of "
                 f"{dims[0]} first (at most {MAX_PANELS} panels), e.g. select={{'{outer}': ...}}"
             )
-        panels = list(data[outer].values)
-    columns = min(len(panels), 3)
-    rows = math.ceil(len(panels) / columns)
-    fig, grid = new_figure(rows, columns, figsize=(6.2 * columns, 4.6 * rows))
-    axes = np.asarray(grid, dtype=object).reshape(-1)
-    for k, value in enumerate(panels):
-        ax = axes[k]
-        part = data if value is None else data.sel({dims[0]: value})
-        flags = _unconverged(part, name)
-        _draw(fig, ax, part[name], flags, part)
-        if value is not None:
-            ax.set_title(f"{dims[0]} = {value}", fontsize="medium")
-    for ax in axes[len(panels) :]:
-        ax.set_visible(False)
-    if title is None:
-        observer = dataset.attrs.get("sensors")
-        gain = dataset.attrs.get("gain")
-        title = f"{name}: {dataset.attrs.get('job', 'sweep')} on {dataset.attrs.get('model', '?')}"
-        if observer:
-            title += f", sensors {observer}, gain {gain}"
-    fig.suptitle(title)
-    return fig
+        return list(data[outer].values)
+    return [None]
 
 
-def save_plot(fig: Figure, path: str | os.PathLike[str], force: bool = False) -> None:
-    """Write ``fig`` atomically; its suffix picks the format (checked before drawing)."""
-    from phdesign.io import atomic_write
-    from phdesign.plots import check_plot_path
-
-    fmt = check_plot_path(path, force=force)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format=fmt, dpi=110)
-    atomic_write(path, buffer.getvalue(), force=force)
+def _title(dataset: Any, name: str) -> str:
+    """Return the default title: the figure, the job, the model, the sensors and gain."""
+    title = f"{name}: {dataset.attrs.get('job', 'sweep')} on {dataset.attrs.get('model', '?')}"
+    if dataset.attrs.get("sensors"):
+        title += f", sensors {dataset.attrs['sensors']}, gain {dataset.attrs.get('gain')}"
+    return title

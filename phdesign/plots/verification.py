@@ -1,0 +1,39 @@
+"""The verification of an exported observer: its error against the continuous observer's.
+
+A front end (matplotlib only, through :func:`phdesign.plots.drawing`): it draws what
+:func:`phdesign.numeric.sampled.verification.verify_observer` computed,
+:meth:`Verification.plot` and :meth:`SampledObserver.plot` hand themselves to it.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from phdesign.plots._figures import drawing
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from matplotlib.axes import Axes
+
+__all__ = ["plot_verification"]
+
+
+def plot_verification(verification: Any, ax: Axes | None = None) -> Axes:
+    """Draw both errors of the performance outputs over time (log scale); return the axes.
+
+    Parameters
+    ----------
+    verification : Verification
+        The run of the sampled observer and of the continuous one against the plant.
+    ax : Axes, optional
+        Draw there (default: a new figure).
+    """
+    with drawing(ax=ax, figsize=(7, 3.5)) as (_, axes):
+        v = verification
+        axes.semilogy(v.t, np.abs(v.continuous_error).max(axis=1), label="continuous")
+        axes.semilogy(v.t, np.abs(v.error).max(axis=1), label=f"{v.sampler}, dt = {v.dt:g}")
+        axes.set_xlabel("t")
+        axes.set_ylabel("|" + ", ".join(v.outputs) + " error|")
+        axes.legend()
+    return axes
