@@ -293,7 +293,7 @@ COMMAND_ROWS = [
     ),
     row(f"{NOISE} --trace e9(1)", "component index in 'e9(1)' is out of range", ExpressionError),
     row(f"{NOISE} --trace e1(0.5)", "is at an interior or outside point 0.5", ExpressionError),
-    row(f"{NOISE} --tol 0", "--tol must be positive; found 0", NumericError),
+    row(f"{NOISE} --tol 0", "--tol must be a finite positive number; found 0.0", NumericError),
     row(
         f"{NOISE} --plot {{tmp}}/noise.png",
         "exists; pass --force",
@@ -345,7 +345,11 @@ COMMAND_ROWS = [
     row(f"{TRADE} --intensity 1,1e200", r"at most 1e\+100 .*found 1e\+200", NumericError),
     row(f"{SIM} --noise-intensity 1 --scheme midpoint", "scheme does not apply", NumericError),
     row(f"{SIM} --noise-intensity 1 --dt 0.01", "--dt asks for a sampled one", NumericError),
-    row("tune wave --sensors 2 --max-rms -1", "--max-rms must be a positive number", NumericError),
+    row(
+        "tune wave --sensors 2 --max-rms -1",
+        "--max-rms must be a finite positive number; found -1.0",
+        NumericError,
+    ),
     row(
         "tune wave --sensors 2 --objective rms", "--objective rms needs --min-decay", NumericError
     ),
@@ -510,7 +514,11 @@ COMMAND_ROWS = [
     row(f"{SIM} --sampler point", "--sampler needs --dt, the sampling period", NumericError),
     row("simulate wave --dt 1e-3", "act on the observer: give --sensors or --cm", NumericError),
     row(f"{SIM} --dt 1e-3 --scheme midpoint", "stepped exactly: drop --scheme", NumericError),
-    row(f"{SIM} --observer-resolution 0", "--observer-resolution must be positive", NumericError),
+    row(
+        f"{SIM} --observer-resolution 0",
+        "--observer-resolution must be a positive integer; found 0",
+        NumericError,
+    ),
     row(
         f"{SIM} --method fd --resolution 20 --observer-resolution 10",
         "is not contained in the plant's",
@@ -830,7 +838,11 @@ COMMAND_ROWS = [
         SweepError,
     ),
     row(f"{MAP} --job classify --tol 1e-3 -o {{tmp}}/m.zarr", "has no option 'tol'", SweepError),
-    row(f"{MAP} --tol -1 -o {{tmp}}/m.zarr", "option tol: expected a positive number", SweepError),
+    row(
+        f"{MAP} --tol -1 -o {{tmp}}/m.zarr",
+        "option tol must be a finite positive number; found -1.0",
+        SweepError,
+    ),
     row(f"{MAP} --job nosuch -o {{tmp}}/m.zarr", "argument --job: invalid choice: 'nosuch'", None),
     row(
         "sweep euler-bernoulli --sensors 3,4 --grid l1=0.1:1:3 --gain 1,2,3 -o {tmp}/m.zarr",

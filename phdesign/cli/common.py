@@ -8,6 +8,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
+from phdesign.core.checks import positive_int, positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError, ParameterError
 
@@ -154,9 +155,15 @@ def emit_json(value: Any) -> None:
 
 
 def check_positive(option: str, value: float | int | None) -> None:
-    """Refuse a given option value that is not positive (``None``: not given, accepted)."""
-    if value is not None and not value > 0:
-        raise NumericError(f"{option} must be positive; found {value}")
+    """Refuse a given option value that is not a positive integer or finite number.
+
+    ``None`` (not given) is accepted; the checks are the library's
+    (:func:`~phdesign.core.checks.positive_int`, :func:`~phdesign.core.checks.positive_number`).
+    """
+    if isinstance(value, int):
+        positive_int(value, option)
+    elif value is not None:
+        positive_number(value, option)
 
 
 def result_text(result: Any) -> str:

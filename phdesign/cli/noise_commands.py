@@ -384,9 +384,8 @@ def noise_tuning(args: argparse.Namespace) -> int | None:
                 f"{flag} belongs to the abscissa search; the noise-aware tuning (--max-rms, "
                 f"--objective rms) does not take it: drop {flag}"
             )
-    for flag, value in (("--max-rms", args.max_rms), ("--min-decay", args.min_decay)):
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise NumericError(f"{flag} must be a positive number; found {value}")
+    check_positive("--max-rms", args.max_rms)
+    check_positive("--min-decay", args.min_decay)
     if args.objective == "rms" and args.min_decay is None:
         raise NumericError("--objective rms needs --min-decay A (the decay rate to keep)")
     model = load_model(args)

@@ -40,6 +40,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from phdesign.core.checks import positive_number
 from phdesign.core.errors import ParameterError, PhdesignError, SweepError
 from phdesign.core.limits import MAX_STORE_METADATA_BYTES, check_sweep_points
 from phdesign.sweep.fields import description_fields
@@ -278,13 +279,10 @@ def _fixed_gain(gain: str | Sequence[float] | float, count: int, per: str) -> tu
         entries = [gain]
     else:
         entries = list(gain)
-    values = tuple(float(v) for v in diagonal_values(entries, count, per))
-    for i, v in enumerate(values):
-        if not v > 0:
-            raise ObserverError(
-                f"gain: entry {i + 1} must be a finite positive number (L + Lᵀ ≻ 0); found {v!r}"
-            )
-    return values
+    values = [float(v) for v in diagonal_values(entries, count, per)]
+    return tuple(
+        positive_number(v, f"gain: entry {i + 1}", ObserverError) for i, v in enumerate(values)
+    )
 
 
 #: A parameter axis of at most this many values is checked at every value before the sweep

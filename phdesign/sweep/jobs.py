@@ -39,6 +39,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from phdesign.core.checks import positive_int, positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import SweepError
 
@@ -132,19 +133,8 @@ class Option:
                 )
             return value
         if self.kind == "int":
-            if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
-                raise SweepError(
-                    f"option {self.name}: expected a positive integer; found {value!r}"
-                )
-            return int(value)
-        number = (
-            float(value)
-            if isinstance(value, int | float) and not isinstance(value, bool)
-            else None
-        )
-        if number is None or not math.isfinite(number) or number <= 0:
-            raise SweepError(f"option {self.name}: expected a positive number; found {value!r}")
-        return number
+            return positive_int(value, f"option {self.name}", SweepError)
+        return positive_number(value, f"option {self.name}", SweepError)
 
 
 @dataclass(frozen=True)
