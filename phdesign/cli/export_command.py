@@ -25,7 +25,7 @@ from phdesign.cli.common import (
     warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
-from phdesign.core.checks import EXPORT_FORMATS, REDUCTIONS, SAMPLERS, positive_number
+from phdesign.core.checks import EXPORT_FORMATS, REDUCTIONS, SAMPLERS
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError, ObserverError, OutputFileError
 
@@ -41,6 +41,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     add_model_argument(ex)
     add_observer_arguments(ex)
+    _add_design_arguments(ex)
+    _add_output_arguments(ex)
+    _add_verification_arguments(ex)
+    add_json_argument(ex)
+    ex.set_defaults(handler=_export)
+
+
+def _add_design_arguments(ex: argparse.ArgumentParser) -> None:
+    """Add the exported observer's period, front end, order and accuracy targets."""
     export = current().export
     ex.add_argument("--dt", type=float, required=True, metavar="DT", help="sampling period (s)")
     ex.add_argument(
@@ -73,6 +82,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         help="error floor of the performance outputs, relative to their peak (default "
         "%(default)g)",
     )
+
+
+def _add_output_arguments(ex: argparse.ArgumentParser) -> None:
+    """Add what is written, and where."""
     ex.add_argument(
         "--format", choices=EXPORT_FORMATS, required=True, help="what to write to -o PATH"
     )
@@ -85,6 +98,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         help="replace an existing output that phdesign wrote (a C folder only while it holds "
         "exactly the files of its marker .phdesign-export)",
     )
+
+
+def _add_verification_arguments(ex: argparse.ArgumentParser) -> None:
+    """Add the runs against the high-resolution plant: initial state, length, plant, outputs."""
+    export = current().export
     ex.add_argument(
         "--verify",
         action="store_true",
@@ -115,8 +133,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         metavar="Z,..",
         help="displacement points of the outputs w(z) (default b, for a model with one)",
     )
-    add_json_argument(ex)
-    ex.set_defaults(handler=_export)
 
 
 def _export(args: argparse.Namespace) -> int:
@@ -177,23 +193,18 @@ def add_sampling_arguments(parser: argparse.ArgumentParser) -> None:
 def sampling_options(args: argparse.Namespace, observed: bool) -> dict[str, Any]:
     """Return the simulation options of ``--dt``, ``--sampler``, ``--observer-resolution``.
 
-    Checked here with the flags' names; empty when none is given (the continuous
-    observer then runs as before).  ``observed``: whether the command has an observer.
+    Their values are checked by the simulation options (the messages name the options:
+    :mod:`phdesign.cli.messages`); empty when none is given (the continuous observer then
+    runs as before).  ``observed``: whether the command has an observer.
     """
     if args.dt is None and args.sampler is None and args.observer_resolution is None:
         return {}
-    from phdesign.core.limits import check_periods
-    from phdesign.numeric.checks import check_sampling
-
     if not observed:
         raise NumericError(
             "--dt, --sampler and --observer-resolution act on the observer: give --sensors or --cm"
         )
     if args.sampler is not None and args.dt is None:
         raise NumericError("--sampler needs --dt, the sampling period")
-    if args.dt is not None:
-        dt = check_sampling(args.dt, args.sampler or "average", dt_name="--dt")
-        check_periods(dt, positive_number(args.t_end, "--t-end"))
     if args.scheme != "expm":
         raise NumericError("a sampled or lower-order observer is stepped exactly: drop --scheme")
     check_positive("--observer-resolution", args.observer_resolution)

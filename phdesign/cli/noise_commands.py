@@ -3,7 +3,7 @@
 Argument parsing and printing only: the figures come from the observer's noise
 questions (:meth:`phdesign.Observer.noise`, :meth:`~phdesign.Observer.tradeoff`,
 :meth:`~phdesign.Observer.tune_noise`), the noisy simulation from
-:mod:`phdesign.numeric.time.stochastic`.  Each command prints ``str(result)`` or
+:meth:`phdesign.Observer.simulate`.  Each command prints ``str(result)`` or
 ``result.to_dict()`` as JSON.
 
 Noise options (shared):
@@ -316,14 +316,9 @@ def noise_options(args: argparse.Namespace) -> dict[str, Any]:
     }
 
 
-def _listed_intensities(text: str | None, flag: str) -> Any:
-    """Intensities checked for sign and finiteness (the library checks their count)."""
-    if text is None:
-        return None
-    from phdesign.numeric.noise.figures import check_intensity
-
-    values = _numbers(text, flag)
-    return check_intensity(values, len(values), flag)
+def _listed_intensities(text: str | None, flag: str) -> list[float] | None:
+    """Return the numbers of an intensity option (the simulation options check them)."""
+    return None if text is None else _numbers(text, flag)
 
 
 # ----------------------------------------------------------------------------- tune

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import Any
 
 from phdesign.cli.common import (
     add_discretization_arguments,
@@ -49,6 +50,12 @@ TUNE_STARTS = 2
 
 def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """Add the numeric commands."""
+    _add_spectrum(subparsers)
+    _add_simulate(subparsers)
+    _add_tune(subparsers)
+
+
+def _add_spectrum(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     sp = subparsers.add_parser(
         "spectrum",
         help="converged spectral abscissa of the plant (u = 0) or of the error system",
@@ -79,9 +86,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     add_json_argument(sp)
     sp.set_defaults(handler=_spectrum)
 
+
+def _add_simulate(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     sim = subparsers.add_parser(
         "simulate", help="simulate the plant (and the observer with --sensors/--cm)"
     )
+    table = current()
     add_model_argument(sim)
     add_observer_arguments(sim)
     add_discretization_arguments(sim, f"default: {table.describe('resolution')}")
@@ -134,6 +144,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     add_stochastic_arguments(sim)
     sim.set_defaults(handler=_simulate)
 
+
+def _add_tune(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     tn = subparsers.add_parser("tune", help="observer gain minimizing the converged abscissa")
     add_model_argument(tn)
     add_observer_arguments(tn, gain=False)
@@ -181,7 +193,6 @@ def _simulate(args: argparse.Namespace) -> int:
 
     from phdesign import SimulationOptions
     from phdesign.design.observer import Plant
-    from phdesign.numeric.inputs import input_function
 
     check_positive("--resolution", args.resolution)
     check_positive("--t-end", args.t_end)
@@ -200,7 +211,7 @@ def _simulate(args: argparse.Namespace) -> int:
     # read the initial states and inputs before the (possibly long) simulation
     x0 = plant.initial_state(args.x0, "x0")
     xhat0 = plant.initial_state(args.xhat0, "xhat0")
-    u = input_function(args.u, plant.numeric, model=model)
+    u = plant.input_signal(args.u)
     # how to run: a sampled or lower-order observer (--dt, --sampler,
     # --observer-resolution), a noisy run (--noise-intensity, --input-noise), else the
     # continuous noiseless one; the design object picks the simulator from the options
@@ -220,6 +231,13 @@ def _simulate(args: argparse.Namespace) -> int:
                 res = plant.simulate(x0, u=u, options=options)
         check_finite_series(res)
         commit(simulation_text(args, model.name, res), res)
+    for warning in (*_notices(args, observer), *res.warnings):
+        warn(warning)
+    return 0
+
+
+def _notices(args: argparse.Namespace, observer: Any) -> list[str]:
+    """Return what a run left to its defaults that the user may not have meant."""
     notices = []
     driven = any(getattr(args, name, None) for name in ("u", "noise_intensity", "input_noise"))
     if args.x0 is None and not driven:  # at rest and undriven: every series is zero
@@ -229,9 +247,7 @@ def _simulate(args: argparse.Namespace) -> int:
         )
     if observer is not None and args.gain is None:
         notices.append("no --gain given: the observer uses L = I (--gain 1)")
-    for warning in (*notices, *res.warnings):
-        warn(warning)
-    return 0
+    return notices
 
 
 def _robust_fraction(text: str | None) -> float | None:

@@ -41,6 +41,11 @@ def _job_options() -> dict[str, Any]:
 
 def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """Add the ``sweep`` and ``plot`` commands."""
+    _add_sweep(subparsers)
+    _add_plot(subparsers)
+
+
+def _add_sweep(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     sp = subparsers.add_parser(
         "sweep",
         help="evaluate a job over a grid of gains, parameters and sensor sets (on Dask)",
@@ -50,6 +55,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         "to a Zarr store (resumable), a CSV or a NetCDF file.",
     )
     add_model_argument(sp)
+    _add_grid_arguments(sp)
+    _add_run_arguments(sp)
+    add_json_argument(sp)
+    sp.defer(_add_job_arguments)  # type: ignore[attr-defined]
+    sp.set_defaults(handler=_sweep)
+
+
+def _add_grid_arguments(sp: argparse.ArgumentParser) -> None:
+    """Add the points of a sweep: sensors or sensor sets, fixed gain, gain and parameter axes."""
     sensors = sp.add_mutually_exclusive_group()
     sensors.add_argument(
         "--sensors", metavar="I,J", help="measured outputs, 1-based indices, e.g. 3,4"
@@ -79,6 +93,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         metavar="NAME=SPEC",
         help="model parameter axis (repeatable), e.g. d=0:0.4:9",
     )
+
+
+def _add_run_arguments(sp: argparse.ArgumentParser) -> None:
+    """Add where a sweep goes and runs: the output, resume or force, the scheduler, chunks."""
     sp.add_argument(
         "-o",
         "--output",
@@ -103,10 +121,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sp.add_argument(
         "--no-progress", action="store_true", help="no progress bar (shown on a terminal)"
     )
-    add_json_argument(sp)
-    sp.defer(_add_job_arguments)  # type: ignore[attr-defined]
-    sp.set_defaults(handler=_sweep)
 
+
+def _add_plot(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     pl = subparsers.add_parser(
         "plot", help="draw a sweep result: a gain map, a parameter study, a sensor-set study"
     )
