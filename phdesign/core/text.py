@@ -186,12 +186,22 @@ def html_table(
     caption: str | None = None,
     footer: str | None = None,
 ) -> str:
-    """Return a small HTML table (escaped), for the ``_repr_html_`` of result objects."""
+    """Return a small HTML table (escaped), for the ``_repr_html_`` of result objects.
+
+    The package's one table: ``headers`` name the columns (none: a table of name and value
+    rows), ``caption`` goes above it and ``footer`` below.
+
+    Examples
+    --------
+    >>> html_table([], [["order", 12]], caption="export")
+    '<p><b>export</b></p><table><tbody><tr><td>order</td><td>12</td></tr></tbody></table>'
+    """
     head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
     body = "".join(
         "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows
     )
-    out = f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    thead = f"<thead><tr>{head}</tr></thead>" if head else ""
+    out = f"<table>{thead}<tbody>{body}</tbody></table>"
     if caption:
         out = f"<p><b>{html.escape(caption)}</b></p>" + out
     if footer:

@@ -19,13 +19,13 @@ converged: true at 1 of 2 points
 
 from __future__ import annotations
 
-import html
 import json
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from phdesign.core.text import html_table
 from phdesign.sweep.dataset import RUN_ATTRIBUTE
 
 __all__ = ["FigureStats", "SweepSummary"]
@@ -252,11 +252,6 @@ class SweepSummary:
         }
 
     def _repr_html_(self) -> str:
-        rows = "".join(
-            f"<tr><td>{html.escape(f.name)}</td>"
-            f"<td>{html.escape(f.text().split(': ', 1)[1])}</td></tr>"
-            for f in self.figures
-        )
-        head = html.escape(str(self).splitlines()[0])
-        header = "<tr><th>figure</th><th>over the points</th></tr>"
-        return f"<table><caption>{head}</caption>{header}{rows}</table>"
+        rows = [(f.name, f.text().split(": ", 1)[1]) for f in self.figures]
+        caption = str(self).splitlines()[0]
+        return html_table(("figure", "over the points"), rows, caption)

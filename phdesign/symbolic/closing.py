@@ -82,12 +82,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache
-from html import escape
 from typing import TYPE_CHECKING, Any
 
 import sympy
 
 from phdesign.core.errors import ModelError, PortError
+from phdesign.core.text import html_table
 from phdesign.symbolic.definition import parse_matrix
 from phdesign.symbolic.expressions import canonical, vanishes
 from phdesign.symbolic.feedback import Feedback, external_indices
@@ -240,16 +240,13 @@ class ClosedPorts:
         )
 
     def _repr_html_(self) -> str:
-        rows = "".join(
-            f"<tr><td>{escape(key)}</td><td>{escape(str(value))}</td></tr>"
-            for key, value in (
-                ("closed inputs", [i + 1 for i in self.closed]),
-                ("gain K", self.gain.tolist()),
-                ("boundary conditions", "; ".join(self.boundary_conditions())),
-                *self.identities.items(),
-            )
+        rows = (
+            ("closed inputs", [i + 1 for i in self.closed]),
+            ("gain K", self.gain.tolist()),
+            ("boundary conditions", "; ".join(self.boundary_conditions())),
+            *self.identities.items(),
         )
-        return f"<table><caption>closed plant</caption>{rows}</table>"
+        return html_table((), rows, "closed plant")
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary (exact entries as strings)."""

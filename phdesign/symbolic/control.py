@@ -85,12 +85,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from html import escape
 from typing import Any
 
 import sympy
 
 from phdesign.core.errors import LoopError, ObserverError
+from phdesign.core.text import html_table
 from phdesign.symbolic.classify import Classification, classify
 from phdesign.symbolic.closing import close_inputs
 from phdesign.symbolic.expressions import vanishes
@@ -432,17 +432,14 @@ class LoopClassification:
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        rows = "".join(
-            f"<tr><td>{escape(k)}</td><td>{escape(str(v))}</td></tr>"
-            for k, v in (
-                ("design", self._design()),
-                ("controlled plant", self.plant.verdict),
-                ("error system", self.error.verdict),
-                ("loop", self.verdict),
-                ("why", self.reason),
-            )
+        rows = (
+            ("design", self._design()),
+            ("controlled plant", self.plant.verdict),
+            ("error system", self.error.verdict),
+            ("loop", self.verdict),
+            ("why", self.reason),
         )
-        return f"<table><caption>{escape(self.model.name)} loop</caption>{rows}</table>"
+        return html_table((), rows, f"{self.model.name} loop")
 
 
 def _variant_lines(result: Classification, plant: bool) -> list[str]:

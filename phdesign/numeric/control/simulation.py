@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.errors import ArgumentError, LoopError
+from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import LoopSystem, NumericLoop, assemble
 from phdesign.numeric.discretization.registry import discretize
@@ -105,13 +106,8 @@ class LoopSimulation(SimulationResult):
         return f"LoopSimulation({body}; {len(self.warnings)} warning(s))"[:300]
 
     def _repr_html_(self) -> str:
-        from html import escape
-
-        rows = "".join(
-            f"<tr><td>{escape(k)}</td><td>{escape(v)}</td></tr>"
-            for k, v in [*self._summary(), *(("warning", w) for w in self.warnings)]
-        )
-        return f"<table><caption>loop simulation</caption>{rows}</table>"
+        rows = [*self._summary(), *(("warning", w) for w in self.warnings)]
+        return html_table((), rows, "loop simulation")
 
     def plot(self, path: Any = None, *, force: bool = False, title: str | None = None) -> Any:
         """Draw the summary figure (energies, tip, estimate): :func:`.plots.plot_simulation`."""

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.defaults import current, method_or_default
+from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import LoopSystem, NumericLoop, assemble
 from phdesign.numeric.discretization.registry import discretize, feedback_matrix
@@ -248,20 +249,15 @@ class LoopSpectrum:
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        from html import escape
-
-        rows = "".join(
-            f"<tr><td>{escape(k)}</td><td>{escape(str(v))}</td></tr>"
-            for k, v in (
-                ("loop abscissa", self.spectral_abscissa),
-                ("converged", self.converged),
-                ("digits", _digits(self.digits)),
-                ("controlled plant", self.plant_abscissa),
-                ("error system", self.error_abscissa),
-                ("separation gap", self.separation_gap),
-            )
+        rows = (
+            ("loop abscissa", self.spectral_abscissa),
+            ("converged", self.converged),
+            ("digits", _digits(self.digits)),
+            ("controlled plant", self.plant_abscissa),
+            ("error system", self.error_abscissa),
+            ("separation gap", self.separation_gap),
         )
-        return f"<table><caption>{escape(self.model)} loop spectrum</caption>{rows}</table>"
+        return html_table((), rows, f"{self.model} loop spectrum")
 
     def plot(self, ax: Any = None) -> Any:
         """Draw the rightmost resolved loop eigenvalues, marked by the block they belong to."""

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.errors import LoopError
+from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import NumericLoop
 from phdesign.numeric.control.spectrum import LoopSpectrum, loop_spectrum
@@ -136,18 +137,13 @@ class LoopTuneResult:
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        from html import escape
-
-        rows = "".join(
-            f"<tr><td>{escape(k)}</td><td>{escape(str(v))}</td></tr>"
-            for k, v in (
-                ("K", np.round(self.loop.K, 8).tolist()),
-                ("L", np.round(self.loop.L, 8).tolist()),
-                ("loop abscissa", self.spectral_abscissa),
-                ("limited by", self.limited_by),
-            )
+        rows = (
+            ("K", np.round(self.loop.K, 8).tolist()),
+            ("L", np.round(self.loop.L, 8).tolist()),
+            ("loop abscissa", self.spectral_abscissa),
+            ("limited by", self.limited_by),
         )
-        return f"<table><caption>tuned loop ({escape(self.tuned)})</caption>{rows}</table>"
+        return html_table((), rows, f"tuned loop ({self.tuned})")
 
 
 def tune_loop(

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.errors import NumericError, ObserverError, check_shape
+from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.invariants import (
     require_definite,
@@ -44,11 +45,6 @@ def _well_posed(loop: np.ndarray) -> np.ndarray:
             f"(condition number {condition:.3g}, expected at most {LOOP_CONDITION:g})"
         )
     return loop
-
-
-def _html_table(rows: list[tuple[str, object]]) -> str:
-    cells = "".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in rows)
-    return f"<table>{cells}</table>"
 
 
 @dataclass(frozen=True, repr=False)
@@ -219,7 +215,7 @@ class DiscretePHS:
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        return _html_table([(k, v) for k, v in self.to_dict().items()])
+        return html_table((), self.to_dict().items())
 
     def check_structure(self) -> dict[str, float]:
         """Return the structural residuals: skewness of J and D, symmetry and signs."""
@@ -287,7 +283,7 @@ class ClosedLoop:
         return f"closed loop u = v - K y around the {self.system}"
 
     def _repr_html_(self) -> str:
-        return _html_table([("system", repr(self.system)), ("K", self.K.tolist())])
+        return html_table((), [("system", repr(self.system)), ("K", self.K.tolist())])
 
 
 def feedback_matrix(C_m: np.ndarray, L: np.ndarray, n_outputs: int) -> np.ndarray:

@@ -73,6 +73,7 @@ import numpy as np
 import scipy.linalg as sl
 from numpy.polynomial import legendre as leg
 
+from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 
 __all__ = ["RANK_TOL", "SpuriousModes", "e_orthogonal_complement", "spurious_modes"]
@@ -120,7 +121,7 @@ class SpuriousModes:
         return self.describe()
 
     def _repr_html_(self) -> str:
-        return f"<table><tr><th>spurious modes</th><td>{self.describe()}</td></tr></table>"
+        return html_table((), [("spurious modes", self.describe())])
 
     def describe(self) -> str:
         """One sentence for reports: how many modes were removed and why."""

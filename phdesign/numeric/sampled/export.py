@@ -42,6 +42,7 @@ from phdesign.core.checks import EXPORT_FORMATS, positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError
 from phdesign.core.limits import check_periods
+from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_initial_state, check_sampling
 from phdesign.numeric.discretization.phs import DiscretePHS
@@ -246,8 +247,7 @@ class SampledObserver:
         if self.verification is not None:
             v = self.verification
             rows.append(("error floor", f"{v.floor:.3g} (continuous {v.continuous_floor:.3g})"))
-        body = "".join(f"<tr><th>{k}</th><td>{val}</td></tr>" for k, val in rows)
-        return f"<table>{body}</table>"
+        return html_table((), rows)
 
     def plot(self, ax: Any = None) -> Any:
         """Draw the verification run (needs ``verify=True``); returns the axes."""

@@ -45,6 +45,7 @@ import numpy as np
 import scipy.linalg as sl
 
 from phdesign.core.defaults import current
+from phdesign.core.text import html_table
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize
 
@@ -107,12 +108,9 @@ class ModalTruncation:
         )
 
     def _repr_html_(self) -> str:
-        rows = self.to_dict()
-        cells = "".join(
-            f"<tr><th>{k}</th><td>{rows[k]}</td></tr>"
-            for k in ("n_kept", "n_removed", "resolutions", "separation")
-        )
-        return f"<table>{cells}</table>"
+        data = self.to_dict()
+        keys = ("n_kept", "n_removed", "resolutions", "separation")
+        return html_table((), [(k, data[k]) for k in keys])
 
 
 def resolved_mask(

@@ -18,6 +18,7 @@ import numpy as np
 
 from phdesign.core.defaults import current
 from phdesign.core.limits import check_periods
+from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_sampling
 from phdesign.numeric.sampled.order import check_order
@@ -122,11 +123,11 @@ class Verification:
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        return (
-            "<table><tr><th>observer</th><th>error floor</th></tr>"
-            f"<tr><td>{self.sampler}, dt = {self.dt:g}</td><td>{self.floor:.3g}</td></tr>"
-            f"<tr><td>continuous</td><td>{self.continuous_floor:.3g}</td></tr></table>"
+        rows = (
+            (f"{self.sampler}, dt = {self.dt:g}", f"{self.floor:.3g}"),
+            ("continuous", f"{self.continuous_floor:.3g}"),
         )
+        return html_table(("observer", "error floor"), rows)
 
     def plot(self, ax: Any = None) -> Any:
         """Draw both errors over time (log scale); returns the axes (:mod:`phdesign.plots`)."""

@@ -8,7 +8,6 @@ eigenvalues in the complex plane (matplotlib imported when called).
 
 from __future__ import annotations
 
-import html
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -16,13 +15,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from phdesign.core.text import html_table
+
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
     from phdesign.numeric.spectrum.branches import Branches
 
-__all__ = ["RefinementStep", "SpectrumReport", "finite_or_none", "html_rows"]
+__all__ = ["RefinementStep", "SpectrumReport", "finite_or_none"]
 
 
 def finite_or_none(x: float | None) -> float | None:
@@ -35,15 +36,6 @@ def finite_or_none(x: float | None) -> float | None:
 
 def _complex_list(values: Sequence[complex] | np.ndarray) -> list[list[float | None]]:
     return [[finite_or_none(z.real), finite_or_none(z.imag)] for z in np.asarray(values).ravel()]
-
-
-def html_rows(caption: str, rows: Sequence[tuple[str, str]]) -> str:
-    """Return a two-column HTML table (name, value) with a caption; values are escaped."""
-    body = "".join(
-        f"<tr><th style='text-align:left'>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>"
-        for k, v in rows
-    )
-    return f"<table><caption>{html.escape(caption)}</caption>{body}</table>"
 
 
 @dataclass(frozen=True)
@@ -237,7 +229,7 @@ class SpectrumReport:
             ("rightmost", ", ".join(f"{z:.6g}" for z in self.rightmost[:4]) or "—"),
         ]
         rows += [("warning", w) for w in self.warnings]
-        return html_rows(f"{self.model}: {self.system} ({self.method})", rows)
+        return html_table((), rows, f"{self.model}: {self.system} ({self.method})")
 
     # -- data -------------------------------------------------------------------------
 

@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.numeric.spectrum.report import SpectrumReport, finite_or_none, html_rows
+from phdesign.core.text import html_table
+from phdesign.numeric.spectrum.report import SpectrumReport, finite_or_none
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.numeric.spectrum.coalescence import Coalescence
@@ -241,7 +242,7 @@ class TuneResult:
             ("robustness", "—" if self.robustness is None else str(self.robustness)),
             ("evaluations", str(self.evaluations)),
         ]
-        return html_rows(f"{self.model}: tuned gain", rows)
+        return html_table((), rows, f"{self.model}: tuned gain")
 
     # -- data -------------------------------------------------------------------------
 
