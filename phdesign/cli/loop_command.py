@@ -70,7 +70,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     sub = parser.add_subparsers(dest="loop_command", metavar="SUBCOMMAND")
     sub.required = True
+    for add in (_add_classify, _add_spectrum, _add_simulate, _add_tune):
+        add(sub)
 
+
+def _add_classify(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     cl = sub.add_parser("classify", help="controlled plant, error system and loop verdicts")
     _loop_arguments(cl)
     cl.add_argument(
@@ -82,6 +86,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     add_json_argument(cl)
     cl.set_defaults(handler=_classify)
 
+
+def _add_spectrum(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     sp = sub.add_parser("spectrum", help="converged spectrum of the assembled loop")
     _loop_arguments(sp)
     add_discretization_arguments(sp, "")
@@ -95,6 +101,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     add_json_argument(sp)
     sp.set_defaults(handler=_spectrum)
 
+
+def _add_simulate(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     sim = sub.add_parser("simulate", help="simulate plant, observer and feedback together")
     _loop_arguments(sim)
     add_discretization_arguments(sim, "")
@@ -115,6 +123,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     sim.add_argument("--force", action="store_true", help="overwrite existing files")
     sim.set_defaults(handler=_simulate)
 
+
+def _add_tune(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     tn = sub.add_parser("tune", help="tune K and/or L on the loop's converged abscissa")
     _loop_arguments(tn)
     tn.add_argument(

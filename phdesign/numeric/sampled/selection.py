@@ -11,6 +11,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from phdesign.core.text import html_table
+
 __all__ = ["Candidate", "OrderSelection"]
 
 
@@ -133,14 +135,17 @@ class OrderSelection:
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        rows = "".join(
-            f"<tr><td>{c.degree}</td><td>{c.order}</td><td>{c.reduction}</td>"
-            f"<td>{'n/a' if c.eigen_error is None else f'{c.eigen_error:.2g}'}</td>"
-            f"<td>{c.floor:.3g}</td><td>{'yes' if c.passed else 'no'}</td></tr>"
+        rows = [
+            (
+                c.degree,
+                c.order,
+                c.reduction,
+                "n/a" if c.eigen_error is None else f"{c.eigen_error:.2g}",
+                f"{c.floor:.3g}",
+                "yes" if c.passed else "no",
+            )
             for c in self.candidates
-        )
-        return (
-            f"<p>order {self.order} (degree {self.degree}, {self.reduction})</p><table>"
-            "<tr><th>degree</th><th>order</th><th>reduction</th><th>eigenvalue error</th>"
-            f"<th>floor</th><th>meets targets</th></tr>{rows}</table>"
-        )
+        ]
+        headers = ("degree", "order", "reduction", "eigenvalue error", "floor", "meets targets")
+        caption = f"order {self.order} (degree {self.degree}, {self.reduction})"
+        return html_table(headers, rows, caption)
