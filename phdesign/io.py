@@ -113,7 +113,38 @@ def model_from_toml(text: str, source: str = "model file") -> BCPHS:
 
 
 def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPHS:
-    """Build a model from the parsed content of a model file."""
+    """Build a model from the parsed content of a model file.
+
+    Each section is read by its own reader, which refuses what the file format does not
+    hold and names the section; :meth:`BCPHS.define` then checks the model itself.
+    """
+    _check_keys(data, source)
+    matrices = _table(data, "matrices", source)
+    ports = _table(data, "ports", source)
+    parameters = _table(data, "parameters", source) if "parameters" in data else {}
+    P = _read_P(matrices, source)
+    outputs = _read_outputs(ports, source)  # checks that [ports] holds inputs
+    feedback = _read_feedback(data, source)
+    units = _table(data, "units", source) if "units" in data else None
+    return BCPHS.define(
+        name=data["name"],
+        description=data.get("description", ""),
+        interval=data["interval"],
+        order=data["order"],
+        P=P,
+        H=matrices["H"],
+        parameters=parameters,
+        inputs=ports["inputs"],
+        outputs=outputs,
+        state_names=_read_states(data, source),
+        displacement=_read_displacement(data, source),
+        feedback=feedback,
+        units=units,
+    )
+
+
+def _check_keys(data: Mapping[str, Any], source: str) -> None:
+    """Refuse a file that is not a table, lacks a required key or has an unknown one."""
     if not isinstance(data, Mapping):
         raise ModelFileError(f"{source} must be a table; found {type(data).__name__}")
     _check_names(data, "the file", source)
@@ -126,10 +157,13 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
             f"{source} has unknown key(s) {', '.join(unknown)}; "
             f"expected only {', '.join(_REQUIRED + _OPTIONAL)}"
         )
-    matrices = _table(data, "matrices", source)
-    ports = _table(data, "ports", source)
-    parameters = _table(data, "parameters", source) if "parameters" in data else {}
-    order = data["order"]
+    for key in ("name", "description"):
+        if key in data and not isinstance(data[key], str):
+            raise ModelFileError(f"{source}: {key} must be text; found {data[key]!r}")
+
+
+def _read_P(matrices: Mapping[str, Any], source: str) -> dict[int, Any]:
+    """Return the P_k of [matrices] by k (H is read apart; it must be there)."""
     P = {}
     for key, value in matrices.items():
         if key == "H":
@@ -141,6 +175,11 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
         P[int(key[1:])] = value
     if "H" not in matrices:
         raise ModelFileError(f"{source}: [matrices] lacks H")
+    return P
+
+
+def _read_outputs(ports: Mapping[str, Any], source: str) -> Any:
+    """Return the outputs of [ports]: trace expressions, or "conjugate" (also omitted)."""
     bad_ports = sorted(set(ports) - {"inputs", "outputs"})
     if bad_ports or "inputs" not in ports:
         raise ModelFileError(
@@ -153,47 +192,43 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
             f"{source}: [ports] outputs must be a list of trace expressions or "
             f'"conjugate"; found {outputs!r}'
         )
+    return outputs
+
+
+def _read_feedback(data: Mapping[str, Any], source: str) -> Mapping[str, Any] | None:
+    """Return the [feedback] table (inputs and gain), or None."""
     feedback = _table(data, "feedback", source) if "feedback" in data else None
     if feedback is not None and set(feedback) != {"inputs", "gain"}:
         raise ModelFileError(
             f"{source}: [feedback] must hold exactly inputs and gain; found "
             f"{', '.join(sorted(feedback)) or 'nothing'}"
         )
-    units = _table(data, "units", source) if "units" in data else None
-    displacement = None
-    if "displacement" in data:
-        table = _table(data, "displacement", source)
-        if set(table) != {"component", "integrations"} or not all(
-            isinstance(v, int) and not isinstance(v, bool) for v in table.values()
-        ):
-            raise ModelFileError(
-                f"{source}: [displacement] must hold integers component and integrations; "
-                f"found {dict(table)}"
-            )
-        displacement = Displacement(table["component"], table["integrations"])
+    return feedback
+
+
+def _read_displacement(data: Mapping[str, Any], source: str) -> Displacement | None:
+    """Return the [displacement] table as a :class:`Displacement`, or None."""
+    if "displacement" not in data:
+        return None
+    table = _table(data, "displacement", source)
+    if set(table) != {"component", "integrations"} or not all(
+        isinstance(v, int) and not isinstance(v, bool) for v in table.values()
+    ):
+        raise ModelFileError(
+            f"{source}: [displacement] must hold integers component and integrations; "
+            f"found {dict(table)}"
+        )
+    return Displacement(table["component"], table["integrations"])
+
+
+def _read_states(data: Mapping[str, Any], source: str) -> tuple[str, ...]:
+    """Return the state labels (a list of names), or none."""
     states = data.get("states", ())
     if "states" in data and not (
         isinstance(states, list) and all(isinstance(s, str) for s in states)
     ):
         raise ModelFileError(f"{source}: states must be a list of names; found {states!r}")
-    for key in ("name", "description"):
-        if key in data and not isinstance(data[key], str):
-            raise ModelFileError(f"{source}: {key} must be text; found {data[key]!r}")
-    return BCPHS.define(
-        name=data["name"],
-        description=data.get("description", ""),
-        interval=data["interval"],
-        order=order,
-        P=P,
-        H=matrices["H"],
-        parameters=parameters,
-        inputs=ports["inputs"],
-        outputs=outputs,
-        state_names=tuple(states),
-        displacement=displacement,
-        feedback=feedback,
-        units=units,
-    )
+    return tuple(states)
 
 
 def _table(data: Mapping[str, Any], key: str, source: str) -> Mapping[str, Any]:

@@ -156,3 +156,19 @@ def test_bad_toml(text, message):
 def test_missing_file(tmp_path):
     with pytest.raises(ModelFileError, match="cannot read model file"):
         read_model(tmp_path / "nope.toml")
+
+
+def test_a_ports_table_without_inputs_is_refused_by_name():
+    # the reading of [ports] comes before the inputs are used (a KeyError escaped once)
+    from phdesign.core.errors import ModelFileError
+    from phdesign.io import model_from_dict
+
+    data = {
+        "name": "x",
+        "interval": [0, 1],
+        "order": 1,
+        "matrices": {"P1": [[0, 1], [1, 0]], "H": [[1, 0], [0, 1]]},
+        "ports": {"outputs": "conjugate"},
+    }
+    with pytest.raises(ModelFileError, match=r"\[ports\] must hold exactly inputs and outputs"):
+        model_from_dict(data)

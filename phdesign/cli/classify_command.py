@@ -28,7 +28,7 @@ from phdesign.core.errors import ObserverError
 __all__ = ["register"]
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``classify`` command."""
     parser = subparsers.add_parser(
         "classify",

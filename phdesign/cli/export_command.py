@@ -32,7 +32,7 @@ from phdesign.core.errors import NumericError, ObserverError, OutputFileError
 __all__ = ["add_sampling_arguments", "register", "sampling_options"]
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``export`` command."""
     ex = subparsers.add_parser(
         "export",

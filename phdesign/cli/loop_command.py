@@ -59,7 +59,7 @@ def _loop_arguments(parser: argparse.ArgumentParser) -> None:
     add_observer_arguments(parser)
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``loop`` command and its four subcommands."""
     parser = subparsers.add_parser(
         "loop",
@@ -74,7 +74,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         add(sub)
 
 
-def _add_classify(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _add_classify(sub: argparse._SubParsersAction) -> None:
     cl = sub.add_parser("classify", help="controlled plant, error system and loop verdicts")
     _loop_arguments(cl)
     cl.add_argument(
@@ -87,7 +87,7 @@ def _add_classify(sub: argparse._SubParsersAction) -> None:  # type: ignore[type
     cl.set_defaults(handler=_classify)
 
 
-def _add_spectrum(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _add_spectrum(sub: argparse._SubParsersAction) -> None:
     sp = sub.add_parser("spectrum", help="converged spectrum of the assembled loop")
     _loop_arguments(sp)
     add_discretization_arguments(sp, "")
@@ -102,7 +102,7 @@ def _add_spectrum(sub: argparse._SubParsersAction) -> None:  # type: ignore[type
     sp.set_defaults(handler=_spectrum)
 
 
-def _add_simulate(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _add_simulate(sub: argparse._SubParsersAction) -> None:
     sim = sub.add_parser("simulate", help="simulate plant, observer and feedback together")
     _loop_arguments(sim)
     add_discretization_arguments(sim, "")
@@ -124,7 +124,7 @@ def _add_simulate(sub: argparse._SubParsersAction) -> None:  # type: ignore[type
     sim.set_defaults(handler=_simulate)
 
 
-def _add_tune(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _add_tune(sub: argparse._SubParsersAction) -> None:
     tn = sub.add_parser("tune", help="tune K and/or L on the loop's converged abscissa")
     _loop_arguments(tn)
     tn.add_argument(

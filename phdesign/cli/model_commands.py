@@ -16,7 +16,7 @@ from phdesign.cli.common import (
 __all__ = ["register"]
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the model commands."""
     models = subparsers.add_parser("models", help="list the built-in models")
     add_json_argument(models)

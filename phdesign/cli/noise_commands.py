@@ -91,7 +91,7 @@ def _add_performance_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``noise`` and ``tradeoff`` commands."""
     nz = subparsers.add_parser(
         "noise",

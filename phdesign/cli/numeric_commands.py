@@ -48,14 +48,14 @@ __all__ = ["register"]
 TUNE_STARTS = 2
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the numeric commands."""
     _add_spectrum(subparsers)
     _add_simulate(subparsers)
     _add_tune(subparsers)
 
 
-def _add_spectrum(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _add_spectrum(subparsers: argparse._SubParsersAction) -> None:
     sp = subparsers.add_parser(
         "spectrum",
         help="converged spectral abscissa of the plant (u = 0) or of the error system",
@@ -87,7 +87,7 @@ def _add_spectrum(subparsers: argparse._SubParsersAction) -> None:  # type: igno
     sp.set_defaults(handler=_spectrum)
 
 
-def _add_simulate(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _add_simulate(subparsers: argparse._SubParsersAction) -> None:
     sim = subparsers.add_parser(
         "simulate", help="simulate the plant (and the observer with --sensors/--cm)"
     )
@@ -145,7 +145,7 @@ def _add_simulate(subparsers: argparse._SubParsersAction) -> None:  # type: igno
     sim.set_defaults(handler=_simulate)
 
 
-def _add_tune(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _add_tune(subparsers: argparse._SubParsersAction) -> None:
     tn = subparsers.add_parser("tune", help="observer gain minimizing the converged abscissa")
     add_model_argument(tn)
     add_observer_arguments(tn, gain=False)

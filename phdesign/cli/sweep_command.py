@@ -39,13 +39,13 @@ def _job_options() -> dict[str, Any]:
     return options
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``sweep`` and ``plot`` commands."""
     _add_sweep(subparsers)
     _add_plot(subparsers)
 
 
-def _add_sweep(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _add_sweep(subparsers: argparse._SubParsersAction) -> None:
     sp = subparsers.add_parser(
         "sweep",
         help="evaluate a job over a grid of gains, parameters and sensor sets (on Dask)",
@@ -58,7 +58,7 @@ def _add_sweep(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[
     _add_grid_arguments(sp)
     _add_run_arguments(sp)
     add_json_argument(sp)
-    sp.defer(_add_job_arguments)  # type: ignore[attr-defined]
+    sp.defer(_add_job_arguments)
     sp.set_defaults(handler=_sweep)
 
 
@@ -123,7 +123,7 @@ def _add_run_arguments(sp: argparse.ArgumentParser) -> None:
     )
 
 
-def _add_plot(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _add_plot(subparsers: argparse._SubParsersAction) -> None:
     pl = subparsers.add_parser(
         "plot", help="draw a sweep result: a gain map, a parameter study, a sensor-set study"
     )

@@ -200,7 +200,9 @@ def render_c(observer: SampledObserver) -> dict[str, str]:
 
 def render_statespace(observer: SampledObserver, filename: str = "observer.py") -> str:
     """Return a Python module that builds the observer as ``control.StateSpace``."""
-    return _environment().get_template("statespace.py.j2").render(_context(observer, filename))
+    return str(
+        _environment().get_template("statespace.py.j2").render(_context(observer, filename))
+    )
 
 
 def _npz_bytes(observer: SampledObserver) -> bytes:

@@ -232,13 +232,13 @@ class OutputFiles:
                     with open(target, "wb") as stream:
                         stream.write(temporary)  # type: ignore[arg-type]
                 elif kind == "new":
-                    info = os.stat(temporary)  # type: ignore[arg-type]
+                    info = os.stat(temporary)
                     created.append((target, (info.st_dev, info.st_ino)))  # before: a signal
                     _link_exclusively(temporary, target)  # type: ignore[arg-type]
                 else:
                     if _classify(target, True) != "replace":  # changed since add()
                         raise OutputFileError(f"output file {str(target)!r} changed meanwhile")
-                    os.replace(temporary, target)  # type: ignore[arg-type]
+                    os.replace(temporary, target)
         except OSError as error:
             undo()
             raise OutputFileError(f"cannot write {str(target)!r}: {_reason(error)}") from None

@@ -56,7 +56,9 @@ Exact decisions that fall back to a numeric check (and say so)
                                             ran past 600 s)
     ==============================  =====  ================================================
 
-Searches and numerics (checked at the entry of each library function)
+Searches and numerics (checked at the entry of each library function; the checks of a
+simulation's span and size, of its sampling periods and of noise intensities are
+:mod:`phdesign.numeric.checks`'s, the other checks this module's)
     =========================  ===========  ===============================================
     ``MAX_SENSOR_OUTPUTS``      16           outputs of a model whose every sensor subset
                                              is classified (2^16 - 1 = 65 535 subsets)
@@ -124,10 +126,10 @@ phdesign.core.errors.ObserverError: the sensor search classifies 2^30 - 1 = 1073
 from __future__ import annotations
 
 import math
-import numbers
 import operator
 from typing import Any
 
+from phdesign.core.defaults import current
 from phdesign.core.errors import (
     ModelError,
     ModelFileError,
@@ -170,18 +172,19 @@ __all__ = [
     "MAX_T_END",
     "MAX_WORKERS_PER_CORE",
     "MIN_TIME_STEP",
+    "budget_text",
     "check_discretization",
     "check_local_workers",
     "check_model_dimensions",
-    "check_noise_intensity",
     "check_noise_resolution",
     "check_parameter_count",
-    "check_periods",
     "check_sensor_outputs",
-    "check_simulation",
     "check_sweep_points",
     "check_tradeoff_gains",
     "check_tuning",
+    "integer",
+    "resolution_or_default",
+    "state_count",
 ]
 
 # ---------------------------------------------------------------- text and exact numbers
@@ -223,17 +226,13 @@ MAX_SWEEP_POINTS = 1_000_000
 MAX_STORE_METADATA_BYTES = 64 << 20
 MAX_WORKERS_PER_CORE = 1
 
-#: The resolution a discretization uses when none is given is at most this (the finite
-#: differences' 70 nodes per group; Galerkin uses 40, or 16 for N >= 3): the estimate of
-#: a simulation's size when no resolution is given.
-_LARGEST_DEFAULT_RESOLUTION = 70
 
-
-def _budget(name: str) -> str:
+def budget_text(name: str) -> str:
+    """Return how a message names the budget ``name``."""
     return f"the budget phdesign.core.limits.{name}"
 
 
-def _integer(value: object, what: str, error: type[Exception]) -> int:
+def integer(value: object, what: str, error: type[Exception]) -> int:
     """``value`` as an int, refusing booleans, fractions and other types by name."""
     if isinstance(value, bool):
         raise error(f"{what} must be an integer; found the boolean {value}")
@@ -248,7 +247,7 @@ def check_parameter_count(count: int) -> None:
     if count > MAX_PARAMETERS:
         raise ModelError(
             f"the model has {count} parameters; expected at most {MAX_PARAMETERS} "
-            f"({_budget('MAX_PARAMETERS')})"
+            f"({budget_text('MAX_PARAMETERS')})"
         )
 
 
@@ -258,12 +257,12 @@ def check_model_dimensions(order: int, size: int) -> None:
         if value > globals()[name]:
             raise ModelError(
                 f"the model's {what} is {value}; expected at most {globals()[name]} "
-                f"({_budget(name)})"
+                f"({budget_text(name)})"
             )
     if order * size > MAX_PORTS:
         raise ModelError(
             f"the model has N n = {order * size} inputs; expected at most {MAX_PORTS} "
-            f"({_budget('MAX_PORTS')})"
+            f"({budget_text('MAX_PORTS')})"
         )
 
 
@@ -272,24 +271,34 @@ def check_file_size(size: int, source: str) -> None:
     if size > MAX_MODEL_FILE_BYTES:
         raise ModelFileError(
             f"{source} is larger than {MAX_MODEL_FILE_BYTES:,} bytes; expected a model file "
-            f"({_budget('MAX_MODEL_FILE_BYTES')})"
+            f"({budget_text('MAX_MODEL_FILE_BYTES')})"
         )
 
 
 def check_sensor_outputs(n_outputs: int) -> None:
     """Refuse a sensor search over more than :data:`MAX_SENSOR_OUTPUTS` outputs."""
-    n_outputs = _integer(n_outputs, "the number of outputs", ObserverError)
+    n_outputs = integer(n_outputs, "the number of outputs", ObserverError)
     if n_outputs > MAX_SENSOR_OUTPUTS:
         count = f" = {2**n_outputs - 1}" if n_outputs <= 64 else ""
         raise ObserverError(
             f"the sensor search classifies 2^{n_outputs} - 1{count} sensor sets "
             f"for {n_outputs} outputs; expected at most {MAX_SENSOR_OUTPUTS} outputs "
-            f"({_budget('MAX_SENSOR_OUTPUTS')}): classify chosen sets with sensors=... instead"
+            f"({budget_text('MAX_SENSOR_OUTPUTS')}): classify chosen sets with sensors=... instead"
         )
 
 
-def _states(nm: Any, resolution: int) -> int:
+def state_count(nm: Any, resolution: int) -> int:
+    """Return the states of a discretization of ``nm`` at ``resolution``: n (p + 1)."""
     return int(nm.size) * (resolution + 1)
+
+
+def resolution_or_default(nm: Any, method: object, resolution: object) -> int:
+    """``resolution``, or the registered default of ``method`` for the model's order."""
+    if resolution is not None:
+        return integer(resolution, "resolution", NumericError)
+    table = current()
+    name = method if isinstance(method, str) and method in table.methods else table.method
+    return table.discretization(name, int(nm.order)).resolution
 
 
 def check_discretization(nm: Any, method: object, *resolutions: object) -> None:
@@ -307,15 +316,15 @@ def check_discretization(nm: Any, method: object, *resolutions: object) -> None:
     for resolution in resolutions:
         if resolution is None:
             continue
-        value = _integer(resolution, "resolution", NumericError)
+        value = integer(resolution, "resolution", NumericError)
         if value < 1:
             raise NumericError(f"resolution must be a positive integer; found {value}")
-        states = _states(nm, value)
+        states = state_count(nm, value)
         if states > MAX_DISCRETE_STATES:
             raise NumericError(
                 f"resolution {value} gives the {method} discretization of a size-{nm.size} "
                 f"model about {states:,} states; expected at most {MAX_DISCRETE_STATES:,} "
-                f"({_budget('MAX_DISCRETE_STATES')}; at 2,000 states an eigenproblem takes "
+                f"({budget_text('MAX_DISCRETE_STATES')}; at 2,000 states an eigenproblem takes "
                 "minutes, an export's verification plant 45 s and 1.6 GB)"
             )
 
@@ -326,129 +335,13 @@ def check_noise_resolution(nm: Any, resolution: int, name: str) -> None:
     ``resolution`` is the largest resolution the refinement may reach, ``name`` the
     argument that sets it (``"resolution"`` or ``"max_resolution"``).
     """
-    states = _states(nm, resolution)
+    states = state_count(nm, resolution)
     if states > MAX_NOISE_STATES:
         raise NumericError(
             f"{name} {resolution} gives the noise figures of a size-{nm.size} model about "
             f"{states:,} states; expected at most {MAX_NOISE_STATES:,} "
-            f"({_budget('MAX_NOISE_STATES')}: dense Lyapunov equations, 13 s and 0.5 GB at "
+            f"({budget_text('MAX_NOISE_STATES')}: dense Lyapunov equations, 13 s and 0.5 GB at "
             "1,000 states on the beam, 67 s and 1.3 GB at 2,000)"
-        )
-
-
-def check_simulation(
-    nm: Any,
-    C_m: Any,
-    t_end: object,
-    samples: object,
-    method: object,
-    resolution: object,
-    discrete: Any = None,
-) -> None:
-    """Refuse a simulation whose time span or size is beyond the budgets.
-
-    Parameters
-    ----------
-    nm : NumericModel
-    C_m : array or None
-        The sensors (the observer runs too when given: twice the states).
-    t_end : float
-        Final time: ``0 < t_end <= MAX_T_END``.
-    samples : int
-        Output samples; ``t_end / (samples - 1) >= MIN_TIME_STEP`` and samples times
-        states at most :data:`MAX_SIMULATION_VALUES`.
-    method, resolution
-        The discretization (checked by :func:`check_discretization`).
-    discrete : DiscretePHS, optional
-        A discretization given ready-made (its states replace the estimate).
-    """
-    if isinstance(t_end, bool) or not isinstance(t_end, numbers.Real):
-        raise NumericError(f"t_end must be a number; found {type(t_end).__name__} {t_end!r}")
-    end = float(t_end)
-    if not (math.isfinite(end) and 0 < end <= MAX_T_END):
-        raise NumericError(
-            f"t_end must be a positive number at most {MAX_T_END:g}; found {end:g} "
-            f"({_budget('MAX_T_END')})"
-        )
-    count = _integer(samples, "samples", NumericError)
-    if count < 2:
-        raise NumericError(f"samples must be at least 2; found {count}")
-    step = end / (count - 1)
-    if not step >= MIN_TIME_STEP:
-        raise NumericError(
-            f"t_end / (samples - 1) = {step:.3g} is below {MIN_TIME_STEP:g}: the time stamps "
-            f"would not be distinct; expected a longer t_end or fewer samples "
-            f"({_budget('MIN_TIME_STEP')})"
-        )
-    if discrete is not None:
-        states = int(discrete.dim)
-    else:
-        check_discretization(nm, method, resolution)
-        res = _LARGEST_DEFAULT_RESOLUTION if resolution is None else int(resolution)  # type: ignore[call-overload]
-        states = _states(nm, res)
-    states *= 1 if C_m is None else 2
-    total = count * states
-    if total > MAX_SIMULATION_VALUES:
-        raise NumericError(
-            f"samples = {count} times {states:,} states is {total:,} values; expected at "
-            f"most {MAX_SIMULATION_VALUES:,} ({_budget('MAX_SIMULATION_VALUES')}): ask for "
-            "fewer samples"
-        )
-
-
-def check_noise_intensity(largest: float, name: str = "intensity") -> None:
-    """Refuse a noise intensity above :data:`MAX_NOISE_INTENSITY` (``largest`` of them)."""
-    if largest > MAX_NOISE_INTENSITY:
-        raise NumericError(
-            f"{name}: intensities must be at most {MAX_NOISE_INTENSITY:g} (variances per "
-            f"unit time); found {largest:g} ({_budget('MAX_NOISE_INTENSITY')})"
-        )
-
-
-def check_periods(
-    dt: float,
-    t_end: float,
-    *,
-    stepped: bool = True,
-    states: int = 0,
-    names: tuple[str, str] = ("`dt`", "`t_end`"),
-) -> None:
-    """Refuse a sampling period longer than the run, or more periods than a run may step.
-
-    Parameters
-    ----------
-    dt, t_end : float
-        The period and the run's length (both checked finite and positive before).
-    stepped : bool
-        The run steps the periods (a simulation, a verification); an export without
-        verification only needs ``dt <= t_end``.
-    states : int
-        States stepped one period at a time (a run with an input signal), whose
-        periods times states count against :data:`MAX_SIMULATION_VALUES`; 0 when the
-        periods are jumped over by powers of the one-period map.
-    names : (str, str)
-        How ``dt`` and ``t_end`` are called in the message: as code, which the command
-        line writes as its options (``--dt``, ``--t-end``).
-    """
-    dt_name, t_name = names
-    if dt > t_end:
-        raise NumericError(
-            f"{dt_name} = {dt:g} s is longer than {t_name} = {t_end:g} s; expected a sampling "
-            f"period at most the run's length (a longer {t_name}, or a shorter {dt_name})"
-        )
-    periods = t_end / dt
-    if stepped and periods > MAX_PERIODS:
-        raise NumericError(
-            f"{t_name} / {dt_name} = {periods:.3g} sampling periods; expected at most "
-            f"{MAX_PERIODS:.0e} ({_budget('MAX_PERIODS')}): a longer {dt_name} or a shorter "
-            f"{t_name}"
-        )
-    if stepped and states and periods * states > MAX_SIMULATION_VALUES:
-        raise NumericError(
-            f"{t_name} / {dt_name} = {periods:.3g} periods, each stepped with an input, times "
-            f"{states:,} states is {periods * states:.3g} values; expected at most "
-            f"{MAX_SIMULATION_VALUES:,} ({_budget('MAX_SIMULATION_VALUES')}): a longer "
-            f"{dt_name} or a shorter {t_name}"
         )
 
 
@@ -464,17 +357,17 @@ def check_tuning(
         ("starts", starts, "MAX_STARTS"),
         ("maxiter", maxiter, "MAX_TUNE_ITERATIONS"),
     ):
-        number = _integer(value, what, NumericError)
+        number = integer(value, what, NumericError)
         if not 1 <= number <= globals()[name]:
             raise NumericError(
                 f"{what} must be an integer from 1 to {globals()[name]:,}; found {number} "
-                f"({_budget(name)})"
+                f"({budget_text(name)})"
             )
-    if _integer(seed, "seed", NumericError) < 0:
+    if integer(seed, "seed", NumericError) < 0:
         raise NumericError(f"seed must be a non-negative integer; found {seed}")
     if resolution is not None:
-        fine = math.ceil(1.5 * _integer(resolution, "resolution", NumericError))
-        check_discretization(nm, "galerkin", resolution, fine)
+        fine = math.ceil(1.5 * integer(resolution, "resolution", NumericError))
+        check_discretization(nm, current().method, resolution, fine)
 
 
 def check_tradeoff_gains(count: int, what: str) -> None:
@@ -486,7 +379,7 @@ def check_tradeoff_gains(count: int, what: str) -> None:
         raise NumericError(
             f"{what} gives {count:,} gains; a trade-off evaluates at most "
             f"{MAX_TRADEOFF_GAINS:,} (a spectrum and the noise figures at each, about 0.1 s "
-            f"apiece on the beam; {_budget('MAX_TRADEOFF_GAINS')})"
+            f"apiece on the beam; {budget_text('MAX_TRADEOFF_GAINS')})"
         )
 
 
@@ -495,7 +388,7 @@ def check_sweep_points(count: int, what: str) -> None:
     if count > MAX_SWEEP_POINTS:
         raise SweepError(
             f"{what} has {count:,} points; a sweep has at most {MAX_SWEEP_POINTS:,} "
-            f"({_budget('MAX_SWEEP_POINTS')}): split the study into several sweeps"
+            f"({budget_text('MAX_SWEEP_POINTS')}): split the study into several sweeps"
         )
 
 
@@ -505,6 +398,6 @@ def check_local_workers(workers: int, cores: int) -> None:
     if workers > cap:
         raise SweepError(
             f"workers: a local cluster has at most {cap} workers on this machine "
-            f"({MAX_WORKERS_PER_CORE} per core it may use, {_budget('MAX_WORKERS_PER_CORE')}: "
+            f"({MAX_WORKERS_PER_CORE} per core it may use, {budget_text('MAX_WORKERS_PER_CORE')}: "
             f"each worker is a process of about 150 MB); found {workers}"
         )

@@ -28,6 +28,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     import numpy as np
     import sympy
 
+    from phdesign.numeric.noise.metrics import Metric
     from phdesign.numeric.noise.report import NoiseReport
     from phdesign.numeric.noise.tradeoff import Tradeoff
     from phdesign.numeric.noise.tuning import NoiseTuneResult
@@ -51,6 +52,7 @@ class ObserverNoise:
         performance: str | Sequence[str] | None = None,
         max_resolution: int | None = None,
         tol: float | None = None,
+        metrics: Sequence[Metric] = (),
     ) -> NoiseReport:
         r"""Return what the gain costs in sensor noise: each figure converged or flagged.
 
@@ -81,6 +83,9 @@ class ObserverNoise:
         max_resolution, tol : optional
             Largest resolution of the refinement, and the relative agreement that makes a
             figure converged (default 1e-6 Galerkin, 1e-3 FD).
+        metrics : sequence of Metric, optional
+            Further figures, one class each (:mod:`phdesign.numeric.noise.metrics`),
+            reported in ``.figures``.
 
         Returns
         -------
@@ -114,6 +119,7 @@ class ObserverNoise:
             resolution=self.plant.resolution,
             max_resolution=max_resolution,
             tol=tol,
+            metrics=metrics,
         )
 
     def tradeoff(

@@ -295,8 +295,6 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         When a parameter is unknown or a symbol other than z stays free (the message
         names them).
     """
-    from phdesign.symbolic.expressions import exact_matrix, exact_number
-    from phdesign.symbolic.model import Z
     from phdesign.symbolic.system import require_model
 
     require_model(model)
@@ -305,72 +303,95 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
             f"parameters must be a mapping of names to values; found {type(parameters).__name__}"
         )
     values = _parameter_values(model, parameters)
-    N, n = int(model.order), int(model.size)
-
-    def subs_matrix(name: str, mat: Any, allow_z: bool) -> Any:
-        out = exact_matrix(mat, name, symbols=True).xreplace(values)
-        free = set(out.free_symbols) - ({Z} if allow_z else set())
-        if free:
-            raise ParameterError(_free_symbols_message(name, free))
-        return out
-
-    a_s, b_s = (exact_number(s, "interval endpoint") for s in model.interval)
-    for nm_, s in (("interval start a", a_s), ("interval end b", b_s)):
-        if s.free_symbols:
-            raise ParameterError(_free_symbols_message(nm_, set(s.free_symbols)))
-    P = [
-        np.array(subs_matrix(f"P{k}", Pk, False).evalf(), dtype=float)
-        for k, Pk in enumerate(model.P)
-        if k > 0
-    ]
-    P0s = subs_matrix("P0", model.P[0], True)
-    P0fun = None
-    if Z in P0s.free_symbols:
-        P0fun = _matrix_function(P0s, n)
-        P.insert(0, np.full((n, n), np.nan))
-    else:
-        P.insert(0, np.array(P0s.evalf(), dtype=float))
-    Hs = subs_matrix("H", model.H, True)
+    sub = _Substitution(values)
+    n = int(model.size)
+    P, P0fun = _numeric_P(sub, model.P, n)
+    Hs = sub.matrix("H", model.H, allow_z=True)
+    H_constant = not sub.depends_on_z(Hs)
     ports = model.ports
-    U = np.array(subs_matrix("U", ports.U, False).evalf(), dtype=float)
-    Y = np.array(subs_matrix("Y", ports.Y, False).evalf(), dtype=float)
-
-    H_constant = Z not in Hs.free_symbols
-    Hfun = constant_H(np.array(Hs.evalf(), dtype=float)) if H_constant else _matrix_function(Hs, n)
-    feedback = None
-    if getattr(model, "feedback", None) is not None:
-        K = np.array(subs_matrix("feedback gain K", model.feedback.gain, False).evalf(), float)
-        feedback = PortFeedback(tuple(model.feedback.closed), K)
-    disp = None
-    d = getattr(model, "displacement", None)
-    if d is not None:
-        disp = DisplacementSpec(int(d.component), int(d.integrations))
     inputs = getattr(model, "external_inputs", model.inputs)
     outputs = getattr(model, "external_outputs", model.outputs)
-    in_labels = tuple(str(e) for e in inputs)
-    out_labels = tuple(str(e) for e in outputs)
-    nm = NumericModel(
+    d = getattr(model, "displacement", None)
+    # H > 0, P0 + P0^T <= 0 and K + K^T >= 0 after substitution are checked by NumericModel
+    # itself (its invariants)
+    return NumericModel(
         name=str(model.name),
-        interval=(float(a_s), float(b_s)),
-        order=N,
+        interval=sub.interval(model.interval),
+        order=int(model.order),
         size=n,
-        P=tuple(P),
-        H=Hfun,
-        U=U,
-        Y=Y,
-        input_labels=in_labels,
-        output_labels=out_labels,
+        P=P,
+        H=constant_H(sub.array(Hs)) if H_constant else _matrix_function(Hs, n),
+        U=sub.array(sub.matrix("U", ports.U)),
+        Y=sub.array(sub.matrix("Y", ports.Y)),
+        input_labels=tuple(str(e) for e in inputs),
+        output_labels=tuple(str(e) for e in outputs),
         state_names=tuple(model.state_names),
-        displacement=disp,
+        displacement=None
+        if d is None
+        else DisplacementSpec(int(d.component), int(d.integrations)),
         H_constant=H_constant,
-        feedback=feedback,
+        feedback=_numeric_feedback(sub, getattr(model, "feedback", None)),
         P0=P0fun,
         units=dict(getattr(model, "units", ())),
         parameters={str(k): float(v) for k, v in values.items()},
     )
-    # H > 0, P0 + P0^T <= 0 and K + K^T >= 0 after substitution are checked by NumericModel
-    # itself (its invariants)
-    return nm
+
+
+class _Substitution:
+    """The parameters' values put into a model's matrices, refusing any other symbol."""
+
+    def __init__(self, values: dict[Any, Any]) -> None:
+        from phdesign.symbolic.model import Z
+
+        self.values, self.z = values, Z
+
+    def matrix(self, name: str, mat: Any, allow_z: bool = False) -> Any:
+        """Return the exact matrix with the values in; only z may stay free (when allowed)."""
+        from phdesign.symbolic.expressions import exact_matrix
+
+        out = exact_matrix(mat, name, symbols=True).xreplace(self.values)
+        free = set(out.free_symbols) - ({self.z} if allow_z else set())
+        if free:
+            raise ParameterError(_free_symbols_message(name, free))
+        return out
+
+    def depends_on_z(self, mat: Any) -> bool:
+        """Tell whether a substituted matrix still holds z."""
+        return self.z in mat.free_symbols
+
+    @staticmethod
+    def array(mat: Any) -> np.ndarray:
+        """Return a substituted matrix without z as floats."""
+        return np.array(mat.evalf(), dtype=float)
+
+    def interval(self, ends: Any) -> tuple[float, float]:
+        """Return the interval's ends as floats (they may be parameters)."""
+        from phdesign.symbolic.expressions import exact_number
+
+        a_s, b_s = (exact_number(s, "interval endpoint") for s in ends)
+        for name, s in (("interval start a", a_s), ("interval end b", b_s)):
+            if s.free_symbols:
+                raise ParameterError(_free_symbols_message(name, set(s.free_symbols)))
+        return float(a_s), float(b_s)
+
+
+def _numeric_P(
+    sub: _Substitution, P_sym: Sequence[Any], n: int
+) -> tuple[tuple[np.ndarray, ...], Callable[[np.ndarray], np.ndarray] | None]:
+    """Return P_0..P_N as floats, and a z-dependent P_0 as a callable (NaN in its slot)."""
+    P = [sub.array(sub.matrix(f"P{k}", Pk)) for k, Pk in enumerate(P_sym) if k > 0]
+    P0s = sub.matrix("P0", P_sym[0], allow_z=True)
+    if sub.depends_on_z(P0s):
+        return (np.full((n, n), np.nan), *P), _matrix_function(P0s, n)
+    return (sub.array(P0s), *P), None
+
+
+def _numeric_feedback(sub: _Substitution, feedback: Any) -> PortFeedback | None:
+    """Return the plant's own feedback with its gain as floats (None without one)."""
+    if feedback is None:
+        return None
+    K = sub.array(sub.matrix("feedback gain K", feedback.gain))
+    return PortFeedback(tuple(feedback.closed), K)
 
 
 def _matrix_function(matrix: Any, n: int) -> Callable[[np.ndarray], np.ndarray]:

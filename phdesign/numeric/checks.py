@@ -24,6 +24,7 @@ phdesign.core.errors.ObserverError: C_m must have full row rank ...; expected ra
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Callable
 from typing import Any
 
@@ -39,9 +40,12 @@ from phdesign.numeric.discretization.registry import check_basis
 __all__ = [
     "SAMPLERS",
     "check_initial_state",
+    "check_noise_intensity",
+    "check_periods",
     "check_sampling",
     "check_sensors_and_gain",
     "check_simulate_arguments",
+    "check_simulation",
     "check_spectrum_arguments",
     "check_tune_arguments",
 ]
@@ -182,7 +186,7 @@ def check_simulate_arguments(
     ``options`` is a checked :class:`~phdesign.numeric.time.options.SimulationOptions`;
     here are the sensors and gain, the initial states and inputs against the model, the
     points ``z_w`` against its interval, and the budget of
-    :func:`phdesign.core.limits.check_simulation`.
+    :func:`check_simulation`.
     """
     require_numeric_model(nm)
     check_sensors_and_gain(nm, C_m, L, what="a simulation")
@@ -196,7 +200,7 @@ def check_simulate_arguments(
         a, b = nm.interval
         if min(options.z_w) < a or max(options.z_w) > b:
             raise NumericError(f"z_w must lie in [{a:g}, {b:g}]; found {list(options.z_w)}")
-    limits.check_simulation(
+    check_simulation(
         nm, C_m, options.t_end, options.samples, options.method, options.resolution, discrete
     )
 
@@ -230,3 +234,118 @@ def check_tune_arguments(
     if not (np.isfinite(low) and np.isfinite(high) and low < high):
         raise NumericError(f"log_range must hold finite low < high; found {log_range!r}")
     limits.check_tuning(nm, starts, seed, maxiter, resolution)
+
+
+def check_simulation(
+    nm: Any,
+    C_m: Any,
+    t_end: object,
+    samples: object,
+    method: object,
+    resolution: object,
+    discrete: Any = None,
+) -> None:
+    """Refuse a simulation whose time span or size is beyond the budgets.
+
+    Parameters
+    ----------
+    nm : NumericModel
+    C_m : array or None
+        The sensors (the observer runs too when given: twice the states).
+    t_end : float
+        Final time: ``0 < t_end <= limits.MAX_T_END``.
+    samples : int
+        Output samples; ``t_end / (samples - 1) >= limits.MIN_TIME_STEP`` and samples times
+        states at most :data:`limits.MAX_SIMULATION_VALUES`.
+    method, resolution
+        The discretization (checked by :func:`check_discretization`).
+    discrete : DiscretePHS, optional
+        A discretization given ready-made (its states replace the estimate).
+    """
+    if isinstance(t_end, bool) or not isinstance(t_end, numbers.Real):
+        raise NumericError(f"t_end must be a number; found {type(t_end).__name__} {t_end!r}")
+    end = float(t_end)
+    if not (math.isfinite(end) and 0 < end <= limits.MAX_T_END):
+        raise NumericError(
+            f"t_end must be a positive number at most {limits.MAX_T_END:g}; found {end:g} "
+            f"({limits.budget_text('MAX_T_END')})"
+        )
+    count = limits.integer(samples, "samples", NumericError)
+    if count < 2:
+        raise NumericError(f"samples must be at least 2; found {count}")
+    step = end / (count - 1)
+    if not step >= limits.MIN_TIME_STEP:
+        raise NumericError(
+            f"t_end / (samples - 1) = {step:.3g} is below {limits.MIN_TIME_STEP:g}: the time "
+            "stamps would not be distinct; expected a longer t_end or fewer samples "
+            f"({limits.budget_text('MIN_TIME_STEP')})"
+        )
+    if discrete is not None:
+        states = int(discrete.dim)
+    else:
+        limits.check_discretization(nm, method, resolution)
+        states = limits.state_count(nm, limits.resolution_or_default(nm, method, resolution))
+    states *= 1 if C_m is None else 2
+    total = count * states
+    if total > limits.MAX_SIMULATION_VALUES:
+        raise NumericError(
+            f"samples = {count} times {states:,} states is {total:,} values; expected at "
+            f"most {limits.MAX_SIMULATION_VALUES:,} "
+            f"({limits.budget_text('MAX_SIMULATION_VALUES')}): ask for fewer samples"
+        )
+
+
+def check_noise_intensity(largest: float, name: str = "intensity") -> None:
+    """Refuse a noise intensity above :data:`limits.MAX_NOISE_INTENSITY` (``largest`` of them)."""
+    if largest > limits.MAX_NOISE_INTENSITY:
+        raise NumericError(
+            f"{name}: intensities must be at most {limits.MAX_NOISE_INTENSITY:g} (variances per "
+            f"unit time); found {largest:g} ({limits.budget_text('MAX_NOISE_INTENSITY')})"
+        )
+
+
+def check_periods(
+    dt: float,
+    t_end: float,
+    *,
+    stepped: bool = True,
+    states: int = 0,
+    names: tuple[str, str] = ("`dt`", "`t_end`"),
+) -> None:
+    """Refuse a sampling period longer than the run, or more periods than a run may step.
+
+    Parameters
+    ----------
+    dt, t_end : float
+        The period and the run's length (both checked finite and positive before).
+    stepped : bool
+        The run steps the periods (a simulation, a verification); an export without
+        verification only needs ``dt <= t_end``.
+    states : int
+        States stepped one period at a time (a run with an input signal), whose
+        periods times states count against :data:`limits.MAX_SIMULATION_VALUES`; 0 when the
+        periods are jumped over by powers of the one-period map.
+    names : (str, str)
+        How ``dt`` and ``t_end`` are called in the message: as code, which the command
+        line writes as its options (``--dt``, ``--t-end``).
+    """
+    dt_name, t_name = names
+    if dt > t_end:
+        raise NumericError(
+            f"{dt_name} = {dt:g} s is longer than {t_name} = {t_end:g} s; expected a sampling "
+            f"period at most the run's length (a longer {t_name}, or a shorter {dt_name})"
+        )
+    periods = t_end / dt
+    if stepped and periods > limits.MAX_PERIODS:
+        raise NumericError(
+            f"{t_name} / {dt_name} = {periods:.3g} sampling periods; expected at most "
+            f"{limits.MAX_PERIODS:.0e} ({limits.budget_text('MAX_PERIODS')}): a longer "
+            f"{dt_name} or a shorter {t_name}"
+        )
+    if stepped and states and periods * states > limits.MAX_SIMULATION_VALUES:
+        raise NumericError(
+            f"{t_name} / {dt_name} = {periods:.3g} periods, each stepped with an input, times "
+            f"{states:,} states is {periods * states:.3g} values; expected at most "
+            f"{limits.MAX_SIMULATION_VALUES:,} ({limits.budget_text('MAX_SIMULATION_VALUES')}): "
+            f"a longer {dt_name} or a shorter {t_name}"
+        )

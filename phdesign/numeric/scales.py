@@ -97,7 +97,7 @@ class ProblemScales:
         :math:`(|c_a| \cdot \sigma_u) / (|c_a| \cdot \sigma_y)`.
         """
         C = np.abs(np.atleast_2d(np.asarray(C_m, dtype=float)))
-        return (C @ self.input_scale) / (C @ self.output_scale)
+        return np.asarray((C @ self.input_scale) / (C @ self.output_scale))
 
 
 def _trace_scales(nm: NumericModel, effort: np.ndarray, length: float) -> np.ndarray:

@@ -31,6 +31,22 @@ __all__ = [
 ]
 
 
+def _resolved_mask(lam: np.ndarray, resolved: np.ndarray | None) -> np.ndarray:
+    """Return the mask of the resolved eigenvalues from a mask or indices (all: none given)."""
+    if resolved is None:
+        return np.ones(lam.size, dtype=bool)
+    r = np.asarray(resolved)
+    if r.dtype != bool:
+        mask = np.zeros(lam.size, dtype=bool)
+        mask[r.astype(int).ravel()] = True
+        return mask
+    if r.size != lam.size:
+        raise NumericError(
+            f"resolved mask has {r.size} entries; expected {lam.size} (one per eigenvalue)"
+        )
+    return r.ravel()
+
+
 def plot_spectrum(
     eigenvalues: np.ndarray,
     resolved: np.ndarray | None = None,
@@ -45,7 +61,7 @@ def plot_spectrum(
     """Eigenvalues in the complex plane, resolved and unresolved ones marked differently.
 
     Resolved eigenvalues (those that agree between two resolutions, see
-    :func:`phdesign.numeric.spectrum.converged.match_resolved`) are filled blue dots; unresolved
+    :func:`phdesign.numeric.spectrum.drift.match_resolved`) are filled blue dots; unresolved
     ones are grey crosses: they are artefacts of the discretization and the spectral
     abscissa ignores them.  The legend, below the axes, lists only what the view shows.
 
@@ -71,18 +87,7 @@ def plot_spectrum(
     """
     lam = np.asarray(eigenvalues, dtype=complex).ravel()
     lam = lam[np.isfinite(lam)]
-    mask = np.ones(lam.size, dtype=bool)
-    if resolved is not None:
-        r = np.asarray(resolved)
-        if r.dtype == bool:
-            if r.size != lam.size:
-                raise NumericError(
-                    f"resolved mask has {r.size} entries; expected {lam.size} (one per eigenvalue)"
-                )
-            mask = r.ravel()
-        else:
-            mask = np.zeros(lam.size, dtype=bool)
-            mask[r.astype(int).ravel()] = True
+    mask = _resolved_mask(lam, resolved)
     fig, ax = axes_or_new(ax, figsize=(6, 4.5))
     ax.plot(
         lam[mask].real,

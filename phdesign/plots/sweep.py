@@ -86,7 +86,7 @@ def _varying(data: Any) -> list[str]:
 
 
 def _is_log(dataset: Any, dim: str) -> bool:
-    return dataset[dim].attrs.get("scale") == "log"
+    return bool(dataset[dim].attrs.get("scale") == "log")
 
 
 def _label(dataset: Any, name: str) -> str:

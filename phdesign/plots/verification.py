@@ -7,7 +7,7 @@ A front end (matplotlib only, through :func:`phdesign.plots.drawing`): it draws 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -36,4 +36,4 @@ def plot_verification(verification: Any, ax: Axes | None = None) -> Axes:
         axes.set_xlabel("t")
         axes.set_ylabel("|" + ", ".join(v.outputs) + " error|")
         axes.legend()
-    return axes
+    return cast("Axes", axes)

@@ -66,7 +66,7 @@ def _stored_list(data: dict[str, Any], key: str, kind: type) -> list[Any] | None
         type(x) is kind or (kind is float and type(x) is int) for x in items
     ):
         raise SweepError(f"the stored {key} must be a short list of {kind.__name__}")
-    return items
+    return list(items)
 
 
 def description_fields(data: Any) -> dict[str, Any]:

@@ -96,10 +96,7 @@ def trace_index(component: int, derivative: int, side: str, order: int, size: in
 def trace_list(order: int, size: int) -> tuple[Trace, ...]:
     """Return the traces of ``v = (phi(b); phi(a))`` in order."""
     return tuple(
-        Trace(i, k, side)  # type: ignore[arg-type]
-        for side in ("b", "a")
-        for k in range(order)
-        for i in range(1, size + 1)
+        Trace(i, k, side) for side in ("b", "a") for k in range(order) for i in range(1, size + 1)
     )
 
 

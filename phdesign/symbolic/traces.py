@@ -103,7 +103,7 @@ def trace_of(symbol: sympy.Basic) -> Trace | None:
     if match is None or symbol != trace_symbol(
         int(match[1]),
         len(match[2]),
-        match[3],  # type: ignore[arg-type]
+        match[3],
     ):
         return None
     return Trace(int(match[1]), len(match[2]), match[3])  # type: ignore[arg-type]

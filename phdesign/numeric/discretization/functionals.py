@@ -204,4 +204,4 @@ def _integral_row(d: DiscretePHS, weight: Callable[[np.ndarray], np.ndarray]) ->
     W = np.asarray(weight(z), dtype=float).reshape(z.size, d.model.size)
     Hinv_W = np.linalg.solve(d.model.H_at(z), W[:, :, None])[:, :, 0]  # H symmetric
     basis = d.effort_basis(z)  # (nq, n, dim)
-    return np.einsum("q,qi,qid->d", wq, Hinv_W, basis)
+    return np.asarray(np.einsum("q,qi,qid->d", wq, Hinv_W, basis))

@@ -370,7 +370,7 @@ class _TrialSpace:
         return np.asarray(self._displacement(z))
 
 
-def _displacement_basis(nm: NumericModel, effort_basis, iv):  # type: ignore[no-untyped-def]
+def _displacement_basis(nm: NumericModel, effort_basis, iv):
     """w(z) = repeated integral from a of x_c = (H^-1 e)_c, as a linear map of ê.
 
     x_c is sampled at Gauss points, expanded in Legendre polynomials by the (exact for
@@ -394,6 +394,6 @@ def _displacement_basis(nm: NumericModel, effort_basis, iv):  # type: ignore[no-
 
     def basis(z: np.ndarray) -> np.ndarray:
         tt = (2 * np.atleast_1d(np.asarray(z, dtype=float)) - iv[0] - iv[1]) / (iv[1] - iv[0])
-        return leg.legvander(tt, coef.shape[0] - 1) @ coef
+        return np.asarray(leg.legvander(tt, coef.shape[0] - 1) @ coef)
 
     return basis

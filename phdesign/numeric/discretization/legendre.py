@@ -108,7 +108,7 @@ def legendre_basis(z: np.ndarray, p: int, k: int, interval: tuple[float, float])
     t = (2.0 * np.asarray(z, dtype=float) - a - b) / (b - a)
     V = leg.legvander(t, p) @ _derivative_coefficients(p, k)
     scale = (2.0 / (b - a)) ** k * np.sqrt((2.0 * np.arange(p + 1) + 1.0) / (b - a))
-    return V * scale
+    return np.asarray(V * scale)
 
 
 def trace_scaling(p: int, order: int, interval: tuple[float, float]) -> np.ndarray:
@@ -125,7 +125,7 @@ def trace_scaling(p: int, order: int, interval: tuple[float, float]) -> np.ndarr
     """
     b = np.array([float(interval[1])])
     peak = np.max([np.abs(legendre_basis(b, p, k, interval)[0]) for k in range(order)], axis=0)
-    return 1.0 / peak
+    return np.asarray(1.0 / peak)
 
 
 @lru_cache(maxsize=64)

@@ -131,14 +131,14 @@ class DiscretePHS:
     def hamiltonian(self, ehat: np.ndarray) -> np.ndarray:
         """Discrete energy ½ êᵀ E ê; ``ehat`` of shape ``(dim,)`` or ``(nt, dim)``."""
         eh = np.asarray(ehat)
-        return 0.5 * np.sum((eh @ self.E) * eh, axis=-1)
+        return np.asarray(0.5 * np.sum((eh @ self.E) * eh, axis=-1))
 
     def output(self, ehat: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
         """Y = Bᵀ ê + D u (row-wise for stacked ``ehat``)."""
         y = np.asarray(ehat) @ self.B
         if u is not None:
             y = y + np.asarray(u) @ self.D.T
-        return y
+        return np.asarray(y)
 
     def close(self, K: np.ndarray | None = None) -> ClosedLoop:
         """Close the output feedback u = v − K y around the system (``K=None``: K = 0).
@@ -304,4 +304,4 @@ def feedback_matrix(C_m: np.ndarray, L: np.ndarray, n_outputs: int) -> np.ndarra
         raise ObserverError("L must be finite")
     if q:
         require_definite("L + L^T", Lm + Lm.T, ObserverError)
-    return C.T @ Lm @ C
+    return np.asarray(C.T @ Lm @ C)

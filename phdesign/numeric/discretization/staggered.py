@@ -346,7 +346,7 @@ def _linear_interp_matrix(grid: np.ndarray, z: np.ndarray) -> np.ndarray:
     return W
 
 
-def _fd_displacement(nm, p, q, zp, zq, Hp, Hq, r, m, dim):  # type: ignore[no-untyped-def]
+def _fd_displacement(nm, p, q, zp, zq, Hp, Hq, r, m, dim):
     """w(z): repeated trapezoidal integration from a of the nodal x_c (x = H⁻¹ e)."""
     spec = nm.displacement
     c = spec.component - 1
@@ -372,6 +372,6 @@ def _fd_displacement(nm, p, q, zp, zq, Hp, Hq, r, m, dim):  # type: ignore[no-un
 
     def basis(z: np.ndarray) -> np.ndarray:
         zz = np.atleast_1d(np.asarray(z, dtype=float))
-        return _linear_interp_matrix(pts, zz) @ vals
+        return np.asarray(_linear_interp_matrix(pts, zz) @ vals)
 
     return basis

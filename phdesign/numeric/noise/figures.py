@@ -69,11 +69,12 @@ from phdesign.core import limits
 from phdesign.core.checks import positive_int, positive_number
 from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import NumericError, ObserverError
-from phdesign.core.limits import check_noise_intensity
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.checks import check_noise_intensity
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.noise.gain import discrete_sup, gain_pair
+from phdesign.numeric.noise.metrics import ErrorEnergy, Metric, OutputVariance
 from phdesign.numeric.noise.report import GainEstimate, NoiseReport
 from phdesign.numeric.noise.settle import Estimate, settle
 from phdesign.numeric.noise.statistics import ErrorStatistics, error_statistics
@@ -158,6 +159,7 @@ def noise(
     max_resolution: int | None = None,
     tol: float | None = None,
     discretizations: MutableMapping[int, DiscretePHS] | None = None,
+    metrics: Sequence[Metric] = (),
 ) -> NoiseReport:
     r"""Noise figures of an observer, each with its verdict under refinement.
 
@@ -186,6 +188,9 @@ def noise(
         table, 1e-6 Galerkin, 1e-3 FD).
     discretizations : dict, optional
         A cache ``{resolution: DiscretePHS}`` shared between calls (filled as needed).
+    metrics : sequence of Metric, optional
+        Further figures, one number per resolution each (:mod:`phdesign.numeric.noise.metrics`:
+        a new figure is one class), judged like the others and reported in ``figures``.
 
     Returns
     -------
@@ -225,12 +230,11 @@ def noise(
             )
     cache = discretizations if discretizations is not None else {}
 
-    run = _Refinement(functionals, tol)
+    run = _Refinement(functionals, tuple(metrics), tol)
     while True:
         if p not in cache:
             cache[p] = discretize(nm, method, p)
-        d = cache[p]
-        run.add(error_statistics(d, C, Lm, sigma, w_in), [f.row(d) for f in functionals], rtol)
+        run.add(error_statistics(cache[p], C, Lm, sigma, w_in), rtol)
         nxt = math.ceil(1.5 * p)
         if run.done() or nxt > pmax:
             break
@@ -239,19 +243,25 @@ def noise(
 
 
 class _Refinement:
-    """The figures at each resolution so far, and their verdicts."""
+    """The figures at each resolution so far, and their verdicts.
 
-    def __init__(self, functionals: Sequence[Functional], tol: float) -> None:
-        self.functionals = tuple(functionals)
+    The per-resolution figures are :class:`~phdesign.numeric.noise.metrics.Metric` s: the
+    variance of each performance output, the error energy, then the caller's; the L²-gain
+    is computed per pair of resolutions.
+    """
+
+    def __init__(self, functionals: Sequence[Functional], extra: tuple[Metric, ...], tol: float):
+        self.outputs = tuple(OutputVariance(functional=f) for f in functionals)
+        self.metrics = (*self.outputs, ErrorEnergy(), *extra)
         self.tol = tol
         self.stats: list[ErrorStatistics] = []
-        self.variances: list[list[float]] = []
+        self.values: list[list[float]] = []
         self.sups: list[tuple[float, float]] = []
         self.pairs: list[dict[str, Any]] = []
 
-    def add(self, stats: ErrorStatistics, rows: list[np.ndarray], rtol: float) -> None:
+    def add(self, stats: ErrorStatistics, rtol: float) -> None:
         self.stats.append(stats)
-        self.variances.append([stats.variance(r) for r in rows])
+        self.values.append([m.value(stats) for m in self.metrics])
         self.sups.append(discrete_sup(stats) if stats.stable else (math.inf, math.nan))
         if len(self.stats) >= 2:
             self.pairs.append(gain_pair(self.stats[-2], stats, rtol, self.tol))
@@ -264,14 +274,18 @@ class _Refinement:
     def resolutions(self) -> tuple[int, ...]:
         return tuple(s.resolution for s in self.stats)
 
-    def performance(self) -> list[Estimate]:
+    def estimates(self) -> list[Estimate]:
+        """Every metric's verdict over the resolutions so far, in the metrics' order."""
         return [
-            settle(f.name, [v[i] for v in self.variances], self.resolutions, self.tol)
-            for i, f in enumerate(self.functionals)
+            settle(m.name, [v[i] for v in self.values], self.resolutions, self.tol)
+            for i, m in enumerate(self.metrics)
         ]
 
+    def performance(self) -> list[Estimate]:
+        return self.estimates()[: len(self.outputs)]
+
     def energy(self) -> Estimate:
-        return settle("E[H~]", [s.energy() for s in self.stats], self.resolutions, self.tol)
+        return self.estimates()[len(self.outputs)]
 
     def gain(self) -> GainEstimate:
         res = self.resolutions
@@ -305,7 +319,7 @@ class _Refinement:
         """Every figure converged or diverging (three resolutions at least), or no steady state."""
         if not self.steady:
             return True
-        figures = [*self.performance(), self.energy(), self.gain().estimate]
+        figures = [*self.estimates(), self.gain().estimate]
         return len(self.stats) >= 3 and all(f.converged or f.diverges for f in figures)
 
     def report(
@@ -326,20 +340,21 @@ class _Refinement:
                 f"(eigenvalue {worst:.6g}): no stationary error exists and the noise figures "
                 "are infinite"
             )
-        performance, energy, gain = self.performance(), self.energy(), self.gain()
-        for est in performance:
-            warnings += _figure_warnings(f"Var[{est.name}~]", est, self.tol, smooth_hint=True)
-        warnings += _figure_warnings("E[H~]", energy, self.tol, smooth_hint=False)
+        estimates, gain = self.estimates(), self.gain()
+        for metric, est in zip(self.metrics, estimates, strict=True):
+            warnings += _figure_warnings(metric.label, est, self.tol, smooth_hint=metric.smooth)
         warnings += gain.warnings(self.tol)
+        n = len(self.outputs)
         return NoiseReport(
             model=nm.name,
             sensors=C,
             gain=Lm,
             intensity=tuple(float(s) for s in sigma),
             input_intensity=None if w_in is None else tuple(float(s) for s in w_in),
-            performance=tuple(performance),
+            performance=tuple(estimates[:n]),
             l2_gain=gain,
-            error_energy=energy,
+            error_energy=estimates[n],
+            figures=tuple(estimates[n + 1 :]),
             resolutions=self.resolutions,
             method=method,
             steady_state=self.steady,

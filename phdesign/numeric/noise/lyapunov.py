@@ -95,7 +95,7 @@ class TriangularPencil:
     def to_state(self, Y: np.ndarray) -> np.ndarray:
         """Map triangular coordinates (columns of ``Y``) to the original state."""
         X = self.Z @ Y
-        return X if self.V is None else self.V @ X
+        return np.asarray(X if self.V is None else self.V @ X)
 
     def covariance(self) -> np.ndarray:
         r"""Return the stationary covariance: :math:`A P E^\top + E P A^\top + GG^\top = 0`."""
@@ -108,7 +108,7 @@ class TriangularPencil:
             X = _generalized_triangular_lyapunov(self.T, self.S, C)
         P = self.to_state(self.to_state(X).conj().T).conj().T
         P = P.real
-        return 0.5 * (P + P.T)
+        return np.asarray(0.5 * (P + P.T))
 
     def response(self, omega: np.ndarray) -> np.ndarray:
         r"""Largest singular value of the energy-norm frequency response at each ``omega``.

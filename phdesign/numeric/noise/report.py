@@ -168,6 +168,8 @@ class NoiseReport:
     warnings : tuple of str
     pencils : tuple of TriangularPencil
         The error system at each resolution (for :meth:`frequency_response`).
+    figures : tuple of Estimate
+        The caller's further figures (:mod:`phdesign.numeric.noise.metrics`), in order.
     """
 
     model: str
@@ -184,6 +186,7 @@ class NoiseReport:
     output_labels: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
     pencils: tuple[TriangularPencil, ...] = field(default=(), compare=False, repr=False)
+    figures: tuple[Estimate, ...] = ()
 
     def frequency_response(self, omega: np.ndarray | None = None) -> dict[int, np.ndarray]:
         """Energy-norm gain from the noise to the error at each resolution, at ``omega``.
@@ -238,6 +241,7 @@ class NoiseReport:
             "performance": performance,
             "l2_gain": self.l2_gain.to_dict(),
             "error_energy": self.error_energy.to_dict(),
+            "figures": [{"name": est.name, **est.to_dict()} for est in self.figures],
             "resolutions": list(self.resolutions),
             "method": self.method,
             "steady_state": self.steady_state,
@@ -283,6 +287,7 @@ class NoiseReport:
         elif energy.diverges:
             verdict = f"{energy.status()}: infinite for the PDE"
         lines.append(f"  expected error energy E[H~]: {verdict} ({values} at resolutions {res})")
+        lines += [f"  {est}" for est in self.figures]
         lines += [f"warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 

@@ -41,10 +41,9 @@ import numpy as np
 from phdesign.core.checks import EXPORT_FORMATS, positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError
-from phdesign.core.limits import check_periods
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.checks import check_initial_state, check_sampling
+from phdesign.numeric.checks import check_initial_state, check_periods, check_sampling
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.sampled.order import REDUCTIONS, select_order

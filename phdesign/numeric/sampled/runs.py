@@ -73,7 +73,7 @@ class LoopRun:
 
     def performance_error(self, observer: ContinuousObserver) -> np.ndarray:
         """Plant minus observer on the performance outputs, ``(nr, n_performance)``."""
-        return self.target - self.yhat[:, list(observer.performance)]
+        return np.asarray(self.target - self.yhat[:, list(observer.performance)])
 
 
 def plant_targets(plant: DiscretePHS, observer: ContinuousObserver) -> np.ndarray:

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from phdesign.core.errors import NumericError
-from phdesign.core.limits import check_periods
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.checks import check_periods
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import input_samples
@@ -57,7 +57,7 @@ def embedding(observer: DiscretePHS, plant: DiscretePHS) -> np.ndarray:
             f"{observer.resolution}) is not contained in the plant's ({plant.method}, "
             f"resolution {plant.resolution}): use Galerkin, or equal resolutions"
         )
-    return P
+    return np.asarray(P)
 
 
 def simulate_sampled(

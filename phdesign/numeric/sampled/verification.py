@@ -17,10 +17,9 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.defaults import current
-from phdesign.core.limits import check_periods
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.checks import check_sampling
+from phdesign.numeric.checks import check_periods, check_sampling
 from phdesign.numeric.sampled.order import check_order
 from phdesign.numeric.sampled.runs import run_against_continuous
 from phdesign.numeric.sampled.samplers import ContinuousObserver

@@ -216,7 +216,7 @@ class Branches:
         interval (measured on the steel Timoshenko beam: 0.97); 10 % is added.
         """
         radians = self.wavenumber * (frequency / rate) ** (1.0 / self.order)
-        return math.ceil(1.1 * radians)
+        return math.ceil(1.1 * float(radians))
 
 
 def merged_branches(parts: dict[str, Branches]) -> Branches:
@@ -259,4 +259,4 @@ def scaled_families(
 def sqrtm_spd(H: np.ndarray) -> np.ndarray:
     """Return the symmetric square root of a symmetric positive definite matrix."""
     w, V = np.linalg.eigh(0.5 * (H + H.T))
-    return (V * np.sqrt(w)) @ V.T
+    return np.asarray((V * np.sqrt(w)) @ V.T)

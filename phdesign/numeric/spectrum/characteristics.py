@@ -201,7 +201,7 @@ def _integral(z: np.ndarray, values: np.ndarray) -> np.ndarray:
     x = 2 * (z - a) / (b - a) - 1
     c = chebyshev.chebfit(x, values, z.size - 1)
     integral = chebyshev.chebint(c, lbnd=-1)
-    return np.asarray(chebyshev.chebval(1.0, integral)) * (b - a) / 2
+    return np.asarray(np.asarray(chebyshev.chebval(1.0, integral)) * (b - a) / 2)
 
 
 def _block_transport(

@@ -195,7 +195,7 @@ def rightmost_indices(chosen: PairResult, count: int) -> np.ndarray:
     """Return the indices (into the pair's eigenvalues) of the ``count`` rightmost counted."""
     lam = chosen.pair.eigenvalues
     counted = np.flatnonzero(chosen.abscissa.counted)
-    return counted[rightmost_order(lam[counted])[:count]]
+    return np.asarray(counted[rightmost_order(lam[counted])[:count]])
 
 
 def abscissa_digits(chosen: PairResult) -> float:

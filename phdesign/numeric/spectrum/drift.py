@@ -193,7 +193,7 @@ class PairSpectrum:
     @property
     def candidates(self) -> np.ndarray:
         """Mask of the eigenvalues that may carry the abscissa (resolved or clustered)."""
-        return self.resolved | self.clustered
+        return np.asarray(self.resolved | self.clustered)
 
     @property
     def n_resolved(self) -> int:

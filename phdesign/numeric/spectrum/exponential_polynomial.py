@@ -322,7 +322,7 @@ def _counts(F: ExponentialPolynomial, thetas: np.ndarray, sigmas: np.ndarray) ->
     companion[..., np.arange(1, degree), np.arange(degree - 1)] = 1.0
     roots = np.linalg.eigvals(companion)
     inside = np.log(np.maximum(np.abs(roots), 1e-300)) < (sigmas * r[0])[..., None]
-    return np.count_nonzero(inside, axis=-1)
+    return np.asarray(np.count_nonzero(inside, axis=-1))
 
 
 def _largest_crossings(

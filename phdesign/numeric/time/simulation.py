@@ -375,6 +375,6 @@ def _difference(f: InitialState, g: InitialState) -> InitialState:
     """Return the initial estimation error x0 - xhat0 (the projection is linear)."""
 
     def diff(z: np.ndarray) -> np.ndarray:
-        return np.asarray(f(z), dtype=float) - np.asarray(g(z), dtype=float)
+        return np.asarray(np.asarray(f(z), dtype=float) - np.asarray(g(z), dtype=float))
 
     return diff

@@ -112,7 +112,7 @@ def _run(Phi: np.ndarray, X0: np.ndarray, u: np.ndarray | None, dt: float, nt: i
 
 
 def _energy_norms(E: np.ndarray, X: np.ndarray) -> np.ndarray:
-    return np.sqrt(np.abs(np.sum((X @ E) * X, axis=1)))
+    return np.asarray(np.sqrt(np.abs(np.sum((X @ E) * X, axis=1))))
 
 
 def integrate(
@@ -292,4 +292,4 @@ def dissipation_integral(F: np.ndarray, P: np.ndarray, dt: float) -> np.ndarray:
     for _ in range(doublings):
         G = G + Phi.T @ G @ Phi
         Phi = Phi @ Phi
-    return 0.5 * (G + G.T)
+    return np.asarray(0.5 * (G + G.T))

@@ -64,7 +64,7 @@ class GainSearch:
     def n_params(self) -> int:
         """Number of parameters: q diagonal gains, or q² (S symmetric and W skew)."""
         q = self.q
-        return q if not self.full else q * q
+        return int(q if not self.full else q * q)
 
     def gain(self, x: np.ndarray) -> np.ndarray:
         """L for the parameters x (module docstring)."""
@@ -79,7 +79,7 @@ class GainSearch:
         iw = np.triu_indices(q, 1)
         W[iw] = x[iu[0].size :]
         core = sl.expm(np.clip(S, -60.0, 60.0)) + W - W.T
-        return self.root[:, None] * core * self.root[None, :]
+        return np.asarray(self.root[:, None] * core * self.root[None, :])
 
     def diagonal_params(self, d: np.ndarray) -> np.ndarray:
         """Parameters of the diagonal gain diag(scale e^d)."""
