@@ -61,6 +61,18 @@ def _kind(a: Abscissa, attained: float) -> list[str]:
     return []
 
 
+def _not_derived(a: Abscissa) -> list[str]:
+    """Return the warning that the chains' limits above the band were not derived, and why."""
+    b = a.branches
+    if b is None or b.analysed or not b.reason:
+        return []
+    return [
+        f"the limits of the eigenvalue chains above the resolved band are not derived "
+        f"({b.reason}): the abscissa is that of the resolved band, with the rising-trend "
+        "rule for real parts that keep rising toward its top"
+    ]
+
+
 def _band(a: Abscissa, pair: PairSpectrum, value: float) -> list[str]:
     """Return the warning of rule 6's lower bound: a band that does not reach the onset."""
     b = a.branches
@@ -172,6 +184,7 @@ def report_warnings(
     warnings = (
         _kind(a, attained)
         + _band(a, pair, value)
+        + _not_derived(a)
         + _no_decay(a, no_decay)
         + ill_text
         + _right_of_abscissa(a, pair, attained, tol)

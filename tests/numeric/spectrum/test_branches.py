@@ -411,3 +411,25 @@ def test_tune_on_a_steel_beam_optimizes_the_true_abscissa():
     delta = timoshenko_determinant(STEEL, 0.5, STEEL["k1"], gain)
     lead = rep.rightmost[0]
     assert abs(polished(delta, lead) - lead) < 1e-9 * abs(lead)
+
+
+def test_a_structure_not_derived_is_said():
+    # a beam whose stiffness varies along z: the chains' limits of an N = 2 model are
+    # derived for constant coefficients only, and the report says so (the uniform viscous
+    # damping still gives every mode Re = -d/2 = -0.1, resolved and converged)
+    beam = BCPHS.define(
+        name="graded beam",
+        interval=[0, 1],
+        order=2,
+        P={0: [["-1/5", 0], [0, 0]], 2: [[0, -1], [1, 0]]},
+        H=[[1, 0], [0, "1 + z"]],
+        inputs=["e1(0)", "e1'(0)", "e2(1)", "e2'(1)"],
+        outputs=["e2'(0)", "-e2(0)", "e1'(1)", "-e1(1)"],
+    )
+    rep = spectrum(to_numeric(beam))
+    assert rep.converged
+    assert abs(rep.spectral_abscissa + 0.1) < 1e-9
+    assert not rep.branches.analysed
+    assert any(
+        "are not derived (the chains' limits are derived for constant" in w for w in rep.warnings
+    )
