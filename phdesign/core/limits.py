@@ -113,6 +113,19 @@ Sweeps (:mod:`phdesign.sweep`, checked before any store is created or worker sta
                                                workers than cores cost memory, not time)
     ============================  ===========  ============================================
 
+Work built once (:mod:`phdesign.core.cache`: least recently used entries go first)
+    ===========================  ========  ============================================
+    ``MAX_CACHED_MODEL_WORK``    64        entries of the work kept per model and
+                                           resolution: dimensionless forms,
+                                           discretizations, their eigen stages
+    ``MAX_CACHED_STRUCTURES``    256       structures of the spectrum above the band
+                                           (one per model and gain, and each model's
+                                           form)
+    ``MAX_CACHE_BYTES``          128 MiB   bytes of arrays each of those caches holds
+                                           (a discretization of 900 states is about
+                                           35 MB, one of 60 states 0.2 MB)
+    ===========================  ========  ============================================
+
 Examples
 --------
 >>> check_sensor_outputs(4)
@@ -145,6 +158,9 @@ __all__ = [
     "EXACT_KAPPA_BITS",
     "EXACT_KAPPA_DEGREE",
     "EXACT_KAPPA_OPERATIONS",
+    "MAX_CACHED_MODEL_WORK",
+    "MAX_CACHED_STRUCTURES",
+    "MAX_CACHE_BYTES",
     "MAX_DEGREE",
     "MAX_DEPTH",
     "MAX_DISCRETE_STATES",
@@ -225,6 +241,10 @@ MAX_TRADEOFF_GAINS = 1000
 MAX_SWEEP_POINTS = 1_000_000
 MAX_STORE_METADATA_BYTES = 64 << 20
 MAX_WORKERS_PER_CORE = 1
+# ---------------------------------------------------------------- work built once
+MAX_CACHED_MODEL_WORK = 64
+MAX_CACHED_STRUCTURES = 256
+MAX_CACHE_BYTES = 128 << 20
 
 
 def budget_text(name: str) -> str:

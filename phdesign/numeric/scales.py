@@ -50,6 +50,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from phdesign.core.cache import MODEL_WORK
 from phdesign.numeric.bridge import NumericModel, trace_index
 
 __all__ = ["ProblemScales", "dimensionless_model", "problem_scales"]
@@ -146,7 +147,14 @@ def dimensionless_model(nm: NumericModel) -> tuple[NumericModel, ProblemScales]:
     >>> nd, sc = dimensionless_model(to_numeric(load_builtin("wave"), {"rho": 1e8, "T": 1e-8}))
     >>> nd.interval, sc.rate, nd.H_at(0.5)[0].round(12).tolist()
     ((0.0, 1.0), 1e-08, [[1.0, 0.0], [0.0, 1.0]])
+
+    It is made once per model (:data:`~phdesign.core.cache.MODEL_WORK`): its
+    discretizations are then built once too.
     """
+    return MODEL_WORK.get(nm, "dimensionless", lambda: _dimensionless_model(nm))
+
+
+def _dimensionless_model(nm: NumericModel) -> tuple[NumericModel, ProblemScales]:
     sc = problem_scales(nm)
     a = nm.interval[0]
     length, rate = sc.length, sc.rate

@@ -40,6 +40,7 @@ module imports the built-in ones and checks that the two agree.
 from __future__ import annotations
 
 from phdesign.core import limits
+from phdesign.core.cache import MODEL_WORK
 from phdesign.core.defaults import MethodDefaults, current
 from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
@@ -95,6 +96,8 @@ def discretize(
     Returns
     -------
     DiscretePHS
+        Built once per model, method, resolution and basis and shared
+        (:data:`~phdesign.core.cache.MODEL_WORK`): its matrices are read-only.
     """
     table = current()
     method = table.method if method is None else method
@@ -103,11 +106,21 @@ def discretize(
     check_basis(entry, basis)
     row = entry.at(nm.order)
     res = row.resolution if resolution is None else int(resolution)
-    discrete = Method.from_name(method).build(nm, res, row.basis if basis is None else basis)
+    chosen = row.basis if basis is None else basis
+    return MODEL_WORK.get(
+        nm, ("discretize", method, res, chosen), lambda: _build(nm, method, res, chosen)
+    )
+
+
+def _build(nm: NumericModel, method: str, resolution: int, basis: str | None) -> DiscretePHS:
+    discrete = Method.from_name(method).build(nm, resolution, basis)
     if discrete.method != method:
         raise NumericError(
             f"the method {method!r} built a discretization that says method="
             f"{discrete.method!r}; expected its own name"
         )
     # the model's own [feedback] closes the open discretization (numeric.feedback)
-    return close_plant_feedback(discrete)
+    closed = close_plant_feedback(discrete)
+    for matrix in (closed.E, closed.J, closed.R, closed.B, closed.D):
+        matrix.setflags(write=False)  # shared by every caller (phdesign.core.cache)
+    return closed

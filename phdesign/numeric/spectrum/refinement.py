@@ -22,13 +22,14 @@ pair contradicts, unless an earlier pair's resolved abscissa lies clearly to the
 from __future__ import annotations
 
 import math
-import weakref
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
+from phdesign.core.cache import MODEL_WORK, OwnerCache
 from phdesign.core.errors import NumericError
+from phdesign.core.limits import MAX_CACHE_BYTES, MAX_CACHED_STRUCTURES
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.feedback import open_port_gain
 from phdesign.numeric.discretization.registry import discretize
@@ -62,12 +63,10 @@ __all__ = [
 
 ILL_CONDITION = 1e4  # energy-norm condition number of an ill-conditioned rightmost eigenvalue
 
-_GAINS_KEPT = 64  # structures above the band kept per model (one per gain)
-#: The structure above the band of each live model: (model, its form, structure by gain).
-_STRUCTURES: dict[
-    int,
-    tuple[weakref.ref[NumericModel], CharacteristicForm | PrincipalForm, dict[bytes, Branches]],
-] = {}
+#: The structure above the band of each model: its form, and its structure by gain.
+_STRUCTURES = OwnerCache(
+    "structures above the band", entries=MAX_CACHED_STRUCTURES, nbytes=MAX_CACHE_BYTES
+)
 
 
 def fine_resolution(p: int) -> int:
@@ -205,31 +204,21 @@ class Discretizations:
     def __init__(self, nm: NumericModel, method: str, basis: str | None = None) -> None:
         self.model, self.method, self.basis = nm, method, basis
         self.dimensionless, self.scales = dimensionless_model(nm)
-        self._cache: dict[int, PreparedSystem] = {}
 
     def branches(self, K: np.ndarray | None) -> Branches:
         """Return the structure above the band of the loop ũ = −Kỹ (K on the external ports).
 
-        It depends on the model and the gain only: it is kept for the model's lifetime
-        (:data:`_STRUCTURES`), the gain-independent characteristic form once, the last
-        :data:`_GAINS_KEPT` gains' structures beside it.
+        It depends on the model and the gain only: it is kept (:data:`_STRUCTURES`), the
+        gain-independent characteristic form once per model, each gain's structure beside it.
         """
-        entry = _STRUCTURES.get(id(self.model))
-        if entry is None or entry[0]() is not self.model:
-            nd = self.dimensionless
-            form = characteristic_form(nd) if nd.order == 1 else principal_form(nd)
-            entry = (weakref.ref(self.model), form, {})
-            _STRUCTURES[id(self.model)] = entry
-            weakref.finalize(self.model, _STRUCTURES.pop, id(self.model), None)
-        _, form, by_gain = entry
-        key = b"" if K is None else np.ascontiguousarray(K, dtype=float).tobytes()
-        if key not in by_gain:
-            nd, sc = self.dimensionless, self.scales
-            W = nd.U + open_port_gain(nd, K) @ nd.Y
-            if len(by_gain) >= _GAINS_KEPT:
-                by_gain.pop(next(iter(by_gain)))
-            by_gain[key] = form.at(W, sc.rate, sc.length)
-        return by_gain[key]
+        gain = b"" if K is None else np.ascontiguousarray(K, dtype=float).tobytes()
+        return _STRUCTURES.get(self.model, ("branches", gain), lambda: self._branches(K))
+
+    def _branches(self, K: np.ndarray | None) -> Branches:
+        nd, sc = self.dimensionless, self.scales
+        form = _STRUCTURES.get(self.model, "form", lambda: _form(nd))
+        W = nd.U + open_port_gain(nd, K) @ nd.Y
+        return form.at(W, sc.rate, sc.length)
 
     def serves(self, nm: NumericModel, method: str, basis: str | None) -> bool:
         """Tell whether these discretizations are those of ``nm`` by ``method`` and ``basis``."""
@@ -241,10 +230,17 @@ class Discretizations:
         Shift and invert (:mod:`phdesign.numeric.spectrum.eigen`) at
         :data:`~phdesign.numeric.spectrum.eigen.SHIFT`, the rate of the dimensionless model.
         """
-        if p not in self._cache:
-            discrete = discretize(self.dimensionless, self.method, p, basis=self.basis)
-            self._cache[p] = prepare(discrete, shift=SHIFT)
-        return self._cache[p]
+        key = ("prepared", self.method, p, self.basis, SHIFT)
+        return MODEL_WORK.get(self.dimensionless, key, lambda: self._prepare(p))
+
+    def _prepare(self, p: int) -> PreparedSystem:
+        discrete = discretize(self.dimensionless, self.method, p, basis=self.basis)
+        return prepare(discrete, shift=SHIFT)
+
+
+def _form(nd: NumericModel) -> CharacteristicForm | PrincipalForm:
+    """Return the gain-independent form of the structure above the band of ``nd``."""
+    return characteristic_form(nd) if nd.order == 1 else principal_form(nd)
 
 
 class ClosedLoopSolver:
