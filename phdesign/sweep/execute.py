@@ -79,9 +79,8 @@ def run_chunk(text: str, chunk_shape: tuple[int, ...], index: int) -> dict[str, 
     PhdesignError
         A point the library refuses (its message names the point).
     """
-    from threadpoolctl import threadpool_limits
-
     from phdesign import __version__
+    from phdesign.numeric.threads import small_dense_threads
 
     description = _description(text)
     if description.version != __version__:
@@ -96,7 +95,7 @@ def run_chunk(text: str, chunk_shape: tuple[int, ...], index: int) -> dict[str, 
     block = tuple(s.stop - s.start for s in region)
     arrays = {f.name: np.full(block, f.fill, dtype=f.dtype) for f in figures}
     start = time.perf_counter()
-    with threadpool_limits(limits=1):
+    with small_dense_threads():  # the thread policy of every numeric entry point
         for point in plan.points(index):
             local = tuple(p - s.start for p, s in zip(point, region, strict=True))
             try:

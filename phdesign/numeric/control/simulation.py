@@ -33,6 +33,7 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import LoopSystem, NumericLoop, assemble
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import input_samples
+from phdesign.numeric.threads import limited_threads
 from phdesign.numeric.time.options import SimulationOptions
 from phdesign.numeric.time.result import SimulationResult
 from phdesign.numeric.time.simulation import ENERGY_BALANCE_RTOL
@@ -116,6 +117,7 @@ class LoopSimulation(SimulationResult):
         return plot_simulation(self, path, force=force, title=title)
 
 
+@limited_threads
 def simulate_loop(
     nm: NumericModel,
     loop: NumericLoop,

@@ -52,7 +52,7 @@ from phdesign.numeric.spectrum.refinement import (
 )
 from phdesign.numeric.spectrum.report import SpectrumReport
 from phdesign.numeric.spectrum.warnings import report_warnings, reported_value
-from phdesign.numeric.threads import small_dense_threads
+from phdesign.numeric.threads import limited_threads
 
 __all__ = ["AssembledLoopSolver", "LoopSpectrum", "loop_spectrum"]
 
@@ -284,6 +284,7 @@ def _tag(values: Sequence[complex], blocks: tuple[np.ndarray, np.ndarray]) -> li
     return out
 
 
+@limited_threads
 def loop_spectrum(
     nm: NumericModel,
     loop: NumericLoop,
@@ -347,10 +348,9 @@ def loop_spectrum(
         start=start,
     )
     solver = AssembledLoopSolver(nm, loop, method=method)
-    with small_dense_threads():
-        trail = plan.refine(solver)
-        chosen, notes = choose_pair(trail)
-        blocks = solver.blocks(chosen.pair.resolutions[1])
+    trail = plan.refine(solver)
+    chosen, notes = choose_pair(trail)
+    blocks = solver.blocks(chosen.pair.resolutions[1])
     triangular = max(solver.systems[r].triangular_residual for r in chosen.pair.resolutions)
     return _report(
         nm, trail, chosen, notes, blocks, plant, error, plan.tol, count, method, triangular, design

@@ -30,6 +30,7 @@ from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import NumericLoop
 from phdesign.numeric.control.spectrum import LoopSpectrum, loop_spectrum
+from phdesign.numeric.threads import limited_threads
 from phdesign.numeric.tuning.search import TuneResult, tune
 
 __all__ = ["TUNE_TARGETS", "LoopTuneResult", "tune_loop"]
@@ -146,6 +147,7 @@ class LoopTuneResult:
         return html_table((), rows, f"tuned loop ({self.tuned})")
 
 
+@limited_threads
 def tune_loop(
     nm: NumericModel,
     loop: NumericLoop,

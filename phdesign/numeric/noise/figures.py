@@ -79,6 +79,7 @@ from phdesign.numeric.noise.report import GainEstimate, NoiseReport
 from phdesign.numeric.noise.settle import Estimate, settle
 from phdesign.numeric.noise.statistics import ErrorStatistics, error_statistics
 from phdesign.numeric.spectrum.converged import default_resolutions
+from phdesign.numeric.threads import limited_threads
 
 __all__ = [
     "GainEstimate",
@@ -145,6 +146,7 @@ def sensor_rows(C_m: Any, what: str) -> np.ndarray:
     return C
 
 
+@limited_threads
 def noise(
     nm: NumericModel,
     C_m: np.ndarray,

@@ -35,6 +35,7 @@ from phdesign.numeric.noise.figures import noise, sensor_rows
 from phdesign.numeric.noise.report import NoiseReport
 from phdesign.numeric.noise.settle import finite_or_none
 from phdesign.numeric.spectrum.converged import SpectrumReport, spectrum
+from phdesign.numeric.threads import limited_threads
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.figure import Figure
@@ -321,6 +322,7 @@ def _floats(values: Any, name: str) -> np.ndarray:
         raise NumericError(f"{name}: expected numbers; found {values!r}") from None
 
 
+@limited_threads
 def tradeoff(
     nm: NumericModel,
     C_m: np.ndarray,

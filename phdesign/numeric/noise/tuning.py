@@ -51,6 +51,7 @@ from phdesign.numeric.spectrum.abscissa import estimate_abscissa
 from phdesign.numeric.spectrum.converged import eigen, spectrum
 from phdesign.numeric.spectrum.drift import pair_spectrum
 from phdesign.numeric.spectrum.report import SpectrumReport
+from phdesign.numeric.threads import limited_threads
 
 __all__ = ["NoiseTuneResult", "tune_noise"]
 
@@ -164,6 +165,7 @@ def _max_rms(report: NoiseReport) -> float | None:
     return math.sqrt(max(values))
 
 
+@limited_threads
 def tune_noise(
     nm: NumericModel,
     C_m: np.ndarray,

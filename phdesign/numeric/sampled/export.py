@@ -61,6 +61,7 @@ from phdesign.numeric.sampled.verification import (
     with_plant_gap,
     with_target_check,
 )
+from phdesign.numeric.threads import limited_threads
 
 __all__ = [
     "FORMATS",
@@ -289,6 +290,7 @@ def displacement_points(nm: NumericModel, points: Any, name: str = "points") -> 
     return values
 
 
+@limited_threads
 def export_observer(
     nm: NumericModel,
     C_m: np.ndarray,

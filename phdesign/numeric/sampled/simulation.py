@@ -30,6 +30,7 @@ from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.sampled.runs import LoopRun, run_against_continuous, run_loop
 from phdesign.numeric.sampled.samplers import ContinuousObserver
+from phdesign.numeric.threads import limited_threads
 from phdesign.numeric.time.options import SAMPLED_SCHEME, SimulationOptions
 from phdesign.numeric.time.result import SimulationResult
 
@@ -60,6 +61,7 @@ def embedding(observer: DiscretePHS, plant: DiscretePHS) -> np.ndarray:
     return np.asarray(P)
 
 
+@limited_threads
 def simulate_sampled(
     nm: NumericModel,
     C_m: np.ndarray,

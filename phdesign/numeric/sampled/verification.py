@@ -24,6 +24,7 @@ from phdesign.numeric.sampled.order import check_order
 from phdesign.numeric.sampled.runs import run_against_continuous
 from phdesign.numeric.sampled.samplers import ContinuousObserver
 from phdesign.numeric.sampled.selection import OrderSelection
+from phdesign.numeric.threads import limited_threads
 
 __all__ = ["Verification", "plant_gap", "verify_observer", "with_plant_gap", "with_target_check"]
 
@@ -135,6 +136,7 @@ class Verification:
         return plot_verification(self, ax)
 
 
+@limited_threads
 def verify_observer(
     plant: Any,
     observer: ContinuousObserver,

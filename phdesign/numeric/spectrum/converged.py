@@ -81,7 +81,7 @@ from phdesign.numeric.spectrum.refinement import (
 )
 from phdesign.numeric.spectrum.report import SpectrumReport
 from phdesign.numeric.spectrum.warnings import report_warnings, reported_value, rightmost_order
-from phdesign.numeric.threads import small_dense_threads
+from phdesign.numeric.threads import limited_threads
 
 __all__ = [
     "RefinementPlan",
@@ -261,6 +261,7 @@ def _unresolved_report(trail: list[PairResult], labels: _Labels) -> SpectrumRepo
     )
 
 
+@limited_threads
 def spectrum(
     nm: NumericModel,
     C_m: np.ndarray | None = None,
@@ -334,11 +335,8 @@ def spectrum(
         tol=tol,
         rtol_resolved=rtol_resolved,
     )
-    with small_dense_threads():
-        solver = ClosedLoopSolver(
-            nm, K, method=method, basis=basis, discretizations=discretizations
-        )
-        trail = plan.refine(solver)
+    solver = ClosedLoopSolver(nm, K, method=method, basis=basis, discretizations=discretizations)
+    trail = plan.refine(solver)
     labels = _Labels(
         method=method,
         system="plant (u = 0)" if K is None else "observer error system",

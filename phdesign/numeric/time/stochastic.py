@@ -52,6 +52,7 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.noise.figures import noise_intensities
+from phdesign.numeric.threads import limited_threads
 from phdesign.numeric.time.options import NOISY_SCHEME, SimulationOptions
 from phdesign.numeric.time.result import SimulationResult
 from phdesign.numeric.time.simulation import coupled_system, simulate
@@ -128,6 +129,7 @@ def sampled_noise(E: np.ndarray, A: np.ndarray, N: np.ndarray, dt: float) -> Sam
     return SampledNoise(Phi, factor, float(dt))
 
 
+@limited_threads
 def simulate_noisy(
     nm: NumericModel,
     C_m: np.ndarray | None = None,

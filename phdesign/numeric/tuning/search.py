@@ -70,7 +70,7 @@ from phdesign.numeric.scales import problem_scales
 from phdesign.numeric.spectrum.coalescence import Coalescence, polish_coalescence
 from phdesign.numeric.spectrum.converged import default_resolutions, spectrum
 from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
-from phdesign.numeric.threads import small_dense_threads
+from phdesign.numeric.threads import limited_threads
 from phdesign.numeric.tuning.objective import (
     Extinct,
     GainSearch,
@@ -157,6 +157,7 @@ def _polish(
     return found.parameters, found
 
 
+@limited_threads
 def tune(
     nm: NumericModel,
     C_m: np.ndarray,
@@ -223,12 +224,9 @@ def tune(
     if robust is not None and not 0 < robust < 1:
         raise NumericError(f"robust must be a fraction in (0, 1); found {robust}")
     start_time = time.perf_counter()
-    with small_dense_threads():
-        run = _setup(nm, C, full, robust, resolution, method, progress)
-        found = _search(
-            run, _Found(np.zeros(run.search.n_params)), starts, seed, log_range, maxiter
-        )
-        return _verify(run, found, start_time)
+    run = _setup(nm, C, full, robust, resolution, method, progress)
+    found = _search(run, _Found(np.zeros(run.search.n_params)), starts, seed, log_range, maxiter)
+    return _verify(run, found, start_time)
 
 
 @dataclass(frozen=True)
