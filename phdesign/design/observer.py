@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import sympy
@@ -182,9 +183,20 @@ class Observer(ObserverNoise):
         return self.L
 
     def numeric_gain(self, what: str = "this computation") -> tuple[np.ndarray, np.ndarray]:
-        """``(C_m, L)`` as float arrays; a symbolic or missing gain is refused."""
-        L = numeric_matrix(self._gain(what), "L", what)
-        return numeric_matrix(self.C_m, "C_m", what), L
+        """``(C_m, L)`` as read-only float arrays; a symbolic or missing gain is refused.
+
+        They are converted once per observer (every numeric method asks for them).
+        """
+        if self._gain(what).free_symbols:
+            numeric_matrix(self._gain(what), "L", what)  # refuses it, saying what to do
+        return self._floats
+
+    @cached_property
+    def _floats(self) -> tuple[np.ndarray, np.ndarray]:
+        C, L = numeric_matrix(self.C_m, "C_m", ""), numeric_matrix(self._gain(""), "L", "")
+        for matrix in (C, L):
+            matrix.setflags(write=False)
+        return C, L
 
     # ------------------------------------------------------------------ questions
     def classify(self, method: str = "auto") -> Classification:
