@@ -82,17 +82,23 @@ class AssembledLoopSolver:
         )
         self.loop, self.method = loop, method
         self.systems: dict[int, LoopSystem] = {}
-        self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._cache: dict[int, tuple[np.ndarray, np.ndarray | None]] = {}
 
-    def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
-        """Eigenvalues and energy-norm condition numbers of the loop at resolution ``p``."""
-        if p not in self._cache:
-            system = assemble(discretize(self.dimensionless, self.method, p), self.loop)
-            self.systems[p] = system
-            lam, kappa = shift_invert(system.A, system.E, shift=SHIFT, condition=True)
-            assert kappa is not None  # condition=True computes them
-            self._cache[p] = (rescaled(lam, self.rate), kappa)
-        return self._cache[p]
+    def __call__(self, p: int, condition: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """Eigenvalues and energy-norm condition numbers of the loop at resolution ``p``.
+
+        ``condition=False``: the eigenvalues alone
+        (:class:`~phdesign.numeric.spectrum.refinement.ResolutionSolver`).
+        """
+        found = self._cache.get(p)
+        if found is None or (condition and found[1] is None):
+            if p not in self.systems:
+                discrete = discretize(self.dimensionless, self.method, p)
+                self.systems[p] = assemble(discrete, self.loop)
+            system = self.systems[p]
+            lam, kappa = shift_invert(system.A, system.E, shift=SHIFT, condition=condition)
+            found = self._cache[p] = (rescaled(lam, self.rate), kappa)
+        return found
 
     def blocks(self, p: int) -> tuple[np.ndarray, np.ndarray]:
         """Eigenvalues of the controlled plant's and the error system's blocks at ``p``."""

@@ -40,7 +40,7 @@ and the residual are its uncertainty.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -54,10 +54,22 @@ from phdesign.numeric.spectrum.branches import (
 )
 from phdesign.numeric.spectrum.exponential_polynomial import chain_limits, exponential_polynomial
 
-__all__ = ["PrincipalForm", "chain_limit_at", "principal_form"]
+__all__ = ["PrincipalForm", "Waves", "chain_limit_at", "principal_form", "waves_at"]
 
 _PROPAGATING = 0.25  # |Re μ| / |μ| below which a wave propagates at λ = iω
 _FAR = 30.0  # |μ| L at the first frequency: far-end factors e^-30 of evanescent waves
+
+
+@dataclass(frozen=True)
+class Waves:
+    """The waves of the companion form at λ = iω: what a chain limit needs but the gain."""
+
+    S: np.ndarray  # the balancing scales of the traces
+    mu: np.ndarray  # wavenumbers
+    V: np.ndarray  # unit eigenvectors, column by column
+    delay: np.ndarray  # dμ/dλ
+    at_a: np.ndarray  # normalized at a (decaying toward b), else at b
+    propagating: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -65,7 +77,8 @@ class PrincipalForm:
     """The gain-independent structure of a dimensionless model of order N >= 2.
 
     ``M0`` and ``M1`` give the companion matrix M(λ) = M0 + λ M1; ``frequency`` is the
-    first frequency of the chain limits' sequence (none when the coefficients depend on z).
+    first frequency of the chain limits' sequence (none when the coefficients depend on z),
+    ``waves`` the waves at its four frequencies (what the chain limits need but the gain).
     """
 
     families: tuple[Family, ...]
@@ -76,6 +89,7 @@ class PrincipalForm:
     M1: np.ndarray
     frequency: float
     reason: str = ""
+    waves: tuple[Waves, ...] = field(default=(), repr=False, compare=False)
 
     def at(self, W: np.ndarray, rate: float, length: float) -> Branches:
         """Return the :class:`~.branches.Branches` of the closure W v = 0."""
@@ -88,36 +102,42 @@ class PrincipalForm:
         )
         if self.reason:
             return replace(base, reason=self.reason)
-        values = [chain_limit_at(self, W, self.frequency * 4.0**k) for k in range(4)]
+        values = [chain_limit_at(waves, W) for waves in self.waves]
         limit, uncertainty = _extrapolate(np.array(values), self.order)
         label = " and ".join(f.label for f in families)
         found = BranchLimit(label, limit * rate, uncertainty * rate, False)
         return replace(base, limits=(found,), analysed=True)
 
 
-def chain_limit_at(form: PrincipalForm, W: np.ndarray, omega: float) -> float:
-    """Return the largest real part of the chains near λ = iω (dimensionless units)."""
-    N, size = form.order, form.M0.shape[0]
+def waves_at(M0: np.ndarray, M1: np.ndarray, order: int, omega: float) -> Waves:
+    """Return the waves of M(λ) = M0 + λ M1 at λ = iω (gain-independent)."""
+    N, size = order, M0.shape[0]
     scale = omega ** (1.0 / N)
     S = np.repeat(scale ** np.arange(N), size // N)  # e^(k) scaled by ω^(k/N): M balanced
-    M = (form.M0 + 1j * omega * form.M1) * S[None, :] / S[:, None] / scale
+    M = (M0 + 1j * omega * M1) * S[None, :] / S[:, None] / scale
     mu, right = np.linalg.eig(M)
     left = np.linalg.inv(right)  # rows l_j with l_j r_j = 1 (distinct wavenumbers)
-    dM = form.M1 * S[None, :] / S[:, None] / scale
+    dM = M1 * S[None, :] / S[:, None] / scale
     delay = np.einsum("jk,kl,lj->j", left, dM, right) * scale  # dμ/dλ, first order
     mu = mu * scale  # back to the unbalanced wavenumbers
-    WS = W * np.concatenate([S, S])[None, :]
     V = right / np.linalg.norm(right, axis=0)
-    Wb_V, Wa_V = WS[:, :size] @ V, WS[:, size:] @ V
-    at_a = mu.real <= 0  # normalized at a (decaying toward b), else at b
-    sign = np.where(at_a, 1.0, -1.0)
     propagating = np.abs(mu.real) < _PROPAGATING * np.abs(mu)
+    return Waves(S, mu, V, delay, mu.real <= 0, propagating)
+
+
+def chain_limit_at(waves: Waves, W: np.ndarray) -> float:
+    """Return the largest real part of the chains near λ = iω of ``waves`` (dimensionless)."""
+    S, mu, V, at_a, propagating = waves.S, waves.mu, waves.V, waves.at_a, waves.propagating
+    size = V.shape[0]
+    WS = W * np.concatenate([S, S])[None, :]
+    Wb_V, Wa_V = WS[:, :size] @ V, WS[:, size:] @ V
+    sign = np.where(at_a, 1.0, -1.0)
     if not propagating.any():
         return -math.inf
     A = np.where(at_a[None, :], Wa_V, Wb_V)
     far = np.where(at_a[None, :], Wb_V, Wa_V) * np.exp(sign * mu)[None, :]  # length 1
     B = np.where(propagating[None, :], far, 0.0)
-    tau = np.where(propagating, sign * delay.real, 0.0)
+    tau = np.where(propagating, sign * waves.delay.real, 0.0)
     tau[~propagating] = tau[propagating][0]  # B is zero there: these columns never move
     limits = chain_limits(exponential_polynomial(A, B, tau))
     finite = [c.limit for c in limits if math.isfinite(c.limit)]
@@ -181,7 +201,8 @@ def principal_form(nm: NumericModel) -> PrincipalForm:
     M0, M1 = _companion(nm)
     frequency = max(_FAR**N * max(groups), 100.0 * onset)
     reason = "" if constant else "the chains' limits are derived for constant coefficients"
-    return PrincipalForm(families, onset, wavenumber, N, M0, M1, frequency, reason)
+    waves = () if reason else tuple(waves_at(M0, M1, N, frequency * 4.0**k) for k in range(4))
+    return PrincipalForm(families, onset, wavenumber, N, M0, M1, frequency, reason, waves)
 
 
 def _companion(nm: NumericModel) -> tuple[np.ndarray, np.ndarray]:

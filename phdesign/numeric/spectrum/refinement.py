@@ -181,8 +181,12 @@ class ResolutionSolver(Protocol):
     dissipative: bool
     branches: Branches | None
 
-    def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
-        """Eigenvalues (in the model's units) and energy-norm condition numbers at p."""
+    def __call__(self, p: int, condition: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """Eigenvalues (in the model's units) and energy-norm condition numbers at p.
+
+        ``condition=False``: the eigenvalues alone (the coarse member of the first pair,
+        whose condition numbers nothing reads), the same numbers without eigenvectors.
+        """
         ...
 
 
@@ -280,14 +284,18 @@ class ClosedLoopSolver:
         self.discretizations, self.scales, self.K = discretizations, discretizations.scales, K
         self.rate = self.scales.rate
         self.branches: Branches | None = discretizations.branches(K)
-        self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._cache: dict[int, tuple[np.ndarray, np.ndarray | None]] = {}
 
-    def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
-        """Eigenvalues and condition numbers at resolution ``p`` (cached)."""
-        if p not in self._cache:
-            lam, kappa = self.discretizations(p).eigen_condition(self.K)
-            self._cache[p] = (rescaled(lam, self.rate), kappa)
-        return self._cache[p]
+    def __call__(self, p: int, condition: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """Eigenvalues and condition numbers at resolution ``p`` (cached; see the protocol)."""
+        found = self._cache.get(p)
+        if found is None or (condition and found[1] is None):
+            prepared = self.discretizations(p)
+            lam, kappa = (
+                prepared.eigen_condition(self.K) if condition else (prepared.eigvals(self.K), None)
+            )
+            found = self._cache[p] = (rescaled(lam, self.rate), kappa)
+        return found
 
 
 def refine(
@@ -312,7 +320,7 @@ def refine(
     band_stop = stop if band_stop is None else max(int(band_stop), stop)
     while True:
         p_fine = fine_resolution(p)
-        coarse, _ = solver(p)
+        coarse, _ = solver(p, condition=False)
         fine, kappa = solver(p_fine)
         pair = pair_spectrum(
             fine,

@@ -127,7 +127,7 @@ class _SpoiledAtHighDegree:
     dissipative = True
     branches = None  # no principal part to derive: the band alone decides
 
-    def __call__(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+    def __call__(self, p: int, condition: bool = True) -> tuple[np.ndarray, np.ndarray]:
         m = np.arange(p // 2 - 3)
         modes = -(20.0 + m) + 1j * (3.0 * m + 3.0)
         special = -9.25 if p < 18 else -9.9
