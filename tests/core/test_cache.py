@@ -41,9 +41,11 @@ def test_the_bytes_bound_drops_old_entries_and_never_keeps_a_value_too_large():
     cache.get(owner, 1, lambda: np.zeros(100))  # 800 bytes
     cache.get(owner, 2, lambda: np.zeros(100))
     cache.get(owner, 3, lambda: np.zeros(100))  # 2400 > 2000: entry 1 goes
-    assert len(cache) == 2 and cache.info().nbytes == 1600
+    assert len(cache) == 2
+    assert cache.info().nbytes == 1600
     big = cache.get(owner, 4, lambda: np.zeros(1000))  # alone above the bound: not kept
-    assert big.size == 1000 and len(cache) == 2
+    assert big.size == 1000
+    assert len(cache) == 2
 
 
 def test_an_owner_that_dies_takes_its_entries_and_its_id_finds_nothing():

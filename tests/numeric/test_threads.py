@@ -16,6 +16,7 @@ from threadpoolctl import ThreadpoolController, threadpool_info, threadpool_limi
 import phdesign as phd
 import phdesign.numeric.threads as threads
 from phdesign.core.cache import MODEL_WORK
+from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
 from phdesign.numeric.threads import SMALL_DENSE_THREADS, small_dense_threads
 
 CALLER_THREADS = 2  # the caller's setting, above the policy's
@@ -50,6 +51,11 @@ def beam_loop() -> phd.Loop:
     return phd.Loop(beam, actuate=3)
 
 
+def evaluator() -> None:
+    wave = phd.to_numeric(phd.load("wave"))
+    AbscissaEvaluator(wave, np.array([[0.0, 1.0]]), 12)(np.array([[0.5]]))
+
+
 def sweep_point() -> None:
     pytest.importorskip("xarray", reason="install the sweep extra")
     pytest.importorskip("zarr", reason="install the sweep extra")
@@ -60,6 +66,7 @@ SIMULATION = {"t_end": 0.2, "samples": 3}
 ENTRY_POINTS = {
     "spectrum": lambda: wave_observer(None).spectrum(),
     "plant spectrum": lambda: phd.Plant(phd.load("wave")).spectrum(),
+    "abscissa evaluator": evaluator,
     "simulate": lambda: wave_observer().simulate("x2: 1", **SIMULATION),
     "simulate noisy": lambda: wave_observer().simulate("x2: 1", noise_intensity=0.1, **SIMULATION),
     "simulate sampled": lambda: wave_observer().simulate(

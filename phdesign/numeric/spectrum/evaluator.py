@@ -55,7 +55,7 @@ from phdesign.numeric.spectrum.refinement import (
     fine_resolution,
     resolvable_band,
 )
-from phdesign.numeric.threads import small_dense_threads
+from phdesign.numeric.threads import limited_threads
 
 __all__ = ["AbscissaEvaluator"]
 
@@ -85,6 +85,7 @@ class AbscissaEvaluator:
         Number of gains evaluated so far.
     """
 
+    @limited_threads
     def __init__(
         self,
         nm: NumericModel,
@@ -127,6 +128,7 @@ class AbscissaEvaluator:
             self.C_m, np.atleast_2d(np.asarray(L, dtype=float)), self.model.n_ports
         )
 
+    @limited_threads
     def pair(self, L: np.ndarray | None = None, *, condition: bool | None = None) -> PairSpectrum:
         """Run the drift test at gain L (eigenvalues in the model's own units).
 
@@ -177,14 +179,10 @@ class AbscissaEvaluator:
         pair = self.pair(L)
         return with_branches(estimate_abscissa(pair, self.tol), pair, self.branches(L))
 
+    @limited_threads
     def abscissas(self, gains: Iterable[np.ndarray]) -> np.ndarray:
-        """Return the abscissas at many gains, on one BLAS thread (a gain map).
-
-        Entering the one-thread limit costs about a millisecond
-        (:mod:`phdesign.numeric.threads`), so many gains share one entry.
-        """
-        with small_dense_threads():
-            return np.array([self(L) for L in gains], dtype=float)
+        """Return the abscissas at many gains (a gain map), inside one thread policy block."""
+        return np.array([self(L) for L in gains], dtype=float)
 
     def __call__(self, L: np.ndarray | None = None) -> float:
         """Return the abscissa as a number (``-inf``: empty spectrum, ``nan``: unresolved)."""
