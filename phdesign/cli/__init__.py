@@ -12,7 +12,9 @@ Exit status: 0 on success, 2 on bad input with exactly one line on stderr
 (:class:`~phdesign.core.errors.PhdesignError`) report; any other exception is a bug and is
 not disguised as bad input.  The library's messages name its arguments; every error and
 warning is printed with the running command's option names instead
-(:mod:`phdesign.cli.messages`).
+(:mod:`phdesign.cli.messages`).  A long command shows its stages on one line of stderr
+when it is a terminal, off with ``--quiet`` and never with ``--json``
+(:func:`~phdesign.cli.common.progress_display`).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from phdesign.cli import messages
+from phdesign.cli.common import progress_display
 from phdesign.cli.design_arguments import join_negative_values
 from phdesign.core.errors import ModelError, ModelFileError, PhdesignError, PortError
 
@@ -125,7 +128,8 @@ def main(argv: Sequence[str] | None = None, *, reraise: bool = False) -> int:
         parser = build_parser()
         args = parser.parse_args(None if argv is None else list(argv))
         messages.use(messages.option_table(parser, args))
-        return int(args.handler(args) or 0)
+        with progress_display(args):  # the stages of a long run, on a terminal's stderr
+            return int(args.handler(args) or 0)
     except _UsageError as error:
         return _fail(str(error))
     except PhdesignError as error:  # bad input; any other exception is a bug and surfaces

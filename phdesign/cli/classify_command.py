@@ -9,12 +9,12 @@ Printing only: the mathematics lives in :mod:`phdesign.symbolic.classify` and
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
 from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
+    add_quiet_argument,
     emit_result,
     load_model,
 )
@@ -54,6 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="how kappa* is computed (the decision is always exact); default: %(default)s",
     )
     add_json_argument(parser)
+    add_quiet_argument(parser)
     parser.set_defaults(handler=_classify)
 
 
@@ -70,23 +71,9 @@ def _classify(args: argparse.Namespace) -> int:
     return emit_result(args, result)
 
 
-def _progress_bar() -> Any:
-    if not sys.stderr.isatty():
-        return None
-
-    def show(done: int, total: int) -> None:
-        width = 30
-        filled = int(width * done / total)
-        end = "\n" if done >= total else ""
-        sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{total}{end}")
-        sys.stderr.flush()
-
-    return show
-
-
 def _search(args: argparse.Namespace, model: Any) -> int:
     from phdesign.symbolic.search import search_sensors
 
     gain = None if args.gain is None else parse_gain_text(args.gain)
-    found = search_sensors(model, gain=gain, progress=_progress_bar())
+    found = search_sensors(model, gain=gain)  # its progress: the command's display
     return emit_result(args, found)

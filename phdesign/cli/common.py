@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 from phdesign.core.checks import positive_int, positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError, ParameterError
+from phdesign.core.progress import Display, erase, reporting
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.model import BCPHS
@@ -20,6 +21,7 @@ __all__ = [
     "add_json_argument",
     "add_method_argument",
     "add_model_argument",
+    "add_quiet_argument",
     "check_finite_series",
     "emit",
     "emit_json",
@@ -27,6 +29,7 @@ __all__ = [
     "non_negative_int",
     "parse_parameter_overrides",
     "printable",
+    "progress_display",
     "result_text",
     "run_outputs",
     "simulation_text",
@@ -67,6 +70,35 @@ def add_json_argument(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="print JSON instead of text (keys: see the command-line reference)",
     )
+
+
+def add_quiet_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--quiet``: no progress line (:func:`progress_display`)."""
+    parser.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no progress line on stderr (a terminal shows one once a run lasts "
+        f"{current().progress.delay:g} s; never with --json)",
+    )
+
+
+@contextmanager
+def progress_display(args: argparse.Namespace) -> Iterator[None]:
+    """Show the stages of the run inside the block on stderr (:mod:`phdesign.core.progress`).
+
+    For the commands that have ``--quiet``, unless it or ``--json`` is given; the line
+    shows on a terminal only, once the run has lasted the table's delay, and is erased
+    before anything else is printed (:func:`emit`, :func:`warn`) and when the block ends.
+    """
+    if not hasattr(args, "quiet") or args.quiet or getattr(args, "json", False):
+        yield
+        return
+    display = Display()
+    try:
+        with reporting(display):
+            yield
+    finally:
+        display.erase()
 
 
 def add_discretization_arguments(
@@ -134,7 +166,8 @@ def printable(text: str) -> str:
 
 
 def emit(text: str) -> None:
-    """Print ``text`` on stdout (terminal control characters escaped)."""
+    """Print ``text`` on stdout (terminal control characters escaped), the progress line erased."""
+    erase()
     text = printable(text)
     sys.stdout.write(text if text.endswith("\n") else text + "\n")
 
@@ -143,6 +176,7 @@ def warn(message: str) -> None:
     """Print one ``phdesign: warning: ...`` line on stderr, in the command's option names."""
     from phdesign.cli.messages import translated
 
+    erase()
     text = printable(" ".join(translated(message).split()))
     print(f"phdesign: warning: {text}", file=sys.stderr)
 

@@ -16,6 +16,7 @@ from typing import Any
 from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
+    add_quiet_argument,
     check_positive,
     emit,
     emit_json,
@@ -45,6 +46,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     _add_output_arguments(ex)
     _add_verification_arguments(ex)
     add_json_argument(ex)
+    add_quiet_argument(ex)
     ex.set_defaults(handler=_export)
 
 

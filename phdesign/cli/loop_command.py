@@ -15,6 +15,7 @@ from phdesign.cli.common import (
     add_discretization_arguments,
     add_json_argument,
     add_model_argument,
+    add_quiet_argument,
     check_finite_series,
     check_positive,
     emit_result,
@@ -57,6 +58,7 @@ def _loop_arguments(parser: argparse.ArgumentParser) -> None:
         "only for measured outputs)",
     )
     add_observer_arguments(parser)
+    add_quiet_argument(parser)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

@@ -30,6 +30,7 @@ from phdesign.cli.common import (
     add_discretization_arguments,
     add_json_argument,
     add_model_argument,
+    add_quiet_argument,
     check_positive,
     emit_result,
     load_model,
@@ -105,6 +106,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_json_argument(nz)
     nz.add_argument("--plot", metavar="FILE", help="draw the frequency response to FILE")
     nz.add_argument("--force", action="store_true", help="overwrite an existing plot file")
+    add_quiet_argument(nz)
     nz.set_defaults(handler=_noise)
 
     tr = subparsers.add_parser(
@@ -135,6 +137,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     tr.add_argument("--output", "-o", metavar="FILE", help="write the table to FILE")
     tr.add_argument("--plot", metavar="FILE", help="draw decay rate against RMS to FILE")
     tr.add_argument("--force", action="store_true", help="overwrite existing files")
+    add_quiet_argument(tr)
     tr.set_defaults(handler=_tradeoff, gain=None)  # the family gives the gains
 
 

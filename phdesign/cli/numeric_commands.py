@@ -15,13 +15,13 @@ parser: user text is never evaluated.
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
 from phdesign.cli.common import (
     add_discretization_arguments,
     add_json_argument,
     add_model_argument,
+    add_quiet_argument,
     check_finite_series,
     check_positive,
     emit_result,
@@ -84,6 +84,7 @@ def _add_spectrum(subparsers: argparse._SubParsersAction) -> None:
         help="rightmost eigenvalues to report; default: %(default)s",
     )
     add_json_argument(sp)
+    add_quiet_argument(sp)
     sp.set_defaults(handler=_spectrum)
 
 
@@ -142,6 +143,7 @@ def _add_simulate(subparsers: argparse._SubParsersAction) -> None:
     sim.add_argument("--force", action="store_true", help="overwrite existing files")
     add_sampling_arguments(sim)  # --dt, --sampler, --observer-resolution (export command)
     add_stochastic_arguments(sim)
+    add_quiet_argument(sim)
     sim.set_defaults(handler=_simulate)
 
 
@@ -168,6 +170,7 @@ def _add_tune(subparsers: argparse._SubParsersAction) -> None:
     )
     add_noise_tuning_arguments(tn)
     add_json_argument(tn)
+    add_quiet_argument(tn)
     tn.set_defaults(handler=_tune)
 
 
@@ -268,32 +271,6 @@ def _robust_fraction(text: str | None) -> float | None:
     return fraction
 
 
-class _Progress:
-    """A one-line progress display on a terminal, shown once a run passes 2 seconds."""
-
-    DELAY = 2.0
-
-    def __init__(self) -> None:
-        import time
-
-        self._clock = time.perf_counter
-        self._start = self._clock()
-        self._shown = 0
-
-    def __call__(self, line: str) -> None:
-        if self._clock() - self._start < self.DELAY:
-            return
-        text = f"{line}   ({self._clock() - self._start:.0f} s)"
-        sys.stderr.write("\r" + text.ljust(self._shown))
-        sys.stderr.flush()
-        self._shown = len(text)
-
-    def clear(self) -> None:
-        if self._shown:
-            sys.stderr.write("\r" + " " * self._shown + "\r")
-            sys.stderr.flush()
-
-
 def _tune(args: argparse.Namespace) -> int:
     if (noisy := noise_tuning(args)) is not None:  # --max-rms / --objective rms
         return noisy
@@ -302,16 +279,7 @@ def _tune(args: argparse.Namespace) -> int:
     robust = _robust_fraction(args.robust)
     model = load_model(args)
     observer = observer_from_args(args, model)  # argparse requires --sensors or --cm here
-    progress = _Progress() if sys.stderr.isatty() else None
-    try:
-        tuned = observer.tune(
-            full=args.full,
-            starts=starts,
-            seed=0 if args.seed is None else args.seed,
-            robust=robust,
-            progress=progress,
-        )
-    finally:
-        if progress is not None:
-            progress.clear()
+    tuned = observer.tune(
+        full=args.full, starts=starts, seed=0 if args.seed is None else args.seed, robust=robust
+    )
     return emit_result(args, tuned.tuning)

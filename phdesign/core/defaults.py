@@ -20,6 +20,8 @@ The table holds
     :mod:`phdesign.numeric.discretization.registry`, which checks that the two agree.
 ``spectrum``, ``simulation``, ``export``
     The rest of the defaults of the spectrum, the simulations and the exported observer.
+``progress``
+    When the progress line of a long run first shows, and how often it is redrawn.
 
 The discretization rows:
 
@@ -95,6 +97,7 @@ __all__ = [
     "ExportDefaults",
     "MethodDefaults",
     "OrderDefaults",
+    "ProgressDefaults",
     "SimulationDefaults",
     "SpectrumDefaults",
     "current",
@@ -311,6 +314,24 @@ class ExportDefaults:
 
 
 @dataclass(frozen=True)
+class ProgressDefaults:
+    """Defaults of the progress line of long runs (:class:`phdesign.core.progress.Display`).
+
+    Attributes
+    ----------
+    delay : float
+        Seconds a run lasts before its progress shows: a command that answers within about
+        two seconds prints nothing but its answer.
+    interval : float
+        Least seconds between two drawings of the line (a terminal redrawn more often
+        only flickers).
+    """
+
+    delay: float = 2.0
+    interval: float = 0.1
+
+
+@dataclass(frozen=True)
 class Defaults:
     """The table of defaults (module docstring); build a changed one with :func:`replace`."""
 
@@ -321,6 +342,7 @@ class Defaults:
     spectrum: SpectrumDefaults = SpectrumDefaults()
     simulation: SimulationDefaults = SimulationDefaults()
     export: ExportDefaults = ExportDefaults()
+    progress: ProgressDefaults = ProgressDefaults()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "methods", MappingProxyType(dict(self.methods)))

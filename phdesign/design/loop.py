@@ -43,6 +43,7 @@ import sympy
 from phdesign.core.checks import choice
 from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import LoopError
+from phdesign.core.progress import Progress, reports_progress
 from phdesign.core.text import html_table
 from phdesign.design.plant import Plant
 from phdesign.symbolic.control import (
@@ -291,6 +292,7 @@ class Loop:
             f"L = {self.L.tolist()}"
         )
 
+    @reports_progress
     def spectrum(
         self,
         *,
@@ -298,10 +300,13 @@ class Loop:
         count: int | None = None,
         resolution: int | None = None,
         max_resolution: int | None = None,
+        progress: Progress | None = None,
     ) -> LoopSpectrum:
         """Return the loop's converged spectrum (:func:`.numeric.loop_spectrum.loop_spectrum`).
 
-        ``resolution`` defaults to the loop's own (its refinement's first resolution).
+        ``resolution`` defaults to the loop's own (its refinement's first resolution);
+        ``progress`` is called with one line of text at each stage
+        (:mod:`phdesign.core.progress`).
         """
         from phdesign.numeric.control.spectrum import loop_spectrum
 
@@ -316,6 +321,7 @@ class Loop:
             design=self.design_label(),
         )
 
+    @reports_progress
     def simulate(
         self,
         *,
@@ -323,6 +329,7 @@ class Loop:
         xhat0: str | Callable[[Any], Any] | None = None,
         u: str | Callable[[float], Any] | None = None,
         options: SimulationOptions | None = None,
+        progress: Progress | None = None,
         **settings: Any,
     ) -> LoopSimulation:
         """Simulate the loop (:func:`~phdesign.numeric.control.simulation.simulate_loop`).
@@ -331,7 +338,7 @@ class Loop:
         ``"u1: sin(t)"``), read as on the command line, or callables.  ``options`` and
         ``settings`` (its fields by name: ``t_end``, ``samples``, ``scheme``, ``z_w``) say
         how to run (:class:`~phdesign.numeric.time.options.SimulationOptions`); the
-        discretization is the loop's.
+        discretization is the loop's; ``progress`` as for :meth:`spectrum`.
         """
         from phdesign.numeric.control.simulation import simulate_loop
         from phdesign.numeric.inputs import initial_state_function, input_function
@@ -359,12 +366,20 @@ class Loop:
             options=opts.discretized(self.method, self.resolution, "Loop"),
         )
 
+    @reports_progress
     def tune(
-        self, target: str = "both", *, full: bool = False, starts: int = 6, seed: int = 0
+        self,
+        target: str = "both",
+        *,
+        full: bool = False,
+        starts: int = 6,
+        seed: int = 0,
+        progress: Progress | None = None,
     ) -> LoopTuneResult:
         """Tune K, L or both on the loop's converged abscissa, by separation.
 
-        ``loop.with_gains(result.loop.K, result.loop.L)`` is the tuned loop.
+        ``loop.with_gains(result.loop.K, result.loop.L)`` is the tuned loop; ``progress``
+        as for :meth:`spectrum`.
         """
         from phdesign.numeric.control.tuning import tune_loop
 

@@ -21,6 +21,7 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 from phdesign.core.errors import ObserverError
+from phdesign.core.progress import Progress, reports_progress
 from phdesign.design.plant import Plant, numeric_matrix
 from phdesign.symbolic.observer import gain_matrix
 
@@ -44,6 +45,7 @@ class ObserverNoise:
     L: sympy.ImmutableMatrix | None
     numeric_gain: Callable[..., tuple[np.ndarray, np.ndarray]]
 
+    @reports_progress
     def noise(
         self,
         *,
@@ -53,6 +55,7 @@ class ObserverNoise:
         max_resolution: int | None = None,
         tol: float | None = None,
         metrics: Sequence[Metric] = (),
+        progress: Progress | None = None,
     ) -> NoiseReport:
         r"""Return what the gain costs in sensor noise: each figure converged or flagged.
 
@@ -86,6 +89,8 @@ class ObserverNoise:
         metrics : sequence of Metric, optional
             Further figures, one class each (:mod:`phdesign.numeric.noise.metrics`),
             reported in ``.figures``.
+        progress : callable, optional
+            Called with one line of text at each stage (:mod:`phdesign.core.progress`).
 
         Returns
         -------
@@ -122,6 +127,7 @@ class ObserverNoise:
             metrics=metrics,
         )
 
+    @reports_progress
     def tradeoff(
         self,
         *,
@@ -131,6 +137,7 @@ class ObserverNoise:
         intensity: float | Sequence[float] | None = None,
         input_intensity: float | Sequence[float] | None = None,
         performance: str | Sequence[str] | None = None,
+        progress: Progress | None = None,
     ) -> Tradeoff:
         r"""Decay rate against error RMS for these sensors, over a ray or a grid of gains.
 
@@ -149,7 +156,7 @@ class ObserverNoise:
             The scales s (default 12 log-spaced from 0.1 to 10).
         grid : sequence of sequences of float, optional
             Per-sensor gain values, every combination a diagonal gain (instead of a ray).
-        intensity, input_intensity, performance
+        intensity, input_intensity, performance, progress
             As for :meth:`noise`.
 
         Returns
@@ -195,6 +202,7 @@ class ObserverNoise:
             method=self.plant.method,
         )
 
+    @reports_progress
     def tune_noise(
         self,
         *,
@@ -204,6 +212,7 @@ class ObserverNoise:
         intensity: float | Sequence[float] | None = None,
         input_intensity: float | Sequence[float] | None = None,
         performance: str | Sequence[str] | None = None,
+        progress: Progress | None = None,
     ) -> NoiseTuneResult:
         """Tune a positive diagonal gain for these sensors under a noise budget.
 
@@ -211,7 +220,7 @@ class ObserverNoise:
         error RMS of the performance outputs at most ``max_rms``; ``"rms"`` minimizes the
         RMS subject to the abscissa at most ``-min_decay``
         (:func:`phdesign.numeric.noise.tuning.tune_noise`).  ``intensity``,
-        ``input_intensity`` and ``performance`` are those of :meth:`noise`.
+        ``input_intensity``, ``performance`` and ``progress`` are those of :meth:`noise`.
 
         Returns
         -------

@@ -39,6 +39,7 @@ import sympy
 from phdesign.core.checks import choice
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, ObserverError
+from phdesign.core.progress import Progress, reports_progress
 from phdesign.core.text import REPR_LIMIT, html_table, matrix_text, sensors_text, shorten
 from phdesign.design.noise import ObserverNoise
 from phdesign.design.plant import Plant, numeric_matrix
@@ -209,12 +210,14 @@ class Observer(ObserverNoise):
 
         return classify(self.plant.design_model, self.C_m, self._gain("classify"), method)
 
+    @reports_progress
     def spectrum(
         self,
         *,
         max_resolution: int | None = None,
         tol: float | None = None,
         count: int | None = None,
+        progress: Progress | None = None,
     ) -> SpectrumReport:
         r"""Return the converged spectrum of the error system.
 
@@ -222,12 +225,15 @@ class Observer(ObserverNoise):
 
         Only eigenvalues that agree at two resolutions are kept; the report says whether
         the abscissa converged (:func:`phdesign.numeric.spectrum.converged.spectrum`).
+        ``progress`` is called with one line of text at each stage of the refinement
+        (:mod:`phdesign.core.progress`).
         """
         C, L = self.numeric_gain("spectrum")
         return self.plant.closed_spectrum(
             C, L, max_resolution=max_resolution, tol=tol, count=count
         )
 
+    @reports_progress
     def simulate(
         self,
         x0: str | Callable[[Any], Any] | None = None,
@@ -235,6 +241,7 @@ class Observer(ObserverNoise):
         xhat0: str | Callable[[Any], Any] | None = None,
         u: str | Callable[[float], Any] | None = None,
         options: SimulationOptions | None = None,
+        progress: Progress | None = None,
         **settings: Any,
     ) -> SimulationResult:
         """Simulate plant and observer together: what ``phdesign simulate`` runs.
@@ -251,6 +258,8 @@ class Observer(ObserverNoise):
         options : SimulationOptions, optional
             How to run (:class:`~phdesign.numeric.time.options.SimulationOptions`: the
             grid, the stepping, a sampled observer, noise); the discretization is the plant's.
+        progress : callable, optional
+            Called with one line of text at each stage (:mod:`phdesign.core.progress`).
         **settings
             Its fields by name, over ``options`` (``t_end=2``, ``dt=1e-3``,
             ``noise_intensity=0.1`` ...); a name that is not a field is refused.
@@ -275,13 +284,13 @@ class Observer(ObserverNoise):
         seed: int = 0,
         resolution: int | None = None,
         robust: float | None = None,
-        progress: Callable[[str], None] | None = None,
+        progress: Progress | None = None,
     ) -> Observer:
         """Tune the gain for these sensors: minimize the error system's converged abscissa.
 
         ``robust`` (a fraction, 0.05 for ±5 %) minimizes the worst abscissa over a box of
         gains around each candidate instead; ``progress`` receives one line of text as the
-        search goes (:func:`phdesign.numeric.tuning.search.tune`).
+        search goes (:func:`phdesign.numeric.tuning.search.tune`, :mod:`phdesign.core.progress`).
 
         Returns
         -------
@@ -324,6 +333,7 @@ class Observer(ObserverNoise):
         return export.error_statespace(d, C, L)
 
     # ------------------------------------------------------------------ export
+    @reports_progress
     def export(
         self,
         *,
@@ -338,6 +348,7 @@ class Observer(ObserverNoise):
         t_end: float | None = None,
         plant_resolution: int | None = None,
         points: float | Sequence[float] | None = None,
+        progress: Progress | None = None,
     ) -> SampledObserver:
         r"""Return the observer a controller runs: finite order, sampled every ``dt``.
 
@@ -375,6 +386,8 @@ class Observer(ObserverNoise):
             Galerkin degree of the verification plant.
         points : sequence of float, optional
             Displacement points of the outputs ``w(z)`` (default b, with a displacement).
+        progress : callable, optional
+            Called with one line of text at each stage (:mod:`phdesign.core.progress`).
 
         Returns
         -------

@@ -19,6 +19,7 @@ import sympy
 from phdesign.core.checks import choice, positive_int
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, ObserverError, ParameterError
+from phdesign.core.progress import Progress, reports_progress
 from phdesign.core.text import REPR_LIMIT, matrix_text, shorten
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.system import require_model
@@ -132,14 +133,20 @@ class Plant:
         text = _text_or_function(x0, name, "'x1: 0, x2: z - 0.9'", "z")
         return x0 if text is None else initial_state_function(text, self.numeric)
 
+    @reports_progress
     def spectrum(
         self,
         *,
         max_resolution: int | None = None,
         tol: float | None = None,
         count: int | None = None,
+        progress: Progress | None = None,
     ) -> SpectrumReport:
-        """Return the converged spectrum of the plant with u = 0."""
+        """Return the converged spectrum of the plant with u = 0.
+
+        ``progress`` is called with one line of text at each stage of the refinement
+        (:mod:`phdesign.core.progress`).
+        """
         return self.closed_spectrum(
             None, None, max_resolution=max_resolution, tol=tol, count=count
         )
@@ -167,17 +174,19 @@ class Plant:
             count=count,
         )
 
+    @reports_progress
     def simulate(
         self,
         x0: str | Callable[[Any], Any] | None = None,
         *,
         u: str | Callable[[float], Any] | None = None,
         options: SimulationOptions | None = None,
+        progress: Progress | None = None,
         **settings: Any,
     ) -> SimulationResult:
         """Simulate the plant alone from ``x0`` (text or a function of z; zero by default).
 
-        ``u``, ``options`` and ``settings`` as for :meth:`phdesign.Observer.simulate`
+        ``u``, ``options``, ``progress`` and ``settings`` as for :meth:`phdesign.Observer.simulate`
         (``t_end=2``, ``scheme="midpoint"``, ``input_intensity=0.1`` ...); the noise on
         the inputs is the only kind of run a plant without sensors has besides the plain one.
         """

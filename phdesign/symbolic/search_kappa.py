@@ -24,6 +24,7 @@ from typing import Any
 
 import sympy
 
+from phdesign.core.progress import report as report_stage
 from phdesign.symbolic.certificate import certify
 from phdesign.symbolic.closing import plant_feedback
 from phdesign.symbolic.expressions import vanishes
@@ -45,12 +46,16 @@ Kappas = dict[Job, float | None]
 
 @dataclass(frozen=True)
 class _Report:
-    """Reports ``progress(done, total)``, for searches of more than PROGRESS_THRESHOLD sets."""
+    """Reports ``progress(done, total)``, for searches of more than PROGRESS_THRESHOLD sets.
+
+    The stage goes to the progress callback in force as well (:mod:`phdesign.core.progress`).
+    """
 
     progress: Progress
     total: int
 
     def __call__(self, done: int) -> None:
+        report_stage(f"classify: sensor sets {done} of {self.total}")
         if self.progress is not None and self.total > PROGRESS_THRESHOLD:
             self.progress(done, self.total)
 

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.errors import ArgumentError, LoopError
+from phdesign.core.progress import report
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import LoopSystem, NumericLoop, assemble
@@ -180,11 +181,13 @@ def simulate_loop(
     zero = lambda z: np.zeros((np.atleast_1d(z).size, nm.size))  # noqa: E731
     e0, eo0 = d.project(x0 or zero), d.project(xhat0 or zero)
     A_Z, B_Z = system.error_coordinates()
+    report(f"loop: simulating the loop, resolution {d.resolution}")
     Z = step_lti(system.E, A_Z, B_Z, np.concatenate([e0, e0 - eo0]), t, V, opts.scheme)
     # the error block is autonomous: stepped on its own, its round-off is the error
     # system's, not that of a stiff controlled plant (a damper on a derivative trace
     # makes ‖A_K‖ ≫ ‖Ã‖, and one exponential of the whole loop carries it into ẽ)
     A_err = A_Z[n:, n:]
+    report("loop: simulating the error system")
     err = step_lti(d.E, A_err, np.zeros((n, 0)), e0 - eo0, t, None, opts.scheme)
     audits = {"error system": energy_balance_residual(d.E, A_err, err, t, opts.scheme)}
     if V is None:  # the loop is autonomous only without free inputs

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.defaults import current, method_or_default
+from phdesign.core.progress import stage
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import LoopSystem, NumericLoop, assemble
@@ -336,11 +337,13 @@ def loop_spectrum(
         "rtol_resolved": rtol_resolved,
         "count": count,
     }
-    plant = replace(
-        spectrum(nm, S_a, np.asarray(loop.K, float), resolution=resolution, **options),
-        system="controlled plant (u_a = -K y_a)",
-    )
-    error = spectrum(nm, loop.C_m, loop.L, resolution=resolution, **options)
+    with stage("loop: the controlled plant"):
+        plant = replace(
+            spectrum(nm, S_a, np.asarray(loop.K, float), resolution=resolution, **options),
+            system="controlled plant (u_a = -K y_a)",
+        )
+    with stage("loop: the error system"):
+        error = spectrum(nm, loop.C_m, loop.L, resolution=resolution, **options)
     start = None
     if resolution is None:  # where both blocks converged: usually one pair suffices
         start = max(plant.resolutions[0], error.resolutions[0])
@@ -354,9 +357,10 @@ def loop_spectrum(
         start=start,
     )
     solver = AssembledLoopSolver(nm, loop, method=method)
-    trail = plan.refine(solver)
-    chosen, notes = choose_pair(trail)
-    blocks = solver.blocks(chosen.pair.resolutions[1])
+    with stage("loop: the assembled loop"):
+        trail = plan.refine(solver)
+        chosen, notes = choose_pair(trail)
+        blocks = solver.blocks(chosen.pair.resolutions[1])
     triangular = max(solver.systems[r].triangular_residual for r in chosen.pair.resolutions)
     return _report(
         nm, trail, chosen, notes, blocks, plant, error, plan.tol, count, method, triangular, design

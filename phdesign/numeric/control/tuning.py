@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.errors import LoopError
+from phdesign.core.progress import stage
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import NumericLoop
@@ -187,10 +188,12 @@ def tune_loop(
     plant = error = None
     K, L = np.asarray(loop.K, float), np.asarray(loop.L, float)
     if target in ("feedback", "both"):
-        plant = tune(nm, loop.selection(nm.n_ports), **options)
+        with stage("loop: tuning K on the controlled plant"):
+            plant = tune(nm, loop.selection(nm.n_ports), **options)
         K = plant.gain
     if target in ("gain", "both"):
-        error = tune(nm, loop.C_m, **options)
+        with stage("loop: tuning L on the error system"):
+            error = tune(nm, loop.C_m, **options)
         L = error.gain
     tuned = replace(loop, K=K, L=L)
     return LoopTuneResult(tuned, target, loop_spectrum(nm, tuned), plant, error)

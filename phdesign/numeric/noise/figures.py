@@ -69,6 +69,7 @@ from phdesign.core import limits
 from phdesign.core.checks import positive_int, positive_number
 from phdesign.core.defaults import current, method_or_default
 from phdesign.core.errors import NumericError, ObserverError
+from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_noise_intensity
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
@@ -234,6 +235,7 @@ def noise(
 
     run = _Refinement(functionals, tuple(metrics), tol)
     while True:
+        report(f"noise: resolution {p}")
         if p not in cache:
             cache[p] = discretize(nm, method, p)
         run.add(error_statistics(cache[p], C, Lm, sigma, w_in), rtol)

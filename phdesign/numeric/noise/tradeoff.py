@@ -27,6 +27,7 @@ import numpy as np
 
 from phdesign.core.errors import NumericError
 from phdesign.core.limits import check_tradeoff_gains
+from phdesign.core.progress import stage
 from phdesign.core.text import gain_text, html_table, measured_text
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
@@ -370,18 +371,19 @@ def tradeoff(
         feedback_matrix(C, L, nm.n_ports)  # every gain valid before any work
     cache: dict[int, DiscretePHS] = {}
     rows = []
-    for L, s in zip(gains, scale_list, strict=True):
-        spec = spectrum(nm, C, L, method=method)
-        rep = noise(
-            nm,
-            C,
-            L,
-            intensity=intensity,
-            input_intensity=input_intensity,
-            performance=functionals,
-            method=method,
-            discretizations=cache,
-        )
+    for i, (L, s) in enumerate(zip(gains, scale_list, strict=True), start=1):
+        with stage(f"tradeoff: gain {i} of {len(gains)}"):
+            spec = spectrum(nm, C, L, method=method)
+            rep = noise(
+                nm,
+                C,
+                L,
+                intensity=intensity,
+                input_intensity=input_intensity,
+                performance=functionals,
+                method=method,
+                discretizations=cache,
+            )
         rows.append((L, s, spec, rep))
     points = _points(rows)
     warnings = []

@@ -39,6 +39,7 @@ from scipy.optimize import minimize, minimize_scalar
 
 from phdesign.core.defaults import OrderDefaults, current
 from phdesign.core.errors import NumericError
+from phdesign.core.progress import report, stage
 from phdesign.core.text import gain_text, html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
@@ -221,9 +222,11 @@ def tune_noise(
             "no displacement: give one (a trace like e1(1) or an integral like 'x2: 1')"
         )
     problem = _Problem(nm, C, sigma, w_in, tuple(functionals), objective, bound)
-    merit = _Merit(problem, _Figures.at_converged_resolutions(problem))
+    with stage("tune: the figures at L = I"):
+        merit = _Merit(problem, _Figures.at_converged_resolutions(problem))
     best = _search(merit, q, log_range, maxiter)
-    return _verified(problem, best, merit.evaluations, maxiter)
+    with stage("tune: verifying the best gain"):
+        return _verified(problem, best, merit.evaluations, maxiter)
 
 
 @dataclass(frozen=True)
@@ -311,6 +314,7 @@ class _Merit:
     def __call__(self, x: np.ndarray) -> float:
         """Return the merit at L = diag(e^x), counting the evaluation."""
         self.evaluations += 1
+        report(f"tune: noise-aware search, {self.evaluations} evaluations")
         alpha, rms = self.figures(x)
         if alpha is None:  # nothing resolved: leave the region
             return 1e6

@@ -41,6 +41,7 @@ import numpy as np
 from phdesign.core.checks import EXPORT_FORMATS, positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError
+from phdesign.core.progress import report
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_initial_state, check_periods, check_sampling
@@ -377,6 +378,7 @@ def export_observer(
     discrete = continuous.sampled(dt, sampler)
     verification = None
     if verify:
+        report("export: verification against the plant")
         verification = verify_observer(
             plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=float(t_end), x0_text=text
         )
@@ -443,6 +445,7 @@ def _plant_checks(
     missed = selection.floor > selection.output_tol  # is it the plant's own resolution?
     if verification is None and not missed:
         return selection, verification
+    report("export: does the verification plant resolve its own outputs?")
     samples = current().simulation.samples
     t = np.linspace(0.0, t_end, samples) if verification is None else verification.t
     found = plant_gap(nm, plant, continuous, initial, t)

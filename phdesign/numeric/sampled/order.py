@@ -51,6 +51,8 @@ import numpy as np
 from phdesign.core.checks import REDUCTIONS
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
+from phdesign.core.progress import report as report_stage
+from phdesign.core.progress import stage
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize, feedback_matrix
@@ -214,7 +216,8 @@ class _Targets:
     ) -> _Targets:
         """Fix the targets: the converged error spectrum, the length of the runs."""
         warnings: list[str] = []
-        report = spectrum(nm, C_m, L, count=count)
+        with stage("export: the converged error spectrum"):
+            report = spectrum(nm, C_m, L, count=count)
         alpha = report.spectral_abscissa
         if report.unbounded_below:
             warnings.append("the error spectrum is unbounded below: no spectral target applies")
@@ -307,6 +310,7 @@ def _smallest_degree(trial: _Trial, candidates: list[Candidate]) -> _Found:
     nm, plant = trial.nm, trial.plant
     tried: list[tuple[Candidate, _Found]] = []
     for p in range(nm.order + 1, plant.dim // (2 * nm.size)):
+        report_stage(f"export: order selection, Galerkin degree {p}")
         try:
             built = trial.build(p)
         except NumericError:  # no converged mode at this degree (modal reduction)
@@ -419,6 +423,7 @@ def _balanced(
     notes: list[str] = []
     if reduced is None:
         for r in range(1, full.order):
+            report_stage(f"export: balanced truncation, order {r}")
             cand = evaluate(reduce(r), degree)
             candidates.append(cand)
             if cand.passed:

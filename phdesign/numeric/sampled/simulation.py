@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from phdesign.core.errors import NumericError
+from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_periods
 from phdesign.numeric.discretization.phs import DiscretePHS
@@ -117,6 +118,7 @@ def simulate_sampled(
     zero = lambda z: np.zeros((np.atleast_1d(z).size, nm.size))  # noqa: E731
     e0, xh0 = plant.project(x0 or zero), d_obs.project(xhat0 or zero)
     warnings: tuple[str, ...] = ()
+    report(f"simulate: plant (resolution {plant.resolution}) and observer stepped together")
     if opts.dt is None:
         run = run_loop(
             plant, observer, C_m, x0=e0, xhat0=xh0, dt=grid.step, n_steps=grid.steps, u=U

@@ -30,6 +30,7 @@ import numpy as np
 from phdesign.core.cache import MODEL_WORK, OwnerCache
 from phdesign.core.errors import NumericError
 from phdesign.core.limits import MAX_CACHE_BYTES, MAX_CACHED_STRUCTURES
+from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.feedback import open_port_gain
 from phdesign.numeric.discretization.registry import discretize
@@ -320,6 +321,7 @@ def refine(
     band_stop = stop if band_stop is None else max(int(band_stop), stop)
     while True:
         p_fine = fine_resolution(p)
+        report(f"spectrum: pair ({p}, {p_fine})")
         coarse, _ = solver(p, condition=False)
         fine, kappa = solver(p_fine)
         pair = pair_spectrum(

@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.errors import NumericError
+from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_simulate_arguments
 from phdesign.numeric.discretization.phs import ClosedLoop
@@ -188,6 +189,7 @@ def simulate(
     step = _Stepper.of(opts)
     U = None if u is None else input_samples(u, step.t, nm.n_ports)
     start = x0 or _zero(nm)
+    report(f"simulate: the plant, resolution {d.resolution}")
     plant = step(d.E, d.J - d.R, d.B, d.project(start), U)
     error = None
     if C_m is not None and L is not None:
@@ -244,10 +246,12 @@ def _error_run(
 ) -> _ErrorRun:
     """Step the error system (module docstring), and again at ⌈1.5 p⌉ to find its floor."""
     loop = d.close(K)
+    report("simulate: the error system")
     error = step(d.E, loop.A, np.zeros((d.dim, 0)), d.project(e0), None)
     if not check_resolution:
         return _ErrorRun(loop, error)
     fine = discretize(nm, d.method, math.ceil(1.5 * d.resolution))
+    report(f"simulate: the error system at resolution {fine.resolution}, to check the first")
     finer = step(fine.E, fine.close(K).A, np.zeros((fine.dim, 0)), fine.project(e0), None)
     floor, until = _resolution_check(step.t, d.hamiltonian(error.X), fine.hamiltonian(finer.X))
     if floor is None or until is None:

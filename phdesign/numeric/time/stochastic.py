@@ -48,6 +48,7 @@ import numpy as np
 import scipy.linalg as sl
 
 from phdesign.core.errors import NumericError, ObserverError
+from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.inputs import input_samples
@@ -170,6 +171,7 @@ def simulate_noisy(
     sigma, w_in = noise_intensities(nm, q, opts.noise_intensity, opts.input_intensity, default=0.0)
     d = discrete if discrete is not None else discretize(nm, opts.method, opts.resolution)
     base = simulate(nm, C_m, L, x0=x0, xhat0=xhat0, u=u, options=opts.deterministic(), discrete=d)
+    report("simulate: the noise's sample path")
     extra = _noise_paths(d, C_m, L, sigma, w_in, base.t, opts.seed)
     U = None if u is None else input_samples(u, base.t, d.n_ports)
     described = []

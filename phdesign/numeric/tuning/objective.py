@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 
 import numpy as np
 import scipy.linalg as sl
 
+from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
 from phdesign.numeric.tuning.robustness import worst_in_box
@@ -49,12 +49,10 @@ class GainSearch:
         scale: np.ndarray,
         full: bool,
         robust: float | None,
-        progress: Callable[[str], None] | None,
     ) -> None:
         self.C, self.q, self.full, self.robust = C, C.shape[0], full, robust
         self.root = np.sqrt(scale)
         self.scale = scale
-        self.progress = progress
         self.best = math.inf
         self.evaluations = 0
         self._last_report = time.perf_counter()
@@ -106,12 +104,12 @@ class GainSearch:
         return v
 
     def tell(self, force: bool = False) -> None:
-        """Report the stage and the best abscissa to ``progress`` (at most every 0.2 s)."""
+        """Report the stage and the best abscissa (:mod:`phdesign.core.progress`), every 0.2 s."""
         now = time.perf_counter()
-        if self.progress is not None and (force or now - self._last_report > 0.2):
+        if force or now - self._last_report > 0.2:
             self._last_report = now
             best = "—" if not math.isfinite(self.best) else f"{self.best:.6g}"
-            self.progress(f"tune: {self.stage}, {self.evaluations} evaluations, best {best}")
+            report(f"tune: {self.stage}, {self.evaluations} evaluations, best {best}")
 
 
 def _nan_as_inf(x: float | None) -> float:

@@ -63,6 +63,7 @@ from scipy.optimize import OptimizeResult, minimize
 
 from phdesign.core.defaults import method_or_default
 from phdesign.core.errors import NumericError, ObserverError
+from phdesign.core.progress import Progress, reporting
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_tune_arguments
 from phdesign.numeric.discretization.registry import feedback_matrix
@@ -170,7 +171,7 @@ def tune(
     maxiter: int = 100,
     robust: float | None = None,
     method: str | None = None,
-    progress: Callable[[str], None] | None = None,
+    progress: Progress | None = None,
 ) -> TuneResult:
     """Tune the observer gain L for the sensors ``C_m`` (module docstring).
 
@@ -197,7 +198,8 @@ def tune(
         Minimize the worst abscissa over the ±robust box of gains instead (0.05 for 5 %).
     method : str, optional
     progress : callable, optional
-        Called with a one-line status now and then (the command line shows it on a terminal).
+        Called with a one-line status now and then (:mod:`phdesign.core.progress`; the
+        command line shows it on a terminal).
 
     Returns
     -------
@@ -224,9 +226,12 @@ def tune(
     if robust is not None and not 0 < robust < 1:
         raise NumericError(f"robust must be a fraction in (0, 1); found {robust}")
     start_time = time.perf_counter()
-    run = _setup(nm, C, full, robust, resolution, method, progress)
-    found = _search(run, _Found(np.zeros(run.search.n_params)), starts, seed, log_range, maxiter)
-    return _verify(run, found, start_time)
+    with reporting(progress):
+        run = _setup(nm, C, full, robust, resolution, method)
+        found = _search(
+            run, _Found(np.zeros(run.search.n_params)), starts, seed, log_range, maxiter
+        )
+        return _verify(run, found, start_time)
 
 
 @dataclass(frozen=True)
@@ -267,12 +272,11 @@ def _setup(
     robust: float | None,
     resolution: int | None,
     method: str,
-    progress: Callable[[str], None] | None,
 ) -> _Run:
     """Fix the verification pair (where the natural gain's spectrum converges) and the search's."""
     scales = problem_scales(nm)
     # the diagonal search always runs first; a full gain only starts from its optimum
-    search = GainSearch(C, scales.gain_scale(C), False, robust, progress)
+    search = GainSearch(C, scales.gain_scale(C), False, robust)
     L0 = search.gain(np.zeros(search.n_params))
     if resolution is None:
         nominal = spectrum(nm, C, L0, method=method)
@@ -392,7 +396,7 @@ def _full_gain(run: _Run, found: _Found, maxiter: int) -> _Found:
     if not run.full:
         return found
     search = run.search
-    wide = GainSearch(run.C, search.scale, True, search.robust, search.progress)
+    wide = GainSearch(run.C, search.scale, True, search.robust)
     wide.stage = "full gain"
     res = _nelder_mead(
         run, wide, run.ev_verify, wide.diagonal_params(found.x), maxiter * wide.n_params
