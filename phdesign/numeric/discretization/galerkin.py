@@ -57,7 +57,7 @@ modes went and why.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Any
 
 import numpy as np
@@ -374,26 +374,47 @@ def _displacement_basis(nm: NumericModel, effort_basis, iv):
     """w(z) = repeated integral from a of x_c = (H^-1 e)_c, as a linear map of ê.
 
     x_c is sampled at Gauss points, expanded in Legendre polynomials by the (exact for
-    polynomials) discrete transform, and integrated exactly in that expansion.
+    polynomials) discrete transform, and integrated exactly in that expansion: the rows
+    that do it at given points depend on the interval alone (:func:`_integration_rows`).
     """
     spec = nm.displacement
     assert spec is not None
     c = spec.component - 1
-    nq = 160
-    zq, wq = gauss_rule(nq, iv)
+    zq, _ = gauss_rule(DISPLACEMENT_POINTS, iv)
     Eq = effort_basis(zq)  # (nq, n, dim)
     Hinv = np.linalg.inv(nm.H_at(zq))
     X = np.einsum("qk,qkd->qd", Hinv[:, c, :], Eq)  # x_c at Gauss points
-    t = (2 * zq - iv[0] - iv[1]) / (iv[1] - iv[0])
-    Vt = leg.legvander(t, nq - 1)
-    norms = 2.0 / (2.0 * np.arange(nq) + 1.0)
-    coef = (Vt * (wq * 2.0 / (iv[1] - iv[0]))[:, None]).T @ X / norms[:, None]
-    half = 0.5 * (iv[1] - iv[0])
-    for _ in range(spec.integrations):
-        coef = leg.legint(coef, lbnd=-1, axis=0) * half
 
     def basis(z: np.ndarray) -> np.ndarray:
-        tt = (2 * np.atleast_1d(np.asarray(z, dtype=float)) - iv[0] - iv[1]) / (iv[1] - iv[0])
-        return np.asarray(leg.legvander(tt, coef.shape[0] - 1) @ coef)
+        points = tuple(float(v) for v in np.atleast_1d(np.asarray(z, dtype=float)))
+        return np.asarray(_integration_rows(points, iv, spec.integrations) @ X)
 
     return basis
+
+
+#: Gauss points of the displacement's Legendre transform (exact for degree < 160).
+DISPLACEMENT_POINTS = 160
+
+
+@lru_cache(maxsize=256)
+def _integration_rows(
+    points: tuple[float, ...], iv: tuple[float, float], integrations: int
+) -> np.ndarray:
+    """Rows taking x_c at the Gauss points to its repeated integral at ``points`` (cached).
+
+    The discrete Legendre transform, integrated ``integrations`` times from a and read at
+    the points: it depends on the interval only, so every discretization and every run
+    shares it.
+    """
+    nq = DISPLACEMENT_POINTS
+    zq, wq = gauss_rule(nq, iv)
+    t = (2 * zq - iv[0] - iv[1]) / (iv[1] - iv[0])
+    norms = 2.0 / (2.0 * np.arange(nq) + 1.0)
+    coef = (leg.legvander(t, nq - 1) * (wq * 2.0 / (iv[1] - iv[0]))[:, None]).T / norms[:, None]
+    half = 0.5 * (iv[1] - iv[0])
+    for _ in range(integrations):
+        coef = leg.legint(coef, lbnd=-1, axis=0) * half
+    tt = (2 * np.array(points) - iv[0] - iv[1]) / (iv[1] - iv[0])
+    rows = leg.legvander(tt, coef.shape[0] - 1) @ coef
+    rows.setflags(write=False)
+    return rows

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -127,6 +128,19 @@ class DiscretePHS:
     def n_ports(self) -> int:
         """Number of inputs (= outputs)."""
         return int(self.B.shape[1])
+
+    @cached_property
+    def explicit(self) -> tuple[np.ndarray, np.ndarray]:
+        r"""``(F, G)``: the explicit form :math:`\dot{\hat e} = F\hat e + G u`, solved once.
+
+        :math:`F = E^{-1}(J - R)`, :math:`G = E^{-1}B` (read-only): every run of this
+        discretization (the order selection's trials, the verification) shares them.
+        """
+        F = np.linalg.solve(self.E, self.J - self.R)
+        G = np.linalg.solve(self.E, self.B)
+        F.setflags(write=False)
+        G.setflags(write=False)
+        return F, G
 
     def hamiltonian(self, ehat: np.ndarray) -> np.ndarray:
         """Discrete energy ½ êᵀ E ê; ``ehat`` of shape ``(dim,)`` or ``(nt, dim)``."""

@@ -380,8 +380,9 @@ def export_observer(
     if verify:
         report("export: verification against the plant")
         verification = verify_observer(
-            plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=float(t_end), x0_text=text
-        )
+            plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=float(t_end),
+            x0_text=text, realization=discrete,
+        )  # fmt: skip
     selection, verification = _plant_checks(
         nm, plant, continuous, initial, float(t_end), text, selection, verification
     )

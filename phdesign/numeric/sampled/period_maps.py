@@ -229,9 +229,10 @@ class ObserverModel:
         C = np.atleast_2d(np.asarray(C_m, dtype=float))
         Lm = np.atleast_2d(np.asarray(L, dtype=float))
         feedback_matrix(C, Lm, d.n_ports)  # checks the shapes and L + Lᵀ ≻ 0
+        F, G = d.explicit
         return cls(
-            F=np.linalg.solve(d.E, d.J - d.R),
-            G=np.linalg.solve(d.E, d.B),
+            F=F,
+            G=G,
             H=d.B.T.copy(),
             D=d.D.copy(),
             C_m=C,

@@ -95,6 +95,7 @@ def run_loop(
     stride: int = 1,
     sampler: str | None = None,
     u: np.ndarray | None = None,
+    realization: Realization | None = None,
 ) -> LoopRun:
     r"""Run ``plant`` and ``observer`` over ``n_steps`` periods, exactly.
 
@@ -103,7 +104,8 @@ def run_loop(
     sampled outputs (:func:`~phdesign.numeric.sampled.period_maps.sample_plant`). The plant
     input u (``(n_steps, N n)``, default zero) is held over each period in both cases;
     ``u`` holds ``u_0 .. u_n_steps`` (the last enters only the outputs of the final
-    record). In the sampled case, with
+    record); ``realization`` is the observer's one-period map for ``sampler`` when the
+    caller has it (default: computed here). In the sampled case, with
     :math:`X = (x; \hat x)`,
 
     .. math::
@@ -118,7 +120,7 @@ def run_loop(
     if n_steps < 1 or stride < 1:
         raise NumericError(f"a run needs n_steps >= 1 and stride >= 1; found {n_steps}, {stride}")
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
-    maps = _LoopMaps.of(plant, observer, C, dt, sampler)
+    maps = _LoopMaps.of(plant, observer, C, dt, sampler, realization)
     n, no, m = plant.dim, observer.order, plant.n_ports
     X0 = np.concatenate([x0, np.zeros(no) if xhat0 is None else xhat0])
     X, U = maps.records(X0, n_steps, stride, u, m)
@@ -163,17 +165,19 @@ class _LoopMaps:
         C: np.ndarray,
         dt: float,
         sampler: str | None,
+        realization: Realization | None = None,
     ) -> _LoopMaps:
-        """Return the period's maps: exact for the continuous or the sampled observer."""
-        F = np.linalg.solve(plant.E, plant.J - plant.R)
-        G = np.linalg.solve(plant.E, plant.B)
+        """Return the period's maps: exact for the continuous or the sampled observer.
+
+        ``realization``: the sampled observer's map, when already computed.
+        """
+        F, G = plant.explicit
         Cp, Dp = plant.B.T, plant.D
         n, no, m = plant.dim, observer.order, plant.n_ports
-        realization = (
-            Realization(observer.A, observer.B, observer.C, observer.D)
-            if sampler is None
-            else observer.sampled(dt, sampler)
-        )
+        if sampler is None:
+            realization = Realization(observer.A, observer.B, observer.C, observer.D)
+        elif realization is None:
+            realization = observer.sampled(dt, sampler)
         Bu, By = realization.B[:, :m], realization.B[:, m:]
         if sampler is None:
             generator = np.zeros((n + no + m, n + no + m))
@@ -230,18 +234,20 @@ def run_against_continuous(
     n_steps: int,
     stride: int = 1,
     u: np.ndarray | None = None,
+    realization: Realization | None = None,
 ) -> tuple[LoopRun, LoopRun, tuple[float, float], str | None]:
     """Run the sampled and the continuous observer on the same plant, data and records.
 
     Returns both runs (sampled first), their performance error floors
-    (:func:`error_floor`, absolute) and the :func:`aliasing_warning` (or None).
+    (:func:`error_floor`, absolute) and the :func:`aliasing_warning` (or None);
+    ``realization`` as for :func:`run_loop`.
     """
     runs = [
         run_loop(
             plant, observer, C_m, x0=x0, xhat0=xhat0, dt=dt, n_steps=n_steps, stride=stride,
-            sampler=s, u=u,
+            sampler=s, u=u, realization=r,
         )
-        for s in (sampler, None)
+        for s, r in ((sampler, realization), (None, None))
     ]  # fmt: skip
     sampled, continuous = (
         error_floor(r.t, r.performance_error(observer), r.target)[0] for r in runs

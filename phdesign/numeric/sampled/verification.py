@@ -21,6 +21,7 @@ from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_periods, check_sampling
 from phdesign.numeric.sampled.order import check_order
+from phdesign.numeric.sampled.period_maps import Realization
 from phdesign.numeric.sampled.runs import run_against_continuous
 from phdesign.numeric.sampled.samplers import ContinuousObserver
 from phdesign.numeric.sampled.selection import OrderSelection
@@ -148,13 +149,15 @@ def verify_observer(
     t_end: float,
     samples: int | None = None,
     x0_text: str = "x0",
+    realization: Realization | None = None,
 ) -> Verification:
     """Run the sampled and the continuous observer against ``plant`` from ``x0``.
 
     Both are stepped exactly (:func:`phdesign.numeric.sampled.runs.run_loop`) over
     round(t_end / dt) periods, the sampler applied to the plant's outputs, and recorded
     on the same instants (every ``stride`` periods, about ``samples`` records; default
-    the simulations', :mod:`phdesign.core.defaults`).
+    the simulations', :mod:`phdesign.core.defaults`).  ``realization`` is the sampled
+    observer's one-period map when the caller has it (the export: computed once).
     """
     samples = current().simulation.samples if samples is None else samples
     dt = check_sampling(dt, sampler)
@@ -163,8 +166,9 @@ def verify_observer(
     n_steps = max(1, round(t_end / dt))
     stride = max(1, round(t_end / ((max(samples, 2) - 1) * dt)))
     sampled, continuous, (floor, cont), warning = run_against_continuous(
-        plant, observer, C_m, sampler=sampler, x0=x0, dt=dt, n_steps=n_steps, stride=stride
-    )
+        plant, observer, C_m, sampler=sampler, x0=x0, dt=dt, n_steps=n_steps, stride=stride,
+        realization=realization,
+    )  # fmt: skip
     errors = [r.performance_error(observer) for r in (sampled, continuous)]
     peak = float(np.max(np.abs(sampled.target)))
     return Verification(
