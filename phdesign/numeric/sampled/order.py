@@ -181,7 +181,7 @@ def select_order(
     order = check_order(
         order, plant.dim, plant.resolution, reduction=reduction, size=n, smallest=n * (N + 2)
     )
-    targets = _Targets.of(nm, C_m, L, plant, t_end, output_tol, count)
+    targets = _Targets.of(nm, C_m, L, plant, t_end, output_tol, count, reduction == "modal")
     trial = _Trial(nm, C_m, L, plant, x0, points, reduction, tol, output_tol, targets)
     candidates: list[Candidate] = []
     if order is not None:
@@ -198,7 +198,7 @@ class _Targets:
 
     reference: np.ndarray  # the converged rightmost error eigenvalues
     alpha: float | None  # the converged abscissa
-    plant_poles: np.ndarray  # the verification plant's error spectrum
+    plant_poles: np.ndarray  # the verification plant's error spectrum (modal reduction only)
     dt_run: float  # the period of the performance run's records
     # the notes for the report, appended by the stages as they go
     warnings: list[str] = field(default_factory=list)
@@ -213,8 +213,13 @@ class _Targets:
         t_end: float,
         output_tol: float,
         count: int | None,
+        modal: bool = False,
     ) -> _Targets:
-        """Fix the targets: the converged error spectrum, the length of the runs."""
+        """Fix the targets: the converged error spectrum, the length of the runs.
+
+        The verification plant's error spectrum is solved for a ``modal`` reduction only
+        (the one that reads it).
+        """
         warnings: list[str] = []
         with stage("export: the converged error spectrum"):
             report = spectrum(nm, C_m, L, count=count)
@@ -223,7 +228,8 @@ class _Targets:
             warnings.append("the error spectrum is unbounded below: no spectral target applies")
         elif not report.converged:
             warnings.append("the error spectrum did not converge: the spectral target is loose")
-        plant_poles = eigen(plant, feedback_matrix(C_m, L, nm.n_ports))[0]
+        K = feedback_matrix(C_m, L, nm.n_ports)
+        plant_poles = eigen(plant, K)[0] if modal else np.zeros(0, dtype=complex)
         run_length = float(t_end)
         if alpha is not None and alpha < 0:
             # long enough for the error's transient to fall to a tenth of the target, so
@@ -424,10 +430,11 @@ def _balanced(
     if reduced is None:
         for r in range(1, full.order):
             report_stage(f"export: balanced truncation, order {r}")
-            cand = evaluate(reduce(r), degree)
+            trial = reduce(r)
+            cand = evaluate(trial, degree)
             candidates.append(cand)
             if cand.passed:
-                reduced = reduce(r)
+                reduced = trial  # not reduced a second time
                 break
         if reduced is None:
             notes.append(
