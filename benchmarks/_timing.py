@@ -2,11 +2,60 @@
 
 from __future__ import annotations
 
+import os
 import statistics
 import subprocess
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+
+
+def fresh_environment() -> dict[str, str]:
+    """The environment of the timed processes: bytecode may be cached, as in an install.
+
+    With ``PYTHONDONTWRITEBYTECODE`` set every fresh process compiles phdesign's modules
+    again (the peers' site-packages are compiled already), which is no user's start-up.
+    """
+    return {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+
+
+def load() -> str:
+    """The machine's load averages (1, 5, 15 minutes) and its processors, as text."""
+    one, five, fifteen = os.getloadavg()
+    return f"load average {one:.2f}, {five:.2f}, {fifteen:.2f} on {os.cpu_count()} processors"
+
+
+def interleaved(
+    commands: Mapping[str, Sequence[str]], rounds: int = 7, warmup: int = 1
+) -> dict[str, list[float]]:
+    """Wall-clock seconds of each command as a fresh process, in interleaved rounds.
+
+    Each round runs every command once (A B A B ...), so that a drift of the machine's
+    speed touches all alike; the first ``warmup`` rounds are not counted.
+    """
+    env = fresh_environment()
+    timings: dict[str, list[float]] = {name: [] for name in commands}
+    for index in range(warmup + rounds):
+        for name, argv in commands.items():
+            start = time.perf_counter()
+            subprocess.run(argv, check=True, capture_output=True, env=env)
+            if index >= warmup:
+                timings[name].append(time.perf_counter() - start)
+    return timings
+
+
+def ratio_report(
+    label: str, timings: Sequence[float], peer: Sequence[float], peer_label: str, target: float
+) -> bool:
+    """Print the medians and the ratio of medians to the peer; return whether it is <= target."""
+    ratio = statistics.median(timings) / statistics.median(peer)
+    ok = ratio <= target
+    print(
+        f"{label}: median {statistics.median(timings):.3f} s (min {min(timings):.3f}, max "
+        f"{max(timings):.3f}); {peer_label}: median {statistics.median(peer):.3f} s; ratio "
+        f"{ratio:.2f}x, target <= {target:g}x: {'met' if ok else 'MISSED'}"
+    )
+    return ok
 
 
 def time_command(argv: Sequence[str], runs: int = 7, warmup: int = 1) -> list[float]:
