@@ -40,11 +40,12 @@ largest real root of :math:`\det(B_r - \mu A_r)` (rational or algebraic).  Float
 path: Cholesky :math:`A_r = R R^\top`, :math:`\mu_{\max} =
 \lambda_{\max}(R^{-1} B_r R^{-\top})` with numpy.  Symbolic gains: the pencil is
 factored over :math:`\mathbb Q(l_1, \dots)`, :math:`\kappa^* = \min_i 1/\mu_i` over
-the non-zero root branches.
+the non-zero root branches (:mod:`phdesign.symbolic.gain_kappa`).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -56,6 +57,7 @@ from sympy.polys.matrices import DomainMatrix
 from phdesign.core.errors import ObserverError
 from phdesign.core.limits import EXACT_KAPPA_BITS, EXACT_KAPPA_DEGREE, EXACT_KAPPA_OPERATIONS
 from phdesign.symbolic.expressions import vanishes
+from phdesign.symbolic.gain_kappa import symbolic_kappa
 from phdesign.symbolic.observer import ErrorSystem
 
 __all__ = ["Certificate", "certify", "float_kappa"]
@@ -166,7 +168,7 @@ def certify(
         return Certificate(True, None, None, True, None, (), "symbolic" if symbolic else "exact")
     pencil = (A_r, B_r, K_m)
     if symbolic:
-        kappa, conditions = _symbolic_kappa(A_r, B_r)
+        kappa, conditions = symbolic_kappa(A_r, B_r)
         return Certificate(True, kappa, None, False, None, (), "symbolic", conditions, pencil)
     return _numeric_kappa(pencil, method)
 
@@ -179,14 +181,46 @@ def _counter_example(
     It fails iff an error output in :math:`\ker C_m` (neither measured nor damped) gives an
     admissible trace that does not vanish on the selected rows.
     """
-    for n_c in _nullspace(C_m):
-        v = es.K * n_c  # the admissible trace with error output n_c (= T⁻¹(0; n_c) when G n_c = 0)
-        zero = [vanishes(v[i]) for i in rows]
+    for trace in _unobserved_traces(es.K, sympy.ImmutableMatrix(C_m)):
+        zero = [trace.vanishes(i) for i in rows]
         if not all(zero):
             free = tuple(i for i, z in zip(rows, zero, strict=True) if not z)
-            witness = tuple(sympy.S.Zero if vanishes(x) else sympy.expand(x) for x in v)
+            witness = tuple(
+                sympy.S.Zero if trace.vanishes(i) else sympy.expand(x)
+                for i, x in enumerate(trace.v)
+            )
             return Certificate(False, None, None, False, witness, free, "exact")
     return None
+
+
+@dataclass(frozen=True)
+class _UnobservedTrace:
+    r"""An admissible trace :math:`v = K n_c`, :math:`n_c \in \ker C_m`, and its zeros.
+
+    Whether an entry vanishes is decided on first use (some need :func:`sympy.simplify`).
+    """
+
+    v: sympy.ImmutableMatrix
+    zero: dict[int, bool] = field(default_factory=dict)
+
+    def vanishes(self, i: int) -> bool:
+        """Return whether entry ``i`` of :math:`v` is identically zero."""
+        if i not in self.zero:
+            self.zero[i] = vanishes(self.v[i])
+        return self.zero[i]
+
+
+@functools.lru_cache(maxsize=64)
+def _unobserved_traces(
+    K: sympy.ImmutableMatrix, C_m: sympy.ImmutableMatrix
+) -> tuple[_UnobservedTrace, ...]:
+    r"""Return the traces :math:`K n_c` over a basis :math:`n_c` of :math:`\ker C_m`.
+
+    The same for every variant of one error system (classify asks up to 14), so they are
+    found once: exact matrices are hashable, and a few dozen error systems are kept.
+    """
+    # K n_c = T⁻¹(0; n_c) when G n_c = 0
+    return tuple(_UnobservedTrace(sympy.ImmutableMatrix(K * n_c)) for n_c in _nullspace(C_m))
 
 
 def _numeric_kappa(
@@ -347,122 +381,6 @@ def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | N
         return None
     # radsimp rationalizes denominators like 1/(4 sqrt(2)/7 + 16/7) = (4 - sqrt(2))/4
     return 1 / mu_max if mu_max.is_rational else sympy.radsimp(1 / mu_max)
-
-
-def _symbolic_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> tuple[sympy.Expr | None, str]:
-    r""":math:`\kappa^* = \min_i 1/\mu_i` over the non-zero root branches of the pencil."""
-    det = sympy.factor((B_r - _MU * A_r).det(method="berkowitz"))
-    branches: list[sympy.Expr] = []
-    unresolved = False
-    _, factors = sympy.factor_list(det, _MU)
-    for factor, _multiplicity in factors:
-        degree = sympy.degree(factor, _MU)
-        if degree == 0:
-            continue
-        if degree > 2:
-            unresolved = True
-            continue
-        for root in sympy.roots(sympy.Poly(factor, _MU)):
-            root = _tidy(root)
-            if root == 0:
-                continue
-            branch = _tidy(1 / root)
-            numerator, _ = sympy.fraction(sympy.together(root))
-            if not numerator.is_positive and not numerator.is_negative:
-                # μ_i vanishes at some gains (e.g. (l - 1)²/(2 l) at l = 1): there the
-                # branch is absent from the pencil and must not enter the minimum
-                branch = sympy.Piecewise((branch, sympy.Ne(numerator, 0)), (sympy.oo, True))
-            branches.append(branch)
-    gains = sorted(A_r.free_symbols | B_r.free_symbols, key=str)
-    names = ", ".join(map(str, gains))
-    if unresolved:
-        return None, (
-            f"holds for all positive {names}; κ* is 1/(largest root) of a pencil "
-            "factor of degree > 2 (no closed form)"
-        )
-    if not branches:
-        return None, f"holds for all positive {names}; RHS vanishes on K"
-    branches = _undominated(branches)
-    kappa = branches[0] if len(branches) == 1 else sympy.Min(*branches)
-    return kappa, f"holds for all positive {names}"
-
-
-def _tidy(expr: sympy.Expr) -> sympy.Expr:
-    """Return a compact exact form: ``simplify``, or for radicals one common denominator.
-
-    ``simplify`` of the root of a quadratic factor in two gains (a square root of a
-    polynomial of degree 8) costs about 0.15 s and shortens it by 5 %; the common
-    denominator with the common factors pulled out costs a sixth of that, for the same
-    size (measured on the random models of tests/symbolic/test_classify_properties.py).
-    """
-    if any(not p.exp.is_Integer for p in expr.atoms(sympy.Pow)):
-        return sympy.factor_terms(sympy.together(expr))
-    return sympy.simplify(expr)
-
-
-def _sign_for_positive(poly: sympy.Poly) -> int | None:
-    """Return the sign (+1 or -1) a polynomial keeps on s > 0, zeros aside; None if it changes.
-
-    Its square-free factors of odd multiplicity (``sqf_list``) must have no root in
-    (0, ∞) (``count_roots``, exact Sturm counting); the sign is then read at the first
-    positive integer that is not a root.
-    """
-    _, factors = poly.sqf_list()
-    for factor, multiplicity in factors:
-        if multiplicity % 2 and factor.degree() > 0:
-            inside = factor.count_roots(0, None) - (1 if factor.eval(0) == 0 else 0)
-            if inside > 0:
-                return None
-    point = 1
-    while poly.eval(point) == 0:
-        point += 1
-    return 1 if poly.eval(point) > 0 else -1
-
-
-def _nonnegative_for_positive(expr: sympy.Expr) -> bool:
-    r"""Prove :math:`f \ge 0` for every positive value of f's one symbol (False: not proved).
-
-    f = p/q with polynomials p, q of rational coefficients in one symbol s: each keeps its
-    sign on :math:`s > 0` when no factor of odd multiplicity has a root there (exact root
-    counting, :func:`_sign_for_positive`), and f ≥ 0 when those signs agree.  No symbol:
-    the sign of the number.
-    """
-    symbols = expr.free_symbols
-    if not symbols:
-        return bool(expr.is_nonnegative)
-    if len(symbols) != 1:
-        return False
-    (s,) = symbols
-    numerator, denominator = sympy.fraction(sympy.together(expr))
-    signs = []
-    for part in (numerator, denominator):
-        try:
-            poly = sympy.Poly(part, s, domain="QQ")
-        except (sympy.PolynomialError, sympy.CoercionFailed, sympy.GeneratorsNeeded):
-            return False
-        if poly.is_zero:
-            return part is numerator  # f = 0
-        sign = _sign_for_positive(poly)
-        if sign is None:
-            return False
-        signs.append(sign)
-    return signs[0] * signs[1] > 0
-
-
-def _undominated(branches: list[sympy.Expr]) -> list[sympy.Expr]:
-    """Drop every branch that another is proved not to exceed for all positive gains.
-
-    ``Min(1, l/(1 + l²))`` is ``l/(1 + l²)`` (``1 - l/(1 + l²) = (l² - l + 1)/(1 + l²)``);
-    branches in several gains, or with pieces, are kept as they are.
-    """
-    kept = list(branches)
-    for branch in branches:
-        if isinstance(branch, sympy.Piecewise):
-            continue
-        others = [b for b in kept if b is not branch and not isinstance(b, sympy.Piecewise)]
-        if any(_nonnegative_for_positive(branch - other) for other in others):
-            kept.remove(branch)
-    return kept
 
 
 def _top_eig(A: Any, B: Any) -> tuple[float, Any]:

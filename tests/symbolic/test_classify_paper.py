@@ -216,6 +216,25 @@ def test_unbounded_when_rhs_vanishes(beam):
     assert cert.minimizer() is None
 
 
+def test_the_unobserved_traces_are_found_once_per_error_system(beam, monkeypatch):
+    # The decision reads the traces K n_c over ker C_m, which depend on the error system
+    # alone: the 14 variants of one classify share them.  A witness is the same trace
+    # whichever variant asks first (sensors 3, 4 leave e2(0) free: v[5] = -1 above).
+    import phdesign.symbolic.certificate as certificate
+
+    es = ObserverDesign(beam, sensor_matrix([3, 4], 4), sympy.eye(2)).error_system()
+    certificate._unobserved_traces.cache_clear()
+    calls = []
+    nullspace = certificate._nullspace
+    monkeypatch.setattr(certificate, "_nullspace", lambda M: calls.append(M) or nullspace(M))
+    first = certify(es, [5])
+    again = certify(es, [4, 5, 6])
+    assert len(calls) == 1
+    assert not first.holds and not again.holds
+    assert first.witness == again.witness
+    assert first.free == (5,) and again.free == (5,)  # e1(0), e1'(0) vanish on K
+
+
 # ----------------------------------------------------------------- other models
 @pytest.mark.parametrize(("sensor", "variant"), [(1, 1), (2, 2)])
 def test_wave_damper_at_either_end_is_exponential(sensor, variant):

@@ -167,7 +167,7 @@ def test_dropping_a_dominated_kappa_branch_needs_a_proof_not_a_guess():
     # the reviewer's counterexamples: real roots that sympy.roots writes in Cardano form
     # (three real roots of g^3 - 3g + 1, two positive) were missed by a filter on real
     # roots, and a sign change on g > 0 passed for a constant sign
-    from phdesign.symbolic.certificate import _nonnegative_for_positive, _undominated
+    from phdesign.symbolic.gain_kappa import _nonnegative_for_positive, _undominated
 
     g = sympy.Symbol("l", positive=True)
     assert not _nonnegative_for_positive(-(g**3 - 3 * g + 1))  # -3 at g = 2
@@ -193,7 +193,7 @@ def test_a_proved_sign_holds_at_every_positive_point_tried(num, den):
     # soundness of the domination proof: whenever f = p/q is proved >= 0 on g > 0, it is
     # >= 0 (to round-off) on a log grid of (1e-3, 1e3) and at every positive real root of
     # p and q nudged by 1e-6 either side, where a missed sign change would show
-    from phdesign.symbolic.certificate import _nonnegative_for_positive
+    from phdesign.symbolic.gain_kappa import _nonnegative_for_positive
 
     g = sympy.Symbol("l", positive=True)
     p = sum(c * g**k for k, c in enumerate(num))
