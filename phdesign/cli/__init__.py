@@ -32,16 +32,25 @@ from phdesign.core.errors import ModelError, ModelFileError, PhdesignError, Port
 
 __all__ = ["build_parser", "main", "run"]
 
-#: Command modules, in the order their commands appear in ``phdesign --help``.
-COMMAND_MODULES = (
-    "phdesign.cli.model_commands",
-    "phdesign.cli.classify_command",
-    "phdesign.cli.numeric_commands",
-    "phdesign.cli.noise_commands",
-    "phdesign.cli.export_command",
-    "phdesign.cli.loop_command",
-    "phdesign.cli.sweep_command",
-)
+#: The module that registers each command, in the order of ``phdesign --help``.  A run
+#: of one command builds only its own module's parsers (argparse's option tables of the
+#: other commands are a tenth of ``phdesign ports``'s start); help and unknown commands
+#: build them all.
+COMMAND_MODULES = {
+    "models": "phdesign.cli.model_commands",
+    "show": "phdesign.cli.model_commands",
+    "ports": "phdesign.cli.model_commands",
+    "classify": "phdesign.cli.classify_command",
+    "spectrum": "phdesign.cli.numeric_commands",
+    "simulate": "phdesign.cli.numeric_commands",
+    "tune": "phdesign.cli.numeric_commands",
+    "noise": "phdesign.cli.noise_commands",
+    "tradeoff": "phdesign.cli.noise_commands",
+    "export": "phdesign.cli.export_command",
+    "loop": "phdesign.cli.loop_command",
+    "sweep": "phdesign.cli.sweep_command",
+    "plot": "phdesign.cli.sweep_command",
+}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -90,8 +99,12 @@ class _UsageError(Exception):
     pass
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """Return the parser with every available command registered."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """Return the parser with every available command registered.
+
+    With ``command`` (a key of :data:`COMMAND_MODULES`) only the module that registers it
+    is imported and registered: the parser of a run of that command.
+    """
     parser = _Parser(
         prog="phdesign",
         description="Boundary observers for boundary-controlled port-Hamiltonian systems.",
@@ -101,7 +114,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"phdesign {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     subparsers.required = True
-    for name in COMMAND_MODULES:
+    if command in COMMAND_MODULES:
+        names = [COMMAND_MODULES[command]]
+    else:
+        names = list(dict.fromkeys(COMMAND_MODULES.values()))
+    for name in names:
         try:
             module = importlib.import_module(name)
         except ModuleNotFoundError as error:
@@ -125,8 +142,9 @@ def main(argv: Sequence[str] | None = None, *, reraise: bool = False) -> int:
     """
     messages.use({})
     try:
-        parser = build_parser()
-        args = parser.parse_args(None if argv is None else list(argv))
+        arguments = sys.argv[1:] if argv is None else list(argv)
+        parser = build_parser(arguments[0] if arguments else None)
+        args = parser.parse_args(arguments)
         messages.use(messages.option_table(parser, args))
         with progress_display(args):  # the stages of a long run, on a terminal's stderr
             return int(args.handler(args) or 0)

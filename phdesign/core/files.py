@@ -37,7 +37,6 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
-import secrets
 import signal
 import stat
 import threading
@@ -339,8 +338,10 @@ def remove_stale_temporaries(folder: Path, now: float | None = None) -> int:
 
 
 def _create_temporary(folder: Path, target: Path) -> Path:
+    # os.urandom is what secrets.token_hex reads; the secrets module would bring hashlib
+    # and hmac into every command's start-up
     for _ in range(100):
-        temporary = folder / f"{TEMPORARY_PREFIX}{secrets.token_hex(4)}{TEMPORARY_SUFFIX}"
+        temporary = folder / f"{TEMPORARY_PREFIX}{os.urandom(4).hex()}{TEMPORARY_SUFFIX}"
         _LIVE.add(temporary)
         try:
             os.close(os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))

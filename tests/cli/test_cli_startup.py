@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import ast
 import subprocess
 import sys
 
-from phdesign.cli import build_parser
+from phdesign.cli import COMMAND_MODULES, build_parser
 
 # Packages that ``ports`` and ``classify`` never need: the sweep (its job registry gives
 # ``sweep`` its options only when that command is parsed), the figures, generated code
@@ -37,3 +38,36 @@ def test_the_sweep_options_are_added_when_sweep_is_used():
     assert "--job {classify,spectrum}" in help_text
     args = parser.parse_args(["sweep", "wave", "-o", "m.csv", "--tol", "-1e-3"])
     assert (args.job, args.option_tol) == ("spectrum", -1e-3)  # a negative value is taken
+
+
+def _commands(parser) -> dict:
+    return next(a for a in parser._actions if a.dest == "command").choices
+
+
+def test_the_command_table_names_the_module_that_registers_each_command():
+    # the full parser's commands, in help order, are exactly the table's keys
+    assert list(_commands(build_parser())) == list(COMMAND_MODULES)
+    for command, module in COMMAND_MODULES.items():
+        alone = _commands(build_parser(command))
+        siblings = [c for c, m in COMMAND_MODULES.items() if m == module]
+        assert list(alone) == siblings, command  # its module's commands and no other's
+
+
+def test_a_run_builds_only_its_own_commands_and_parses_as_the_full_parser():
+    argv = ["classify", "wave", "--sensors", "2", "--gain", "0.5"]
+    assert (
+        vars(build_parser("classify").parse_args(argv)).keys()
+        == vars(build_parser().parse_args(argv)).keys()
+    )
+    probe = (
+        "import contextlib, io, sys\n"
+        "from phdesign.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    assert main(['ports', 'wave', '--json']) == 0\n"
+        "print(sorted(m for m in sys.modules if m.startswith('phdesign.cli.')))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    loaded = ast.literal_eval(out.stdout)
+    assert "phdesign.cli.model_commands" in loaded
+    assert not {"phdesign.cli.numeric_commands", "phdesign.cli.loop_command"} & set(loaded)
