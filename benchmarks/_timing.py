@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -26,21 +27,27 @@ def load() -> str:
 
 
 def interleaved(
-    commands: Mapping[str, Sequence[str]], rounds: int = 7, warmup: int = 1
+    commands: Mapping[str, Sequence[str]], rounds: int = 7, warmup: int = 1, cpu: bool = False
 ) -> dict[str, list[float]]:
-    """Wall-clock seconds of each command as a fresh process, in interleaved rounds.
+    """Seconds of each command as a fresh process, in interleaved rounds.
 
     Each round runs every command once (A B A B ...), so that a drift of the machine's
-    speed touches all alike; the first ``warmup`` rounds are not counted.
+    speed touches all alike; the first ``warmup`` rounds are not counted.  Wall-clock
+    seconds, or with ``cpu`` the process's user + system seconds (less sensitive to the
+    other processes of a loaded machine).
     """
     env = fresh_environment()
     timings: dict[str, list[float]] = {name: [] for name in commands}
     for index in range(warmup + rounds):
         for name, argv in commands.items():
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
             start = time.perf_counter()
             subprocess.run(argv, check=True, capture_output=True, env=env)
+            wall = time.perf_counter() - start
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            used = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
             if index >= warmup:
-                timings[name].append(time.perf_counter() - start)
+                timings[name].append(used if cpu else wall)
     return timings
 
 
