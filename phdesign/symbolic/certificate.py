@@ -237,7 +237,8 @@ def _numeric_kappa(
             "use method='float'"
         )
     exact_path = method in ("auto", "exact") and affordable
-    if exact_path and (size := _root_size(_characteristic(A_r, B_r))) is not None:
+    characteristic = _characteristic(A_r, B_r) if exact_path else None
+    if characteristic is not None and (size := _root_size(characteristic)) is not None:
         # isolating roots factors integers (and polynomials in e or pi) of this size: 598 bits
         # took 55 s, exp(100) (degree 200 in e) 30 s; the float path scales them instead
         if method == "exact":
@@ -246,8 +247,8 @@ def _numeric_kappa(
                 "phdesign.core.limits.EXACT_KAPPA_BITS and EXACT_KAPPA_DEGREE); use method='float'"
             )
         exact_path = False
-    if exact_path:
-        exact = _exact_kappa(A_r, B_r)
+    if exact_path and characteristic is not None:
+        exact = _exact_kappa(characteristic)
         if exact is not None:
             return Certificate(
                 True, exact, _as_float(exact), False, None, (), "exact", None, pencil
@@ -361,9 +362,11 @@ def _equilibrated(
     return sympy.ImmutableMatrix(D * A_r * D), sympy.ImmutableMatrix(D * B_r * D)
 
 
-def _exact_kappa(A_r: sympy.MatrixBase, B_r: sympy.MatrixBase) -> sympy.Expr | None:
-    r"""Exact :math:`1/\mu_{\max}`, or ``None`` if the roots cannot be isolated exactly."""
-    poly = _characteristic(A_r, B_r)
+def _exact_kappa(poly: sympy.Poly) -> sympy.Expr | None:
+    r"""Exact :math:`1/\mu_{\max}` from the pencil's characteristic polynomial ``poly``.
+
+    ``None`` if its roots cannot be isolated exactly.
+    """
     try:
         roots = sympy.real_roots(poly)
     except (sympy.PolynomialError, NotImplementedError, sympy.DomainError):

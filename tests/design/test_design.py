@@ -440,7 +440,7 @@ def test_library_raises_no_plain_value_errors(beam, monkeypatch):
 
     with pytest.raises(ObserverError, match="method must be one of 'auto', 'exact', 'float'"):
         phd.classify(beam, phd.sensor_matrix([4], 4), 1, method="bogus")
-    monkeypatch.setattr(certificate, "_exact_kappa", lambda A, B: None)  # no closed form
+    monkeypatch.setattr(certificate, "_exact_kappa", lambda poly: None)  # no closed form
     with pytest.raises(ObserverError, match="method='exact': no exact root"):
         phd.classify(beam, phd.sensor_matrix([4], 4), 1, method="exact")
     with pytest.raises(ObserverError, match="needs the partition"):
