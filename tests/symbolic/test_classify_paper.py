@@ -230,9 +230,11 @@ def test_the_unobserved_traces_are_found_once_per_error_system(beam, monkeypatch
     first = certify(es, [5])
     again = certify(es, [4, 5, 6])
     assert len(calls) == 1
-    assert not first.holds and not again.holds
+    assert not first.holds
+    assert not again.holds
     assert first.witness == again.witness
-    assert first.free == (5,) and again.free == (5,)  # e1(0), e1'(0) vanish on K
+    assert first.free == (5,)
+    assert again.free == (5,)  # e1(0), e1'(0) vanish on K
 
 
 # ----------------------------------------------------------------- other models
