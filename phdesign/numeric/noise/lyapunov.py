@@ -114,35 +114,86 @@ class TriangularPencil:
         r"""Largest singular value of the energy-norm frequency response at each ``omega``.
 
         :math:`\sigma_{\max}(R (i\omega S - T)^{-1} H)`, vectorized over the frequencies by
-        one back substitution on the triangular pencil.
+        one back substitution on the triangular pencil (:func:`_shifted_back_substitution`).
         """
         w = np.atleast_1d(np.asarray(omega, dtype=float))
         n, m = self.H.shape
         if n == 0 or m == 0:
             return np.zeros(w.size)
         # columns of Y: (input channel, frequency) pairs, frequency fastest
-        s = np.tile(1j * w, m)
-        H = np.repeat(self.H, w.size, axis=1)
-        Y = np.empty((n, m * w.size), dtype=complex)
-        for i in range(n - 1, -1, -1):
-            rhs = H[i] + self.T[i, i + 1 :] @ Y[i + 1 :] - s * (self.S[i, i + 1 :] @ Y[i + 1 :])
-            Y[i] = rhs / (s * self.S[i, i] - self.T[i, i])
+        Y = _shifted_back_substitution(self.T, None if self.whitened else self.S, self.H, w)
         if self.energy_map is not None:
             Y = self.energy_map @ Y
-        Y3 = Y.reshape(n, m, w.size)
-        gram = np.einsum("kaw,kbw->wab", Y3.conj(), Y3)
-        top = np.linalg.eigvalsh(gram)[:, -1]
-        return np.sqrt(np.maximum(top, 0.0))
+        top = _largest_gram_eigenvalues(Y.reshape(n, m, w.size))
+        return np.asarray(np.sqrt(np.maximum(top, 0.0)))
 
     def response_at(self, omega: float) -> float:
         """:meth:`response` at one frequency, by one LAPACK triangular solve."""
         if self.H.size == 0:
             return 0.0
-        Y = sl.solve_triangular(1j * omega * self.S - self.T, self.H, check_finite=False)
+        if self.whitened:  # S is the identity: i omega on the diagonal only
+            shifted = -self.T
+            shifted.flat[:: shifted.shape[0] + 1] += 1j * omega
+        else:
+            shifted = 1j * omega * self.S - self.T
+        Y = sl.solve_triangular(shifted, self.H, check_finite=False)
         if self.energy_map is not None:
             Y = self.energy_map @ Y
         # sigma_max from the small Gram matrix (one column per noise channel)
         return float(np.sqrt(max(np.linalg.eigvalsh(Y.conj().T @ Y)[-1], 0.0)))
+
+
+def _largest_gram_eigenvalues(Y: np.ndarray) -> np.ndarray:
+    r"""Largest eigenvalue of :math:`Y_w^* Y_w` for each frequency w (``Y``: (n, m, w)).
+
+    One or two channels in closed form, :math:`\tfrac12(a + b) + \sqrt{\tfrac14(a - b)^2
+    + |c|^2}` for the Gram matrix [[a, c], [c̄, b]]; more by a batched eigensolve.
+    """
+    m = Y.shape[1]
+    if m <= 2:
+        a = np.sum(Y[:, 0].real ** 2 + Y[:, 0].imag ** 2, axis=0)
+        if m == 1:
+            return np.asarray(a)
+        b = np.sum(Y[:, 1].real ** 2 + Y[:, 1].imag ** 2, axis=0)
+        c = np.sum(Y[:, 0].conj() * Y[:, 1], axis=0)
+        return np.asarray(0.5 * (a + b) + np.sqrt(0.25 * (a - b) ** 2 + np.abs(c) ** 2))
+    gram = np.einsum("kaw,kbw->wab", Y.conj(), Y)
+    return np.asarray(np.linalg.eigvalsh(gram)[:, -1])
+
+
+#: Rows per block of :func:`_shifted_back_substitution` (its updates are matrix products).
+_BLOCK = 16
+
+
+def _shifted_back_substitution(
+    T: np.ndarray, S: np.ndarray | None, H: np.ndarray, omega: np.ndarray
+) -> np.ndarray:
+    r"""Solve :math:`(i\omega_k S - T) Y_{jk} = H_j` for every channel j and frequency k.
+
+    T and S upper triangular (``S=None``: the identity, the whitened path); the columns
+    of the result are (channel, frequency) pairs, frequency fastest.  Every column has its
+    own shift, so the diagonal blocks are solved row by row; the off-diagonal blocks of
+    T and S are the same for every column, and their updates are matrix products over
+    all columns at once (BLAS 3).
+    """
+    n, m = H.shape
+    s = np.tile(1j * omega, m)
+    Y = np.repeat(H.astype(complex), omega.size, axis=1)  # right-hand sides, then Y
+    diagonal = np.diag(T)
+    scale = np.ones(n, dtype=complex) if S is None else np.diag(S)
+    for stop in range(n, 0, -_BLOCK):
+        start = max(stop - _BLOCK, 0)
+        if stop < n:
+            Y[start:stop] += T[start:stop, stop:] @ Y[stop:]
+            if S is not None:
+                Y[start:stop] -= s * (S[start:stop, stop:] @ Y[stop:])
+        for i in range(stop - 1, start - 1, -1):
+            if i + 1 < stop:
+                Y[i] += T[i, i + 1 : stop] @ Y[i + 1 : stop]
+                if S is not None:
+                    Y[i] -= s * (S[i, i + 1 : stop] @ Y[i + 1 : stop])
+            Y[i] /= s * scale[i] - diagonal[i]
+    return Y
 
 
 def triangularize(
