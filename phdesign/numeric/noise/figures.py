@@ -53,7 +53,8 @@ inside its resolution as the fine member is at Ω.  Peaks within the tolerance o
 largest are equal, and the lowest-frequency one is reported with its frequency: the damped
 wave's response has equal peaks at infinitely many frequencies (one per resonance), and
 the first is both the PDE's answer and the one a discretization resolves best.
-The discretization's own supremum over all frequencies is reported beside it.
+The discretization's own supremum over all frequencies (a sweep of the whole band) is
+reported beside it, unless ``discrete_sup=False`` (the trade-off's points).
 """
 
 from __future__ import annotations
@@ -74,7 +75,7 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_noise_intensity
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
-from phdesign.numeric.noise.gain import discrete_sup, gain_pair
+from phdesign.numeric.noise.gain import PeakSearch, gain_pair
 from phdesign.numeric.noise.metrics import ErrorEnergy, Metric, OutputVariance
 from phdesign.numeric.noise.report import GainEstimate, NoiseReport
 from phdesign.numeric.noise.settle import Estimate, settle
@@ -163,6 +164,7 @@ def noise(
     tol: float | None = None,
     discretizations: MutableMapping[int, DiscretePHS] | None = None,
     metrics: Sequence[Metric] = (),
+    discrete_sup: bool = True,
 ) -> NoiseReport:
     r"""Noise figures of an observer, each with its verdict under refinement.
 
@@ -194,6 +196,10 @@ def noise(
     metrics : sequence of Metric, optional
         Further figures, one number per resolution each (:mod:`phdesign.numeric.noise.metrics`:
         a new figure is one class), judged like the others and reported in ``figures``.
+    discrete_sup : bool, optional
+        Also report the discretization's own supremum over all frequencies
+        (``l2_gain.discrete``, and the warning when it exceeds the banded gain): a sweep of
+        the whole band at every resolution.  The trade-off leaves it out.
 
     Returns
     -------
@@ -233,7 +239,7 @@ def noise(
             )
     cache = discretizations if discretizations is not None else {}
 
-    run = _Refinement(functionals, tuple(metrics), tol)
+    run = _Refinement(functionals, tuple(metrics), tol, discrete=discrete_sup)
     while True:
         report(f"noise: resolution {p}")
         if p not in cache:
@@ -254,21 +260,32 @@ class _Refinement:
     is computed per pair of resolutions.
     """
 
-    def __init__(self, functionals: Sequence[Functional], extra: tuple[Metric, ...], tol: float):
+    def __init__(
+        self,
+        functionals: Sequence[Functional],
+        extra: tuple[Metric, ...],
+        tol: float,
+        discrete: bool = True,
+    ):
         self.outputs = tuple(OutputVariance(functional=f) for f in functionals)
         self.metrics = (*self.outputs, ErrorEnergy(), *extra)
         self.tol = tol
+        self.discrete = discrete
         self.stats: list[ErrorStatistics] = []
+        self.searches: list[PeakSearch] = []
         self.values: list[list[float]] = []
         self.sups: list[tuple[float, float]] = []
         self.pairs: list[dict[str, Any]] = []
 
     def add(self, stats: ErrorStatistics, rtol: float) -> None:
+        search = PeakSearch(stats)  # its refined peaks serve both pairs of this resolution
         self.stats.append(stats)
+        self.searches.append(search)
         self.values.append([m.value(stats) for m in self.metrics])
-        self.sups.append(discrete_sup(stats) if stats.stable else (math.inf, math.nan))
+        if self.discrete:
+            self.sups.append(search.discrete() if stats.stable else (math.inf, math.nan))
         if len(self.stats) >= 2:
-            self.pairs.append(gain_pair(self.stats[-2], stats, rtol, self.tol))
+            self.pairs.append(gain_pair(self.searches[-2], search, rtol, self.tol))
 
     @property
     def steady(self) -> bool:
@@ -295,10 +312,13 @@ class _Refinement:
         res = self.resolutions
         if not self.steady:
             return GainEstimate.missing(res)
-        discrete = settle("discrete sup", [v for v, _ in self.sups], res, self.tol)
+        discrete, discrete_frequency = None, None
+        if self.sups:
+            discrete = settle("discrete sup", [v for v, _ in self.sups], res, self.tol)
+            discrete_frequency = self.sups[-1][1]
         banded = [pr for pr in self.pairs if pr.get("band") is not None]
         if not banded:
-            return GainEstimate.missing(res, discrete, self.sups[-1][1])
+            return GainEstimate.missing(res, discrete, discrete_frequency)
         last = banded[-1]
         estimate = settle(
             "gamma",
@@ -316,7 +336,7 @@ class _Refinement:
             frequencies=tuple(pr["fine"][1] for pr in banded),
             band=last["band"],
             discrete=discrete,
-            discrete_frequency=self.sups[-1][1],
+            discrete_frequency=discrete_frequency,
         )
 
     def done(self) -> bool:

@@ -5,8 +5,17 @@ of the noise-driven error system (:mod:`phdesign.numeric.noise.statistics`), tak
 the *resolved band* :math:`|\omega| \le \Omega` of a pair of resolutions (the largest
 modulus of an eigenvalue they agree on), because the unresolved high frequencies of a
 discretization lose the boundary damping (:mod:`phdesign.numeric.noise.figures`).
-:func:`peak_gain` finds a response's peak; :func:`gain_pair` the pair's banded peaks;
-:func:`discrete_sup` the discretization's own supremum over all frequencies.
+
+The response of a stable system peaks at its resonances (an eigenvalue λ gives a peak
+near :math:`\omega = |\operatorname{Im}\lambda|`, of half-power width
+:math:`|\operatorname{Re}\lambda|`), at :math:`\omega = 0` or at the end of the range.  So
+:func:`peak_gain` evaluates the response at those frequencies (one vectorized back
+substitution), brackets each local maximum between its neighbours and refines it by a
+bounded scalar search (Brent).  The banded gain (:func:`gain_pair`) needs no more than
+that; the discretization's own supremum over *all* frequencies (:func:`discrete_sup`, a
+diagnostic that the report prints and warns with) adds log- and linearly spaced points,
+a sweep of the whole band.  :class:`PeakSearch` keeps the refined peaks of one
+resolution, so the two pairs a resolution belongs to share them.
 """
 
 from __future__ import annotations
@@ -20,10 +29,42 @@ from scipy.optimize import minimize_scalar
 from phdesign.numeric.noise.statistics import ErrorStatistics
 from phdesign.numeric.spectrum.drift import match_resolved
 
-__all__ = ["discrete_sup", "gain_pair", "peak_gain"]
+__all__ = ["PeakSearch", "discrete_sup", "frequency_grid", "gain_pair", "peak_gain"]
 
 #: Grid maxima this far (relative) below the largest peak are not refined as its ties.
 _TIE_SCREEN = 1e-2
+#: Without the sweep, local maxima of the resonance grid below this fraction of its
+#: highest value are not refined: a resonance's grid value (at ω = |Im λ| and its
+#: half-power neighbours) is within a factor √2 of its peak.
+_RESONANCE_SCREEN = 0.5
+
+#: A refined peak: (gain, frequency), keyed by its bracket (low, grid point, high).
+Peaks = dict[tuple[float, float, float], tuple[float, float]]
+
+
+def frequency_grid(upper: float, eigenvalues: np.ndarray, sweep: bool = True) -> np.ndarray:
+    """Return the frequencies in ``[0, upper]`` where :func:`peak_gain` starts.
+
+    0, ``upper``, and each eigenfrequency in range with its half-power neighbours
+    (ω ± |Re λ|); with ``sweep``, also 100 log- and 40 linearly spaced points.  Distinct
+    to round-off, increasing.
+    """
+    lam = eigenvalues[np.isfinite(eigenvalues)]
+    freqs = np.abs(lam.imag)
+    inside = freqs <= upper
+    width = np.abs(lam.real[inside])
+    hints = np.concatenate([freqs[inside], freqs[inside] + width, freqs[inside] - width])
+    parts = [np.array([0.0, upper]), hints]
+    if sweep:
+        parts += [
+            np.geomspace(max(upper * 1e-6, 1e-12), upper, 100) if upper > 0 else np.array([]),
+            np.linspace(0.0, upper, 40),
+        ]
+    grid = np.concatenate(parts)
+    grid = np.unique(grid[(grid >= 0) & (grid <= upper)])
+    # conjugate eigenvalues give frequencies equal to round-off: one grid point each, or a
+    # local maximum would be bracketed by its own twin
+    return grid[np.r_[True, np.diff(grid) > 1e-12 * np.maximum(1.0, grid[1:])]]
 
 
 def peak_gain(
@@ -34,14 +75,18 @@ def peak_gain(
     refine: int = 3,
     rtol: float = 1e-7,
     ties: float = 0.0,
+    *,
+    sweep: bool = True,
+    peaks: Peaks | None = None,
 ) -> tuple[float, float]:
     """Return ``(gain, frequency)``: the largest ``response`` over ``0 <= omega <= upper``.
 
-    A sweep over 0, the eigenfrequencies in range and their half-power neighbours
-    (ω ± |Re λ|), and log- and linearly spaced points, then a bounded scalar refinement
-    (Brent, to ``rtol`` in ω: the peak value is then exact to about ``rtol``²
-    relative to the peak's width) of the ``refine`` highest local maxima between their
-    grid neighbours.
+    The response at :func:`frequency_grid` (``sweep``: with the whole band's spaced
+    points), then a bounded scalar refinement (Brent, to ``rtol`` in ω: the peak value
+    is then exact to about ``rtol``² relative to the peak's width) of the ``refine``
+    highest local maxima between their grid neighbours; without ``sweep``, of those at
+    least half the highest grid value.  ``peaks`` keeps the refinements by bracket, to be
+    shared by the searches of one response.
 
     With ``ties > 0``, peaks within ``ties`` (relative) of the largest are equal: the
     lowest-frequency one is returned, with its own value.  A PDE whose response has equal
@@ -49,26 +94,11 @@ def peak_gain(
     supremum at the first; a discretization resolves that one best, while the highest it
     happens to find may lie at the edge of what it resolves.
     """
-    lam = eigenvalues[np.isfinite(eigenvalues)]
-    freqs = np.abs(lam.imag)
-    inside = freqs <= upper
-    width = np.abs(lam.real[inside])
-    hints = np.concatenate([freqs[inside], freqs[inside] + width, freqs[inside] - width])
-    grid = np.concatenate(
-        [
-            [0.0, upper],
-            hints,
-            np.geomspace(max(upper * 1e-6, 1e-12), upper, 100) if upper > 0 else [],
-            np.linspace(0.0, upper, 40),
-        ]
-    )
-    grid = np.unique(grid[(grid >= 0) & (grid <= upper)])
-    # conjugate eigenvalues give frequencies equal to round-off: one grid point each, or a
-    # local maximum would be bracketed by its own twin
-    grid = grid[np.r_[True, np.diff(grid) > 1e-12 * np.maximum(1.0, grid[1:])]]
+    grid = frequency_grid(upper, eigenvalues, sweep)
     values = response(grid)
     interior = np.r_[True, values[1:] >= values[:-1]] & np.r_[values[:-1] >= values[1:], True]
     maxima = np.flatnonzero(interior)
+    memo: Peaks = {} if peaks is None else peaks
 
     def refined(k: int) -> tuple[float, float]:
         """Return the local maximum bracketed by the grid neighbours of point ``k``."""
@@ -76,17 +106,22 @@ def peak_gain(
         lo, hi = float(grid[max(k - 1, 0)]), float(grid[min(k + 1, grid.size - 1)])
         if hi <= lo:
             return point
-        found = minimize_scalar(
-            lambda w: -response_at(float(w)),
-            bounds=(lo, hi),
-            method="bounded",
-            options={"xatol": rtol * max(1.0, hi)},
-        )
-        return max(point, (-float(found.fun), float(found.x)))
+        key = (lo, point[1], hi)
+        if key not in memo:
+            found = minimize_scalar(
+                lambda w: -response_at(float(w)),
+                bounds=(lo, hi),
+                method="bounded",
+                options={"xatol": rtol * max(1.0, hi)},
+            )
+            memo[key] = (-float(found.fun), float(found.x))
+        return max(point, memo[key])
 
     highest = maxima[np.argsort(-values[maxima])[:refine]]
-    peaks = {int(k): refined(int(k)) for k in highest}
-    best = max(peaks.values())
+    if not sweep:
+        highest = highest[values[highest] >= _RESONANCE_SCREEN * values[highest[0]]]
+    found = {int(k): refined(int(k)) for k in highest}
+    best = max(found.values())
     if ties <= 0:
         return best
     # the lowest-frequency peak within `ties` of the largest; grid values are lower
@@ -97,19 +132,49 @@ def peak_gain(
             break
         if values[k] < (1.0 - _TIE_SCREEN) * best[0]:
             continue
-        peak = peaks.get(k) or refined(k)
+        peak = found.get(k) or refined(k)
         if peak[0] >= threshold:
             return peak
     return best
 
 
-def _sup(
-    stats: ErrorStatistics, upper: float, refine: int = 3, ties: float = 0.0
-) -> tuple[float, float]:
-    pencil = stats.pencil
-    return peak_gain(
-        pencil.response, pencil.response_at, upper, stats.eigenvalues, refine, ties=ties
-    )
+class PeakSearch:
+    """The peaks of one resolution's response, each refined once (module docstring).
+
+    Parameters
+    ----------
+    stats : ErrorStatistics
+        The stable error system at one resolution.
+    """
+
+    def __init__(self, stats: ErrorStatistics) -> None:
+        self.stats = stats
+        self.peaks: Peaks = {}
+
+    def banded(self, upper: float, ties: float) -> tuple[float, float]:
+        """Return the peak over ``|ω| <= upper``, from the resonances (no sweep)."""
+        return self._peak(upper, ties=ties, sweep=False)
+
+    def discrete(self) -> tuple[float, float]:
+        """Return the supremum over all frequencies: a sweep up to twice the top eigenvalue."""
+        lam = self.stats.eigenvalues
+        top = float(np.max(np.abs(lam[np.isfinite(lam)]))) if lam.size else 1.0
+        return self._peak(2.0 * top, refine=1, sweep=True)
+
+    def _peak(
+        self, upper: float, refine: int = 3, ties: float = 0.0, sweep: bool = False
+    ) -> tuple[float, float]:
+        pencil = self.stats.pencil
+        return peak_gain(
+            pencil.response,
+            pencil.response_at,
+            upper,
+            self.stats.eigenvalues,
+            refine,
+            ties=ties,
+            sweep=sweep,
+            peaks=self.peaks,
+        )
 
 
 def _resolved_band(fine: ErrorStatistics, coarse: ErrorStatistics, rtol: float) -> float | None:
@@ -118,7 +183,10 @@ def _resolved_band(fine: ErrorStatistics, coarse: ErrorStatistics, rtol: float) 
 
 
 def gain_pair(
-    coarse: ErrorStatistics, fine: ErrorStatistics, rtol: float, tol: float
+    coarse: ErrorStatistics | PeakSearch,
+    fine: ErrorStatistics | PeakSearch,
+    rtol: float,
+    tol: float,
 ) -> dict[str, Any]:
     r"""Return the fine member's peak over the pair's resolved band, and its check.
 
@@ -130,21 +198,22 @@ def gain_pair(
     (near the edge its response lags its eigenvalues: the tails of the unresolved
     resonances just above).  Peaks within ``tol`` of the largest count as equal and the
     lowest-frequency one is taken (:func:`peak_gain`): the figure cannot tell them apart,
-    and the first is the one both members resolve best.
+    and the first is the one both members resolve best.  Give each member's
+    :class:`PeakSearch` to share its refined peaks with its other pair.
     """
-    out: dict[str, Any] = {"resolution": fine.resolution, "band": None}
-    if not (coarse.stable and fine.stable):
+    low = coarse if isinstance(coarse, PeakSearch) else PeakSearch(coarse)
+    high = fine if isinstance(fine, PeakSearch) else PeakSearch(fine)
+    out: dict[str, Any] = {"resolution": high.stats.resolution, "band": None}
+    if not (low.stats.stable and high.stats.stable):
         return out
-    band = _resolved_band(fine, coarse, rtol)
+    band = _resolved_band(high.stats, low.stats, rtol)
     out["band"] = band
     if band is not None:
-        out["fine"] = _sup(fine, band, ties=tol)
-        out["coarse"] = _sup(coarse, band * coarse.resolution / fine.resolution, ties=tol)
+        out["fine"] = high.banded(band, tol)
+        out["coarse"] = low.banded(band * low.stats.resolution / high.stats.resolution, tol)
     return out
 
 
-def discrete_sup(stats: ErrorStatistics) -> tuple[float, float]:
+def discrete_sup(stats: ErrorStatistics | PeakSearch) -> tuple[float, float]:
     """Supremum of the discretization's response over all frequencies (a diagnostic)."""
-    lam = stats.eigenvalues
-    top = float(np.max(np.abs(lam[np.isfinite(lam)]))) if lam.size else 1.0
-    return _sup(stats, 2.0 * top, refine=1)
+    return (stats if isinstance(stats, PeakSearch) else PeakSearch(stats)).discrete()

@@ -39,11 +39,15 @@ import math
 
 import numpy as np
 import pytest
+from numeric_models import PAPER_SENSORS, numeric
 
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
+from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.noise.figures import noise
+from phdesign.numeric.noise.gain import PeakSearch, peak_gain
 from phdesign.numeric.noise.settle import settle
+from phdesign.numeric.noise.statistics import error_statistics
 
 K_DAMPER, L_SENSOR = 0.5, 2.0
 
@@ -109,3 +113,53 @@ def test_wave_gain_reports_the_first_of_its_equal_peaks(k, first_peak):
     assert gain.value == pytest.approx(max(1.0, k), rel=1e-10)  # tests/numeric/noise/test_noise.py
     # Brent locates the peak to 1e-7 relative in ω (peak_gain's rtol)
     assert gain.frequency == pytest.approx(first_peak, abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("name", "C", "L", "p"),
+    [
+        ("euler-bernoulli", [[0, 0, 1, 0], [0, 0, 0, 1]], [[0.1, 0], [0, 1]], 30),
+        ("timoshenko", [[0, 0, 1, 0], [0, 0, 0, 1]], [[1, 0], [0, 1]], 20),
+        ("airy", [[1, 0, 0]], [[1]], 12),  # the QZ path (E far from the identity)
+    ],
+)
+def test_banded_peak_from_the_resonances_is_the_swept_peak(name, C, L, p):
+    # the banded search starts from 0, the band's edge and the resonances ω = |Im λ| ± |Re λ|
+    # only; the whole band's log- and linearly spaced points add no peak it misses, and
+    # the refined value is the same to round-off (Brent's xatol of 1e-7 ω is 1e-14 in
+    # value at a smooth peak)
+    d = discretize(numeric(name), "galerkin", p)
+    stats = error_statistics(d, np.array(C, float), np.array(L, float), np.ones(len(C)))
+    pencil, lam = stats.pencil, stats.eigenvalues
+    band = float(np.sort(np.abs(lam))[lam.size // 3])  # a band holding a third of the spectrum
+    for ties in (0.0, 1e-6):
+        swept = peak_gain(pencil.response, pencil.response_at, band, lam, ties=ties)
+        found = PeakSearch(stats).banded(band, ties)
+        assert found[0] == pytest.approx(swept[0], rel=1e-13)
+        assert found[1] == pytest.approx(swept[1], rel=1e-6)
+
+
+def test_a_resolution_refines_each_peak_once_for_both_its_pairs(monkeypatch):
+    # resolutions 20, 30, 45: the pairs (20, 30) and (30, 45) both search 30, whose peak
+    # is refined once; the banded gain needs one refinement per resolution and the
+    # discretization's own supremum one more, and the trade-off's reports leave that out
+    from phdesign.numeric.noise import gain
+
+    calls = []
+    original = gain.minimize_scalar
+    monkeypatch.setattr(
+        gain, "minimize_scalar", lambda *a, **k: calls.append(1) or original(*a, **k)
+    )
+    beam, L = numeric("euler-bernoulli"), np.diag([0.1, 1.0])
+    report = noise(beam, PAPER_SENSORS, L, performance=[])
+    assert report.resolutions == (20, 30, 45)
+    assert report.l2_gain.converged
+    assert len(calls) == 3 + 3
+    calls.clear()
+    quiet = noise(beam, PAPER_SENSORS, L, performance=[], discrete_sup=False)
+    assert len(calls) == 3
+    assert quiet.l2_gain.discrete is None
+    assert report.l2_gain.discrete is not None
+    assert quiet.l2_gain.estimate == report.l2_gain.estimate
+    assert quiet.error_energy == report.error_energy
+    assert quiet.warnings == tuple(w for w in report.warnings if "beyond the resolved" not in w)
