@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from phdesign.core.defaults import method_or_default
 from phdesign.core.errors import NumericError
 from phdesign.core.limits import check_tradeoff_gains
 from phdesign.core.progress import stage
@@ -36,6 +37,7 @@ from phdesign.numeric.noise.figures import noise, sensor_rows
 from phdesign.numeric.noise.report import NoiseReport
 from phdesign.numeric.noise.settle import finite_or_none
 from phdesign.numeric.spectrum.converged import SpectrumReport, spectrum
+from phdesign.numeric.spectrum.refinement import Discretizations
 from phdesign.numeric.threads import limited_threads
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
@@ -351,7 +353,10 @@ def tradeoff(
         Per-sensor gain values; every combination is a diagonal gain (instead of a ray).
     intensity, input_intensity, performance, model, method
         As for :func:`phdesign.numeric.noise.figures.noise`; the first performance output is the
-        one traded against the decay rate.
+        one traded against the decay rate.  The points' noise reports leave out the
+        discretization's own supremum over all frequencies (``discrete_sup=False``: a
+        diagnostic of one design, a sweep of the whole band; ask
+        :func:`~phdesign.numeric.noise.figures.noise` for it).
 
     Returns
     -------
@@ -369,22 +374,7 @@ def tradeoff(
     gains, scale_list, L0 = gain_family(q, direction=direction, scales=scales, grid=grid)
     for L in gains:
         feedback_matrix(C, L, nm.n_ports)  # every gain valid before any work
-    cache: dict[int, DiscretePHS] = {}
-    rows = []
-    for i, (L, s) in enumerate(zip(gains, scale_list, strict=True), start=1):
-        with stage(f"tradeoff: gain {i} of {len(gains)}"):
-            spec = spectrum(nm, C, L, method=method)
-            rep = noise(
-                nm,
-                C,
-                L,
-                intensity=intensity,
-                input_intensity=input_intensity,
-                performance=functionals,
-                method=method,
-                discretizations=cache,
-            )
-        rows.append((L, s, spec, rep))
+    rows = _figures(nm, C, gains, scale_list, method, functionals, intensity, input_intensity)
     points = _points(rows)
     warnings = []
     missing = sum(1 for point in points if point.noise.rms() is None)
@@ -404,6 +394,40 @@ def tradeoff(
         output_labels=nm.output_labels,
         warnings=tuple(warnings),
     )
+
+
+def _figures(
+    nm: NumericModel,
+    C: np.ndarray,
+    gains: list[np.ndarray],
+    scales: list[float | None],
+    method: str | None,
+    functionals: Sequence[Functional],
+    intensity: Any,
+    input_intensity: Any,
+) -> list[tuple[np.ndarray, float | None, SpectrumReport, NoiseReport]]:
+    """Return the spectrum and the noise figures at every gain, on shared discretizations."""
+    # the discretizations do not depend on the gain: built once, for every gain
+    method = method_or_default(method)
+    cache: dict[int, DiscretePHS] = {}
+    shared = Discretizations(nm, method)
+    rows = []
+    for i, (L, s) in enumerate(zip(gains, scales, strict=True), start=1):
+        with stage(f"tradeoff: gain {i} of {len(gains)}"):
+            spec = spectrum(nm, C, L, method=method, discretizations=shared)
+            rep = noise(
+                nm,
+                C,
+                L,
+                intensity=intensity,
+                input_intensity=input_intensity,
+                performance=functionals,
+                method=method,
+                discretizations=cache,
+                discrete_sup=False,  # the report's diagnostic, not a figure of the trade-off
+            )
+        rows.append((L, s, spec, rep))
+    return rows
 
 
 def _points(

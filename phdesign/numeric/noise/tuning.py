@@ -241,7 +241,7 @@ class _Problem:
     objective: str
     bound: float
 
-    def report(self, L: np.ndarray) -> NoiseReport:
+    def report(self, L: np.ndarray, discrete_sup: bool = True) -> NoiseReport:
         """Return the noise figures at ``L``, refined (:func:`~.figures.noise`)."""
         return noise(
             self.nm,
@@ -250,6 +250,7 @@ class _Problem:
             intensity=self.sigma,
             input_intensity=self.w_in,
             performance=list(self.functionals),
+            discrete_sup=discrete_sup,
         )
 
 
@@ -267,7 +268,7 @@ class _Figures:
     def at_converged_resolutions(cls, problem: _Problem) -> _Figures:
         """Fix the resolutions where the figures converged for the starting gain L = I."""
         nm, C, q = problem.nm, problem.C, problem.C.shape[0]
-        start = problem.report(np.eye(q))
+        start = problem.report(np.eye(q), discrete_sup=False)  # its variances are read
         first = spectrum(nm, C, np.eye(q))
         row = current().discretization(first.method, nm.order)
         p_lo = first.resolutions[0] if first.converged else row.tune_fallback
