@@ -121,6 +121,9 @@ Work built once (:mod:`phdesign.core.cache`: least recently used entries go firs
     ``MAX_CACHED_STRUCTURES``    256       structures of the spectrum above the band
                                            (one per model and gain, and each model's
                                            form)
+    ``MAX_CACHED_ROWS``          256       rows of performance outputs (one per
+                                           discretization and output: the noise
+                                           figures read them at every call)
     ``MAX_CACHE_BYTES``          128 MiB   bytes of arrays each of those caches holds
                                            (a discretization of 900 states is about
                                            35 MB, one of 60 states 0.2 MB)
@@ -159,6 +162,7 @@ __all__ = [
     "EXACT_KAPPA_DEGREE",
     "EXACT_KAPPA_OPERATIONS",
     "MAX_CACHED_MODEL_WORK",
+    "MAX_CACHED_ROWS",
     "MAX_CACHED_STRUCTURES",
     "MAX_CACHE_BYTES",
     "MAX_DEGREE",
@@ -244,6 +248,7 @@ MAX_WORKERS_PER_CORE = 1
 # ---------------------------------------------------------------- work built once
 MAX_CACHED_MODEL_WORK = 64
 MAX_CACHED_STRUCTURES = 256
+MAX_CACHED_ROWS = 256
 MAX_CACHE_BYTES = 128 << 20
 
 

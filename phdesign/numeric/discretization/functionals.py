@@ -29,7 +29,9 @@ from typing import Any
 import numpy as np
 from numpy.polynomial import legendre as leg
 
+from phdesign.core.cache import OwnerCache
 from phdesign.core.errors import NumericError, ParameterError
+from phdesign.core.limits import MAX_CACHE_BYTES, MAX_CACHED_ROWS
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.inputs import initial_state_function, trace_row
@@ -45,6 +47,10 @@ __all__ = [
 ]
 
 _DISPLACEMENT = re.compile(r"\s*w\s*\((?P<point>[^()]*)\)\s*\Z")
+
+#: The displacement rows of each discretization (a Legendre-Vandermonde row of degree 159
+#: each, about 1 ms): the noise figures read them at every call.
+_ROWS = OwnerCache("displacement rows", entries=MAX_CACHED_ROWS, nbytes=MAX_CACHE_BYTES)
 
 
 @dataclass(frozen=True)
@@ -73,14 +79,20 @@ class Functional:
     )
 
     def row(self, d: DiscretePHS) -> np.ndarray:
-        """Return ``c`` with the functional equal to ``c @ ê`` on the discretization ``d``."""
+        """Return ``c`` with the functional equal to ``c @ ê`` on the discretization ``d``.
+
+        A displacement's row is built once per discretization and point, and shared
+        (read-only).
+        """
         if self.kind == "displacement":
             if d.displacement_basis is None:
                 raise NumericError(
                     f"{self.name}: the model {d.model.name!r} defines no displacement; "
                     "give a trace or an integral of a state component instead"
                 )
-            return np.asarray(d.displacement_basis(np.array([self.point]))[0], dtype=float)
+            basis, point = d.displacement_basis, self.point
+            build = lambda: _read_only(basis(np.array([point])))  # noqa: E731
+            return _ROWS.get(d, ("displacement", point), build)
         if self.kind == "trace":
             T = d.info.get("T")
             if T is None or self.trace is None:
@@ -92,6 +104,13 @@ class Functional:
         if self.kind == "integral" and self.weight is not None:
             return _integral_row(d, self.weight)
         raise NumericError(f"unknown kind of functional {self.kind!r}")  # pragma: no cover
+
+
+def _read_only(rows: np.ndarray) -> np.ndarray:
+    """Return the first row of ``rows`` as a read-only float array (a shared cache entry)."""
+    row = np.array(rows[0], dtype=float)
+    row.flags.writeable = False
+    return row
 
 
 def displacement_at(nm: NumericModel, point: float | str) -> Functional:

@@ -15,7 +15,8 @@ bounded scalar search (Brent).  The banded gain (:func:`gain_pair`) needs no mor
 that; the discretization's own supremum over *all* frequencies (:func:`discrete_sup`, a
 diagnostic that the report prints and warns with) adds log- and linearly spaced points,
 a sweep of the whole band.  :class:`PeakSearch` keeps the refined peaks of one
-resolution, so the two pairs a resolution belongs to share them.
+resolution and its response at every grid frequency, so the sweep and the two pairs a
+resolution belongs to share them (their grids share the resonances).
 """
 
 from __future__ import annotations
@@ -150,6 +151,30 @@ class PeakSearch:
     def __init__(self, stats: ErrorStatistics) -> None:
         self.stats = stats
         self.peaks: Peaks = {}
+        self.values: dict[float, float] = {}  # the response at each grid frequency so far
+        self.evaluated = 0  # frequencies whose response was computed (a probe for tests)
+        self._work: np.ndarray | None = None
+
+    def response(self, omega: np.ndarray) -> np.ndarray:
+        """Return the response at ``omega``, computing only the frequencies not seen yet.
+
+        The searches of one resolution (its discrete supremum and the bands of its two
+        pairs) start from grids that share the resonances: each frequency is solved once.
+        """
+        known = self.values
+        points = omega.tolist()
+        new = [w for w in dict.fromkeys(points) if w not in known]
+        if new:
+            values = self.stats.pencil.response(np.array(new)).tolist()
+            known.update(zip(new, values, strict=True))
+            self.evaluated += len(new)
+        return np.array([known[w] for w in points])
+
+    def response_at(self, omega: float) -> float:
+        """Return the response at one frequency (a refinement's step), in a kept work array."""
+        if self._work is None:
+            self._work = np.empty_like(self.stats.pencil.T)
+        return self.stats.pencil.response_at(omega, self._work)
 
     def banded(self, upper: float, ties: float) -> tuple[float, float]:
         """Return the peak over ``|ω| <= upper``, from the resonances (no sweep)."""
@@ -164,10 +189,9 @@ class PeakSearch:
     def _peak(
         self, upper: float, refine: int = 3, ties: float = 0.0, sweep: bool = False
     ) -> tuple[float, float]:
-        pencil = self.stats.pencil
         return peak_gain(
-            pencil.response,
-            pencil.response_at,
+            self.response,
+            self.response_at,
             upper,
             self.stats.eigenvalues,
             refine,

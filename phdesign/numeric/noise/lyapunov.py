@@ -127,16 +127,30 @@ class TriangularPencil:
         top = _largest_gram_eigenvalues(Y.reshape(n, m, w.size))
         return np.asarray(np.sqrt(np.maximum(top, 0.0)))
 
-    def response_at(self, omega: float) -> float:
-        """:meth:`response` at one frequency, by one LAPACK triangular solve."""
+    def response_at(self, omega: float, work: np.ndarray | None = None) -> float:
+        r""":meth:`response` at one frequency, by one LAPACK triangular solve.
+
+        ``work``, an array shaped and typed like ``T``, holds the shifted matrix
+        :math:`i\omega S - T` (a caller that evaluates many frequencies, a peak search,
+        passes one and saves an allocation per frequency); it is overwritten.
+        """
         if self.H.size == 0:
             return 0.0
+        shifted = np.empty_like(self.T) if work is None else work
         if self.whitened:  # S is the identity: i omega on the diagonal only
-            shifted = -self.T
+            np.negative(self.T, out=shifted)
             shifted.flat[:: shifted.shape[0] + 1] += 1j * omega
         else:
-            shifted = 1j * omega * self.S - self.T
-        Y = sl.solve_triangular(shifted, self.H, check_finite=False)
+            np.multiply(1j * omega, self.S, out=shifted)
+            shifted -= self.T
+        # LAPACK's trtrs as solve_triangular calls it (on the transpose of a C-ordered matrix)
+        trtrs = sl.get_lapack_funcs("trtrs", (shifted, self.H))
+        if shifted.flags.f_contiguous:
+            Y, info = trtrs(shifted, self.H, lower=0, trans=0)
+        else:
+            Y, info = trtrs(shifted.T, self.H, lower=1, trans=1)
+        if info != 0:  # pragma: no cover - a pole on the imaginary axis (stable pencils only)
+            raise NumericError(f"the frequency response is singular at omega = {omega}")
         if self.energy_map is not None:
             Y = self.energy_map @ Y
         # sigma_max from the small Gram matrix (one column per noise channel)

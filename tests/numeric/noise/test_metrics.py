@@ -42,3 +42,27 @@ def test_the_built_in_figures_are_metrics():
     assert not ErrorEnergy().smooth
     with pytest.raises(NotImplementedError, match="defines no value"):
         Metric(name="nothing").value(None)  # type: ignore[arg-type]
+
+
+def test_a_displacement_row_is_built_once_per_discretization_and_point():
+    # the variance of w(1) reads the row c with w(1) = c ê at every call: it is the
+    # discretization's displacement basis at the point, built once and shared read-only
+    from phdesign.numeric.bridge import to_numeric
+    from phdesign.numeric.discretization.functionals import displacement_at
+    from phdesign.numeric.discretization.registry import discretize
+
+    d = discretize(to_numeric(phd.load("euler-bernoulli")), "galerkin", 20)
+    tip = displacement_at(d.model, 1.0)
+    built = []
+    basis = d.displacement_basis
+
+    class Probe:
+        model, displacement_basis = d.model, staticmethod(lambda z: built.append(1) or basis(z))
+
+    probe = Probe()
+    first, again = tip.row(probe), tip.row(probe)  # type: ignore[arg-type]
+    assert len(built) == 1
+    assert again is first
+    np.testing.assert_array_equal(first, basis(np.array([1.0]))[0])
+    assert not first.flags.writeable
+    assert tip.row(d) is not first  # another owner, its own entry

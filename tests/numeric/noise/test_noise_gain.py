@@ -163,3 +163,45 @@ def test_a_resolution_refines_each_peak_once_for_both_its_pairs(monkeypatch):
     assert quiet.l2_gain.estimate == report.l2_gain.estimate
     assert quiet.error_energy == report.error_energy
     assert quiet.warnings == tuple(w for w in report.warnings if "beyond the resolved" not in w)
+
+
+def test_the_searches_of_a_resolution_solve_each_frequency_once():
+    # the discrete supremum's sweep and the bands of the resolution's two pairs start from
+    # grids sharing the resonances: the response is solved once per distinct frequency,
+    # and the memo returns the values a fresh solve gives (to round-off: the blocks of the
+    # back substitution sum in an order that depends on how many columns they hold)
+    from phdesign.numeric.noise.gain import frequency_grid
+
+    d = discretize(numeric("euler-bernoulli"), "galerkin", 30)
+    stats = error_statistics(d, PAPER_SENSORS, np.diag([0.1, 1.0]), np.ones(2))
+    lam = stats.eigenvalues
+    band = float(np.sort(np.abs(lam))[lam.size // 2])
+    search = PeakSearch(stats)
+    search.discrete()
+    swept = search.evaluated
+    top = 2.0 * float(np.max(np.abs(lam)))
+    assert swept == frequency_grid(top, lam).size
+    trimmed = band * 20 / 30  # the coarse member's band in the pair (20, 30)
+    search.banded(band, 1e-6)
+    search.banded(trimmed, 1e-6)
+    grids = [frequency_grid(top, lam), *(frequency_grid(u, lam, False) for u in (band, trimmed))]
+    assert search.evaluated == np.unique(np.concatenate(grids)).size < sum(g.size for g in grids)
+    grid = grids[1]
+    np.testing.assert_allclose(search.response(grid), stats.pencil.response(grid), rtol=1e-13)
+
+
+def test_response_at_with_a_work_array_is_the_plain_solve():
+    # the kept work array of a peak search gives the same numbers as a fresh shifted matrix,
+    # on the whitened (Schur) path and on the QZ path
+    airy = ("airy", np.array([[1.0, 0.0, 0.0]]), 12)
+    for name, C, p in (("euler-bernoulli", PAPER_SENSORS, 20), airy):
+        d = discretize(numeric(name), "galerkin", p)
+        pencil = error_statistics(d, C, np.eye(C.shape[0]), np.ones(C.shape[0])).pencil
+        work = np.empty_like(pencil.T)
+        for omega in (0.0, 2.2, 40.0):
+            assert pencil.response_at(omega, work) == pencil.response_at(omega)
+            Y = np.linalg.solve(1j * omega * pencil.S - pencil.T, pencil.H)
+            if pencil.energy_map is not None:
+                Y = pencil.energy_map @ Y
+            expected = np.linalg.norm(Y, 2)
+            assert pencil.response_at(omega, work) == pytest.approx(expected, rel=1e-10)
