@@ -66,8 +66,11 @@ def resampling(z: np.ndarray, m: int) -> np.ndarray:
     return P / P.sum(axis=1, keepdims=True)
 
 
-def peer_eigenvalues(n: int) -> np.ndarray:
-    """The finite eigenvalues of the rectangular collocation with n points per component."""
+def peer_eigenvalues(n: int, l1: float = L1, l2: float = L2) -> np.ndarray:
+    """The finite eigenvalues of the rectangular collocation with n points per component.
+
+    ``l1``, ``l2``: the diagonal gain L = diag(l1, l2) in the boundary conditions.
+    """
     z, D = chebyshev(n)
     P, Z = resampling(z, n - 2), np.zeros((n - 2, n))
     A = np.block([[-D_VISCOUS * P, -P @ D @ D], [P @ D @ D, Z]])
@@ -76,9 +79,9 @@ def peer_eigenvalues(n: int) -> np.ndarray:
     bc = np.zeros((4, 2 * n))
     bc[0, a] = 1.0  # e1(0) = 0
     bc[1, :n] = D[a]  # e1'(0) = 0
-    bc[2, n + b], bc[2, :n] = 1.0, L1 * D[b]  # e2(1) + l1 e1'(1) = 0
+    bc[2, n + b], bc[2, :n] = 1.0, l1 * D[b]  # e2(1) + l1 e1'(1) = 0
     bc[3, n:] = D[b]
-    bc[3, b] -= L2  # e2'(1) - l2 e1(1) = 0
+    bc[3, b] -= l2  # e2'(1) - l2 e1(1) = 0
     lam = sl.eig(np.vstack([A, bc]), np.vstack([B, np.zeros((4, 2 * n))]), right=False)
     return lam[np.isfinite(lam)]
 
