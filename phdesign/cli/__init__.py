@@ -42,6 +42,7 @@ COMMAND_MODULES = {
     "ports": "phdesign.cli.model_commands",
     "classify": "phdesign.cli.classify_command",
     "spectrum": "phdesign.cli.numeric_commands",
+    "modes": "phdesign.cli.numeric_commands",
     "simulate": "phdesign.cli.numeric_commands",
     "tune": "phdesign.cli.numeric_commands",
     "noise": "phdesign.cli.noise_commands",

@@ -51,6 +51,7 @@ TUNE_STARTS = 2
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the numeric commands."""
     _add_spectrum(subparsers)
+    _add_modes(subparsers)
     _add_simulate(subparsers)
     _add_tune(subparsers)
 
@@ -60,6 +61,22 @@ def _add_spectrum(subparsers: argparse._SubParsersAction) -> None:
         "spectrum",
         help="converged spectral abscissa of the plant (u = 0) or of the error system",
     )
+    _add_spectrum_options(sp, "rightmost eigenvalues to report")
+    sp.set_defaults(handler=_spectrum)
+
+
+def _add_modes(subparsers: argparse._SubParsersAction) -> None:
+    md = subparsers.add_parser(
+        "modes",
+        help="modal table: the resolved modes by frequency (natural frequency, damping "
+        "ratio, decay rate) of the plant (u = 0) or of the error system",
+    )
+    _add_spectrum_options(md, "modes to list, lowest frequency first")
+    md.set_defaults(handler=_modes)
+
+
+def _add_spectrum_options(sp: argparse.ArgumentParser, count_help: str) -> None:
+    """Add the options ``spectrum`` and ``modes`` share (``count_help`` says what --count is)."""
     add_model_argument(sp)
     add_observer_arguments(sp, required=True)
     table = current()
@@ -81,11 +98,10 @@ def _add_spectrum(subparsers: argparse._SubParsersAction) -> None:
         "--count",
         type=int,
         default=table.spectrum.count,
-        help="rightmost eigenvalues to report; default: %(default)s",
+        help=count_help + "; default: %(default)s",
     )
     add_json_argument(sp)
     add_quiet_argument(sp)
-    sp.set_defaults(handler=_spectrum)
 
 
 def _add_simulate(subparsers: argparse._SubParsersAction) -> None:
@@ -175,6 +191,15 @@ def _add_tune(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _spectrum(args: argparse.Namespace) -> int:
+    return emit_result(args, _spectrum_report(args, "spectrum"))
+
+
+def _modes(args: argparse.Namespace) -> int:
+    return emit_result(args, _spectrum_report(args, "modes").modes(count=args.count))
+
+
+def _spectrum_report(args: argparse.Namespace, command: str) -> Any:
+    """Return the spectrum report of the plant, or of the error system with sensors."""
     from phdesign.design.plant import Plant
 
     check_positive("--resolution", args.resolution)
@@ -183,12 +208,11 @@ def _spectrum(args: argparse.Namespace) -> int:
     check_positive("--max-resolution", args.max_resolution)
     model = load_model(args)
     observer = observer_from_args(
-        args, model, command="spectrum", method=args.method, resolution=args.resolution
+        args, model, command=command, method=args.method, resolution=args.resolution
     )
     # the error system of the observer, or the plant with u = 0 without sensors
     design = observer or Plant(model, method=args.method, resolution=args.resolution)
-    rep = design.spectrum(max_resolution=args.max_resolution, tol=args.tol, count=args.count)
-    return emit_result(args, rep)
+    return design.spectrum(max_resolution=args.max_resolution, tol=args.tol, count=args.count)
 
 
 def _simulate(args: argparse.Namespace) -> int:

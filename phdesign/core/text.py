@@ -32,6 +32,7 @@ __all__ = [
     "number_text",
     "sensors_text",
     "shorten",
+    "text_table",
 ]
 
 #: Longest ``repr`` of a result object.
@@ -207,3 +208,20 @@ def html_table(
     if footer:
         out += f"<p>{html.escape(footer)}</p>"
     return out
+
+
+def text_table(headers: Sequence[str], rows: Iterable[Sequence[Any]]) -> list[str]:
+    """Return the lines of a plain-text table: columns padded to their widest cell.
+
+    The text twin of :func:`html_table`, for the ``__str__`` of result objects.
+
+    Examples
+    --------
+    >>> text_table(["mode", "ω"], [[1, "3.516"], [2, "22.03"]])
+    ['mode  ω', '1     3.516', '2     22.03']
+    """
+    cells = [[str(h) for h in headers]] + [[str(c) for c in row] for row in rows]
+    widths = [max(len(row[j]) for row in cells) for j in range(len(headers))]
+    return [
+        "  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in cells
+    ]

@@ -110,3 +110,28 @@ def test_tune_json_contract(capsys):
     data = json.loads(out)
     assert {"gain", "spectral_abscissa"} <= set(data)
     assert data["gain"][0][0] > 0
+
+
+def test_modes_table_and_json(capsys):
+    # the wave plant (u = 0): ω_m = (m + ½)π, undamped (DESIGN.md)
+    status, out, _ = run(capsys, "modes", "wave", "--count", "2")
+    assert status == 0
+    assert "ω_n [rad/s]" in out
+    assert "1.5707963" in out
+    assert "4.712389" in out
+    status, out, _ = run(capsys, "modes", "wave", "--sensors", "2", "--gain", "0.5", "--json")
+    data = json.loads(out)
+    assert data["units"]["frequency"] == "Hz"
+    assert len(data["modes"]) == 6
+    first = data["modes"][0]
+    # ½ ln(1/3) + iπ/2: ζ = −Re λ / |λ|
+    lam = complex(0.5 * math.log(1 / 3), math.pi / 2)
+    assert abs(first["damping_ratio"] + lam.real / abs(lam)) < 1e-9
+    assert first["block"] == "error"
+
+
+def test_modes_bad_count_is_one_line(capsys):
+    status, _, err = run(capsys, "modes", "wave", "--count", "0")
+    assert status == 2
+    assert err.count("\n") == 1
+    assert "--count" in err

@@ -61,6 +61,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -69,6 +70,7 @@ from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_spectrum_arguments
 from phdesign.numeric.discretization.phs import DiscretePHS, feedback_matrix
+from phdesign.numeric.spectrum.drift import PairSpectrum
 from phdesign.numeric.spectrum.eigen import prepare
 from phdesign.numeric.spectrum.refinement import (
     ClosedLoopSolver,
@@ -192,10 +194,17 @@ class RefinementPlan:
 
 
 def rightmost_indices(chosen: PairResult, count: int) -> np.ndarray:
-    """Return the indices (into the pair's eigenvalues) of the ``count`` rightmost counted."""
-    lam = chosen.pair.eigenvalues
-    counted = np.flatnonzero(chosen.abscissa.counted)
-    return np.asarray(counted[rightmost_order(lam[counted])[:count]])
+    """Return the indices (into the pair's eigenvalues) of the ``count`` rightmost listed.
+
+    Listed are the counted eigenvalues and every resolved one that does not lie right of
+    the abscissa (a resolved mode whose real part is not converged to the abscissa's
+    tolerance is still a mode); real parts that tie within their accuracy are ordered by
+    frequency (:func:`~phdesign.numeric.spectrum.warnings.rightmost_order`).
+    """
+    pair, a = chosen.pair, chosen.abscissa
+    listed = np.flatnonzero(a.counted | (pair.resolved & ~a.loose_right))
+    order = rightmost_order(pair.eigenvalues[listed], pair.uncertainty[listed])
+    return np.asarray(listed[order[:count]])
 
 
 def abscissa_digits(chosen: PairResult) -> float:
@@ -217,6 +226,7 @@ class _Labels:
     rate: float
     sensors: list[list[float]] | None
     gain: list[list[float]] | None
+    time_unit: str | None = None
 
 
 def _unresolved_report(trail: list[PairResult], labels: _Labels) -> SpectrumReport:
@@ -258,6 +268,7 @@ def _unresolved_report(trail: list[PairResult], labels: _Labels) -> SpectrumRepo
         resolved=last.pair.resolved,
         sensors=labels.sensors,
         gain=labels.gain,
+        **_mode_data(last.pair, labels),
     )
 
 
@@ -344,6 +355,7 @@ def spectrum(
         rate=solver.scales.rate,
         sensors=None if C_m is None else np.atleast_2d(np.asarray(C_m, float)).tolist(),
         gain=None if L is None else np.atleast_2d(np.asarray(L, float)).tolist(),
+        time_unit=dict(nm.units).get("t"),
     )
     chosen, notes = choose_pair(trail)
     a = chosen.abscissa
@@ -405,4 +417,15 @@ def _report(
         gain=labels.gain,
         branches=a.branches,
         complete_band=pair.complete_band,
+        **_mode_data(pair, labels),
     )
+
+
+def _mode_data(pair: PairSpectrum, labels: _Labels) -> dict[str, Any]:
+    """Return the report's fields of the modal table: masks, accuracies, units."""
+    return {
+        "kept": pair.clustered,
+        "real_accuracy": pair.uncertainty,
+        "condition_all": np.zeros(0) if pair.condition is None else pair.condition,
+        "time_unit": labels.time_unit,
+    }

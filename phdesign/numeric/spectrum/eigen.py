@@ -87,6 +87,7 @@ __all__ = [
     "condition_numbers",
     "prepare",
     "rescaled",
+    "roundoff_bound",
     "shift_invert",
     "system_shift",
 ]
@@ -108,6 +109,33 @@ def rescaled(lam: np.ndarray, factor: float) -> np.ndarray:
     out = np.full(lam.shape, complex(np.inf, 0.0))
     out[finite] = lam[finite] * factor
     return out
+
+
+def roundoff_bound(lam: np.ndarray, kappa: np.ndarray, rate: float, dim: int) -> np.ndarray:
+    r"""Return the round-off bound of shift and invert's eigenvalues.
+
+    :math:`n \epsilon \kappa \max(|\lambda|, |\lambda - \sigma|^2 / \sigma)`: a real part of
+    either sign below it is round-off.
+
+    The error model of the module docstring, :math:`|\delta\lambda| \approx \epsilon \kappa
+    \|S\| |\lambda - \sigma|^2` with :math:`\|S\| \le 1/\sigma` (:math:`\sigma` = :data:`SHIFT`
+    times the rate), times the pencil's dimension n: the backward errors of the LU
+    factorization and of the Hessenberg QR grow like :math:`n \epsilon`.  A computed real
+    part of either sign below it is round-off.  Measured on the airy plant (lossless: every
+    exact real part is 0), the largest positive real part is 8.7, 13 and 62 times
+    :math:`\epsilon \kappa |\lambda - \sigma|^2/\sigma` at n = 41, 62 and 93 (+1.45e3 at
+    :math:`|\lambda|` = 1.29e9 for n = 41).
+
+    Examples
+    --------
+    >>> float(roundoff_bound(np.array([1e9j]), np.array([1.0]), 1.0, 41)[0]) > 1.45e3
+    True
+    """
+    lam = np.asarray(lam, dtype=complex)
+    sigma = SHIFT * float(rate)
+    k = np.minimum(np.asarray(kappa, dtype=float), 1e300)
+    size = np.maximum(np.abs(lam), np.abs(lam - sigma) ** 2 / sigma)
+    return np.asarray(int(dim) * np.finfo(float).eps * k * size)
 
 
 def condition_numbers(X: np.ndarray, Y: np.ndarray, E: np.ndarray | None) -> np.ndarray:

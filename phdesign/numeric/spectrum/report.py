@@ -16,12 +16,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from phdesign.core.text import html_table
+from phdesign.numeric.spectrum.eigen import roundoff_bound
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
     from phdesign.numeric.spectrum.branches import Branches
+    from phdesign.numeric.spectrum.modes import ModalTable
 
 __all__ = ["RefinementStep", "SpectrumReport", "finite_or_none"]
 
@@ -143,6 +145,15 @@ class SpectrumReport:
         the principal part, its onset and the chains' limits.
     complete_band : float or None
         Every eigenvalue up to this modulus is resolved (``inf``: all of them).
+    kept : ndarray of bool
+        Mask of the unresolved eigenvalues kept in the resolved band (members of a cluster
+        or ill-conditioned, near a coalescence).
+    real_accuracy : ndarray of float
+        Accuracy of the real part of each resolved or kept eigenvalue (``nan`` elsewhere).
+    condition_all : ndarray of float
+        Energy-norm condition number of every eigenvalue (empty when not computed).
+    time_unit : str or None
+        The model's unit of time (``[units] t``), when it states one.
     """
 
     spectral_abscissa: float | None
@@ -171,6 +182,10 @@ class SpectrumReport:
     gain: list[list[float]] | None = None
     branches: Branches | None = None
     complete_band: float | None = None
+    kept: np.ndarray = field(default_factory=lambda: np.zeros(0, bool), repr=False)
+    real_accuracy: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    condition_all: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    time_unit: str | None = None
 
     # -- text -------------------------------------------------------------------------
 
@@ -206,8 +221,15 @@ class SpectrumReport:
         lines.append(line)
         if self.rightmost:
             lines.append("rightmost eigenvalues:")
-            for z, c in zip(self.rightmost, self.condition_numbers, strict=False):
-                lines.append(f"  {z.real:+.10g} {z.imag:+.10g}i   (condition {c:.3g})")
+            bounds = roundoff_bound(
+                np.asarray(self.rightmost),
+                np.asarray(self.condition_numbers),
+                self.rate_scale,
+                self.n_total,
+            )
+            for z, c, b in zip(self.rightmost, self.condition_numbers, bounds, strict=False):
+                note = "; Re λ > 0 is round-off" if 0 < z.real <= b else ""
+                lines.append(f"  {z.real:+.10g} {z.imag:+.10g}i   (condition {c:.3g}{note})")
         lines += [f"warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 
@@ -263,6 +285,15 @@ class SpectrumReport:
             "complete_band": finite_or_none(self.complete_band),
             "branches": None if self.branches is None else self.branches.to_dict(),
         }
+
+    def modes(self, count: int | None = None) -> ModalTable:
+        """Return the first ``count`` resolved modes by frequency (ω_n, f, ζ, decay rate).
+
+        See :func:`phdesign.numeric.spectrum.modes.modal_table`.
+        """
+        from phdesign.numeric.spectrum.modes import modal_table
+
+        return modal_table(self, count)
 
     def plot(
         self,

@@ -21,16 +21,44 @@ import numpy as np
 
 from phdesign.numeric.spectrum.abscissa import Abscissa
 from phdesign.numeric.spectrum.drift import KAPPA_MIN, PairSpectrum
+from phdesign.numeric.spectrum.eigen import SHIFT, roundoff_bound
 from phdesign.numeric.spectrum.refinement import ILL_CONDITION, PairResult
 
-__all__ = ["ILL_GAP", "report_warnings", "reported_value", "rightmost_order"]
+__all__ = [
+    "ILL_GAP",
+    "positive_roundoff",
+    "report_warnings",
+    "reported_value",
+    "rightmost_order",
+]
 
 ILL_GAP = 1e-3  # relative gap to the nearest other eigenvalue below which it may be ill-posed
 
 
-def rightmost_order(lam: np.ndarray) -> np.ndarray:
-    """Return the indices of ``lam`` by decreasing real part (12 decimals), then |Im|."""
-    return np.lexsort((np.abs(lam.imag), -np.round(lam.real, 12)))
+def rightmost_order(lam: np.ndarray, accuracy: np.ndarray | None = None) -> np.ndarray:
+    r"""Return the indices of ``lam`` by decreasing real part (12 decimals), then |Im|.
+
+    With ``accuracy`` (the absolute accuracy of each real part), real parts that tie
+    within it are ordered by frequency: the rightmost remaining eigenvalue leads a
+    group of every remaining one whose interval reaches its own,
+    :math:`\operatorname{Re}\lambda_j + u_j \ge \operatorname{Re}\lambda_0 - u_0`, listed by
+    increasing |Im|; the next group starts at the rightmost eigenvalue left.  So on an
+    undamped plant, whose real parts are round-off, the list is the lowest modes, not
+    those that round-off happened to push right.
+    """
+    order = np.lexsort((np.abs(lam.imag), -np.round(lam.real, 12)))
+    if accuracy is None:
+        return order
+    u = np.nan_to_num(np.asarray(accuracy, dtype=float), nan=0.0)
+    left = list(order)
+    out: list[int] = []
+    while left:
+        floor = lam.real[left[0]] - u[left[0]]
+        group = [j for j in left if lam.real[j] + u[j] >= floor]
+        out += sorted(group, key=lambda j: abs(lam.imag[j]))
+        taken = set(group)
+        left = [j for j in left if j not in taken]
+    return np.asarray(out, dtype=int)
 
 
 def _kind(a: Abscissa, attained: float) -> list[str]:
@@ -154,6 +182,37 @@ def _right_of_abscissa(a: Abscissa, pair: PairSpectrum, attained: float, tol: fl
     return out
 
 
+def positive_roundoff(pair: PairSpectrum, idx: np.ndarray) -> str:
+    """Say which of the eigenvalues ``idx`` have positive real parts, and whether round-off.
+
+    A positive real part within :func:`~phdesign.numeric.spectrum.eigen.roundoff_bound` is
+    round-off of the eigen stage, not an instability of the discretization.  Returns ""
+    when none of them has a positive real part.
+    """
+    lam = pair.eigenvalues
+    pos = idx[lam.real[idx] > 0]
+    if pos.size == 0:
+        return ""
+    kappa = np.ones(lam.size) if pair.condition is None else pair.condition
+    bound = roundoff_bound(lam[pos], kappa[pos], pair.scale, lam.size)
+    within = lam.real[pos] <= bound
+    top = pos[np.argmax(lam.real[pos])]
+    text = (
+        f"{int(np.count_nonzero(within))} of them have positive real parts within round-off "
+        f"(Re λ <= n ε κ max(|λ|, |λ − σ|²/σ), n = {lam.size}, σ = {SHIFT * pair.scale:.3g}: "
+        f"the largest, {lam.real[top]:.3g} at |λ| = {abs(lam[top]):.3g}, is "
+        f"{lam.real[top] / bound[np.flatnonzero(pos == top)[0]]:.2g} of its bound): "
+        "round-off of the eigenvalue computation, not an instability of the discretization"
+    )
+    if not within.all():
+        worst = pos[~within][np.argmax(lam.real[pos[~within]])]
+        text += (
+            f"; {int(np.count_nonzero(~within))} lie beyond it (max Re {lam.real[worst]:.3g} "
+            f"at |λ| = {abs(lam[worst]):.3g})"
+        )
+    return text
+
+
 def _unresolved_right(a: Abscissa, pair: PairSpectrum, right: np.ndarray) -> str:
     lam = pair.eigenvalues
     head = (
@@ -161,14 +220,20 @@ def _unresolved_right(a: Abscissa, pair: PairSpectrum, right: np.ndarray) -> str
         f"{float(np.max(lam.real[right])):.3g}), above the resolved frequency band "
         f"(|λ| > {pair.band:.3g})"
     )
+    roundoff = positive_roundoff(pair, right)
+    tail = f"; {roundoff}" if roundoff else ""
     b = a.branches
     if b is not None and a.band_short(pair):
-        return head + ": not discarded; the band does not reach the onset of the principal part"
+        return (
+            head + ": not discarded; the band does not reach the onset of the principal part"
+        ) + tail
     if b is not None and b.analysed:
         top = b.limit
         bound = "no chain" if top is None else f"the chains' limits (at most {top.limit:.6g})"
-        return head + f": unresolved high frequencies, where {bound} account for the spectrum"
-    return head + ": unresolved high frequencies, discarded"
+        return (
+            head + f": unresolved high frequencies, where {bound} account for the spectrum" + tail
+        )
+    return head + ": unresolved high frequencies, discarded" + tail
 
 
 def report_warnings(
