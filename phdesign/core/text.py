@@ -18,12 +18,14 @@ Examples
 
 from __future__ import annotations
 
+import difflib
 import html
 from collections.abc import Iterable, Sequence
 from typing import Any
 
 __all__ = [
     "REPR_LIMIT",
+    "did_you_mean",
     "gain_text",
     "html_table",
     "kappa_text",
@@ -225,3 +227,19 @@ def text_table(headers: Sequence[str], rows: Iterable[Sequence[Any]]) -> list[st
     return [
         "  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in cells
     ]
+
+
+def did_you_mean(name: object, choices: Iterable[str]) -> str:
+    """Return ``" (did you mean 'x'?)"`` for the choice closest to ``name``, or "".
+
+    :func:`difflib.get_close_matches` with its default cutoff (0.6).
+
+    Examples
+    --------
+    >>> did_you_mean("euler-bernouli", ["wave", "euler-bernoulli"])
+    " (did you mean 'euler-bernoulli'?)"
+    >>> did_you_mean("xyz", ["wave"])
+    ''
+    """
+    close = difflib.get_close_matches(str(name), list(choices), n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""

@@ -23,6 +23,7 @@ from importlib import resources
 from pathlib import Path
 
 from phdesign.core.errors import ArgumentError, ModelFileError, ParameterError
+from phdesign.core.text import did_you_mean
 from phdesign.symbolic.model import BCPHS
 
 __all__ = ["builtin_names", "builtin_toml", "load", "load_builtin"]
@@ -44,8 +45,8 @@ def builtin_toml(name: str) -> str:
     """
     if not isinstance(name, str) or name not in builtin_names():
         raise ModelFileError(
-            f"unknown model {name!r}; expected a built-in model ({', '.join(builtin_names())}) "
-            "or the path of a TOML file"
+            f"unknown model {name!r}{did_you_mean(name, builtin_names())}; expected a built-in "
+            f"model ({', '.join(builtin_names())}) or the path of a TOML file"
         )
     return resources.files(__package__).joinpath(f"{name}.toml").read_text(encoding="utf-8")
 

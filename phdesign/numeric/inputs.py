@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.errors import ExpressionError, NumericError, ParameterError, PhdesignError
+from phdesign.core.text import did_you_mean
 from phdesign.numeric.bridge import (
     NumericModel,
     _free_symbols_message,
@@ -212,7 +213,10 @@ def _substituted_values(
     for name, value in (parameters or {}).items():
         if str(name) not in values:
             known = ", ".join(values) or "none"
-            raise ParameterError(f"unknown parameter {name!r}; the model's parameters are {known}")
+            raise ParameterError(
+                f"unknown parameter {name!r}{did_you_mean(name, values)}; the model's "
+                f"parameters are {known}"
+            )
         values[str(name)] = ex.exact_number(value, f"parameter {name}")
     return values
 

@@ -43,6 +43,7 @@ from typing import Any
 from phdesign.core.checks import positive_number
 from phdesign.core.errors import ParameterError, PhdesignError, SweepError
 from phdesign.core.limits import MAX_STORE_METADATA_BYTES, check_sweep_points
+from phdesign.core.text import did_you_mean
 from phdesign.sweep.fields import description_fields
 from phdesign.sweep.grids import Axis, parse_axis, parse_sensor_sets, sensor_set_indices
 from phdesign.sweep.jobs import Job, get_job
@@ -294,8 +295,8 @@ _CHECKED_PARAMETER_VALUES = 256
 def _parameter_axis(name: str, text: Any, known: tuple[str, ...]) -> Axis:
     if name not in known:
         raise ParameterError(
-            f"unknown parameter {name!r}; the model's parameters are "
-            f"{', '.join(known) if known else 'none'}"
+            f"unknown parameter {name!r}{did_you_mean(name, known)}; the model's parameters "
+            f"are {', '.join(known) if known else 'none'}"
         )
     return parse_axis(name, text, "parameter")
 

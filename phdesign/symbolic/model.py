@@ -29,6 +29,7 @@ from typing import Any
 import sympy
 
 from phdesign.core.errors import ExpressionError, ModelError, ParameterError
+from phdesign.core.text import did_you_mean
 from phdesign.symbolic import display
 from phdesign.symbolic.closing import ClosedPorts, closed_ports
 from phdesign.symbolic.definition import (
@@ -319,8 +320,8 @@ class BCPHS(PortedSystem):
         for name, value in values.items():
             if name not in known:
                 raise ParameterError(
-                    f"unknown parameter {name!r}; the model's parameters are "
-                    f"{', '.join(known) if known else 'none'}"
+                    f"unknown parameter {name!r}{did_you_mean(name, known)}; the model's "
+                    f"parameters are {', '.join(known) if known else 'none'}"
                 )
             try:
                 updated[parameter_symbol(name)] = exact_number(value, f"parameter {name}")

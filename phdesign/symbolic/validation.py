@@ -21,6 +21,7 @@ from phdesign.core.errors import (
     ExpressionError,
     ModelError,
     ParameterError,
+    PortError,
     check_shape,
 )
 from phdesign.core.limits import check_model_dimensions, check_parameter_count
@@ -30,6 +31,7 @@ from phdesign.symbolic.definiteness import check_definite
 from phdesign.symbolic.definition import Displacement
 from phdesign.symbolic.expressions import Z, canonical, vanishes
 from phdesign.symbolic.feedback import check_feedback_indices
+from phdesign.symbolic.output_faults import outputs_fault_message
 from phdesign.symbolic.parser import brief, check_expression
 from phdesign.symbolic.traces import linear_coefficients, trace_of
 from phdesign.symbolic.units import check_units
@@ -139,7 +141,13 @@ def _check_all_ports(
         object.__setattr__(model, "outputs", outputs)
         checks.append("outputs: derived, the least-norm power conjugates of the inputs")
     _check_ports(model, symbols, ("outputs",))
-    model.ports  # noqa: B018 - derives the ports (checking the identities) and caches them
+    try:
+        model.ports  # noqa: B018 - derives the ports (checking the identities) and caches them
+    except PortError as exc:
+        located = outputs_fault_message(model, defaults)  # the outputs at fault, named
+        if not located:
+            raise
+        raise PortError(f"{exc}; {located}") from None
     checks.append("port identities: exact")
     return checks
 

@@ -131,7 +131,10 @@ def test_an_unregistered_method_is_refused(capsys):
 
 def test_a_changed_tolerance_changes_the_spectrum():
     # the beam (N = 2) with sensors 3, 4: 15 eigenvalues agree to the drift 1e-6 at
-    # (20, 30); a drift tolerance of 0.1 in the table's N = 2 row lets 23 count as resolved
+    # (20, 30); a drift tolerance of 0.1 in the table's N = 2 row lets 21 count as resolved
+    # (23 pass the relative test; the pair -11.01 ± 1139.4i drifts by 10.3, 5 % of the
+    # spacing 202 to its neighbour, where a chance match cannot be told from the same mode:
+    # the drift test's spacing rule, numeric/spectrum/drift.py, does not count it)
     beam, wave = numeric("euler-bernoulli"), numeric("wave")
     L, C_wave, k = np.diag([0.1, 1.0]), np.array([[0.0, 1.0]]), np.array([[0.5]])
     before = spectrum(beam, PAPER_SENSORS, L)
@@ -142,7 +145,7 @@ def test_a_changed_tolerance_changes_the_spectrum():
         wave_after = spectrum(wave, C_wave, k)  # its N = 1 row is unchanged
         evaluator = AbscissaEvaluator(beam, PAPER_SENSORS, (20, 30))
     assert (before.resolutions, before.n_resolved) == ((20, 30), 15)
-    assert (after.resolutions, after.n_resolved) == ((20, 30), 23)
+    assert (after.resolutions, after.n_resolved) == ((20, 30), 21)
     assert wave_after.n_resolved == wave_before.n_resolved
     assert evaluator.rtol_resolved == 0.1
     assert spectrum(beam, PAPER_SENSORS, L).n_resolved == 15  # the table is back
