@@ -70,12 +70,17 @@ SEPARATION = 1e-2  # largest drift, per unit of the local spacing, of an unambig
 UNAMBIGUOUS = float(np.sqrt(np.finfo(float).eps))  # relative drift no chance match reaches
 
 
-def _spacing(f: np.ndarray) -> np.ndarray:
-    """Return the distance from each of ``f`` to its nearest other member (inf when alone)."""
+def _spacing(f: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Return the distance from each of ``f`` to its nearest other eigenvalue (inf: alone).
+
+    Members within :data:`UNAMBIGUOUS` ``size`` of each other are copies of one multiple
+    eigenvalue (two identical strings: whichever copy a coarse one pairs with, it is the
+    same mode), not neighbours whose matches could be confused.
+    """
     if f.size < 2:
         return np.full(f.shape, np.inf)
     gaps = np.abs(f[:, None] - f[None, :])
-    np.fill_diagonal(gaps, np.inf)
+    gaps[gaps <= UNAMBIGUOUS * size[:, None]] = np.inf  # the diagonal, and multiple copies
     return np.asarray(np.min(gaps, axis=1))
 
 
@@ -102,7 +107,7 @@ def _drift_test(
     d_re = np.abs(f.real - c[nearest_c].real)
     # ... and the match must be unambiguous where the spectrum is dense (module docstring)
     size = np.maximum(scale, np.abs(f))
-    unambiguous = (drift <= SEPARATION * _spacing(f)) | (drift <= UNAMBIGUOUS * size)
+    unambiguous = (drift <= SEPARATION * _spacing(f, size)) | (drift <= UNAMBIGUOUS * size)
     resolved[f_idx] = (
         mutual
         & unambiguous

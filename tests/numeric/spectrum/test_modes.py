@@ -113,6 +113,30 @@ def test_a_dense_spectrum_shifted_by_spacings_is_not_resolved():
     assert np.all(drift <= 1e-2 * np.abs(fine[high]))  # what the relative test alone allows
 
 
+def test_a_double_eigenvalue_drifting_with_the_grid_is_still_resolved(monkeypatch):
+    # two identical strings: every mode is double (copies 1e-15 apart).  A second-order
+    # grid moves both copies alike by 1e-3 |λ| (below rtol = 1e-2): each copy's nearest
+    # other eigenvalue is its twin, which is the same mode, so the spacing to reckon with
+    # is the next mode's (2k + 1 away): the drift 1e-3 |−1 + i k²| stays under 1 % of it
+    # for k = 1..5 (1.4e-3 < 0.03, ..., 2.5e-2 < 0.11).  The rule must not judge the twins
+    # by the 1e-15 between them (with the twin as neighbour nothing would be resolved).
+    import phdesign.numeric.spectrum.drift as drift_module
+
+    k = np.repeat(np.arange(1.0, 6.0), 2)
+    exact = -1 + 1j * k**2 + np.tile([0.0, 1e-15], 5)
+    coarse = exact * (1 + 1e-3)
+    pair = pair_spectrum(exact, coarse, resolutions=(4, 6), rtol=1e-2, scale=1.0)
+    drift = np.abs(exact - coarse)
+    with monkeypatch.context() as patch:
+        patch.setattr(drift_module, "SEPARATION", np.inf)  # the relative test alone
+        alone = pair_spectrum(exact, coarse, resolutions=(4, 6), rtol=1e-2, scale=1.0)
+    assert np.all(drift <= 1e-2 * (2 * k + 1))
+    expected = alone.resolved
+    assert pair.resolved.tolist() == expected.tolist()
+    assert pair.resolved[:2].any()  # k = 1 (the first twin at least, as before the rule)
+    assert pair.resolved[2:4].any()  # k = 2
+
+
 def test_fd_beam_lists_no_artefact_and_every_resolved_mode():
     # the case: before, −14.805 ± 37845.7i was listed and −7.62 ± 23.9i omitted
     obs = phd.Observer(
