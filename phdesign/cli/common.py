@@ -181,6 +181,14 @@ def warn(message: str) -> None:
     print(f"phdesign: warning: {text}", file=sys.stderr)
 
 
+def note(message: str) -> None:
+    """Print one ``phdesign: ...`` line on stderr (``sweep: ...``), in the command's options."""
+    from phdesign.cli.messages import translated
+
+    text = printable(" ".join(translated(message, leading=False).split()))
+    print(f"phdesign: {text}", file=sys.stderr)
+
+
 def emit_json(value: Any) -> None:
     """Print ``value`` as strict JSON (phdesign's one JSON writer); sympy values are text."""
     from phdesign.io import dumps_json

@@ -20,6 +20,7 @@ from phdesign.cli.common import (
     emit_json,
     emit_result,
     load_model,
+    note,
 )
 from phdesign.core.errors import SweepError
 
@@ -110,13 +111,16 @@ def _add_run_arguments(sp: argparse.ArgumentParser) -> None:
     sp.add_argument(
         "--scheduler",
         metavar="WHERE",
-        help="'local' (a LocalCluster sized to the machine; the default unless "
-        "DASK_SCHEDULER_ADDRESS is set), 'synchronous' (in this process) or an address "
-        "such as tcp://HOST:PORT",
+        help="'local' (a LocalCluster sized to the machine), 'synchronous' (in this "
+        "process) or an address such as tcp://HOST:PORT; default: DASK_SCHEDULER_ADDRESS "
+        "when set, else this process until a local cluster would repay its start",
     )
     sp.add_argument("--workers", type=int, metavar="N", help="workers of the local cluster")
     sp.add_argument(
-        "--chunk-size", type=int, metavar="N", help="points per task (default: about 0.5 s)"
+        "--chunk-size",
+        type=int,
+        metavar="N",
+        help="points per task (default: from the grid and the workers)",
     )
     sp.add_argument(
         "--no-progress", action="store_true", help="no progress bar (shown on a terminal)"
@@ -215,6 +219,7 @@ def _sweep(args: argparse.Namespace) -> int:
         workers=args.workers,
         chunk_size=args.chunk_size,
         progress=False if args.no_progress else None,
+        notify=note,
     )
     summary = summarize(dataset)
     return emit_result(args, summary)

@@ -2,8 +2,8 @@
 
 ``phdesign.sweep(...)`` evaluates a job (``spectrum``: converged spectral abscissa;
 ``classify``: verdict and κ*) at every point of a grid of gains, model parameters and
-sensor sets, in chunks of points that run in this process, on a local cluster (the
-default) or on any Dask cluster, and returns an :class:`xarray.Dataset`: one variable per
+sensor sets, in chunks of points that run in this process, on a local cluster or on any
+Dask cluster, and returns an :class:`xarray.Dataset`: one variable per
 figure, the axes as coordinates, the model, options and package version as attributes.
 With ``output="map.zarr"`` the chunks are stored as they complete, and an interrupted
 sweep resumes where it stopped (``resume=True``).
@@ -15,7 +15,8 @@ the ``sweep`` extra, ``pip install "phdesign[sweep]"``.
 Modules: :mod:`~phdesign.sweep.grids` (axes), :mod:`~phdesign.sweep.jobs` (the job
 registry), :mod:`~phdesign.sweep.description` (what a sweep computes, its stored fields
 checked by :mod:`~phdesign.sweep.fields`),
-:mod:`~phdesign.sweep.plan` (chunks), :mod:`~phdesign.sweep.schedulers` (where they run),
+:mod:`~phdesign.sweep.plan` (chunks), :mod:`~phdesign.sweep.schedulers` (where they run,
+:mod:`~phdesign.sweep.automatic` when nobody says),
 :mod:`~phdesign.sweep.execute` (running them), :mod:`~phdesign.sweep.store` (Zarr),
 :mod:`~phdesign.sweep.export` (CSV, NetCDF), :mod:`~phdesign.sweep.summary` (the printed
 result; its pictures are drawn by :mod:`phdesign.plots.sweep`); the jobs'
@@ -116,11 +117,13 @@ def sweep(
         Continue the sweep an existing store holds, or replace an existing output.
     scheduler : None, "local", "synchronous", address or distributed.Client
         Where the chunks run (:mod:`phdesign.sweep.schedulers`); default: the cluster of
-        ``DASK_SCHEDULER_ADDRESS``, else a local cluster sized to the machine.
+        ``DASK_SCHEDULER_ADDRESS``, else this process until a local cluster would repay
+        its start (:mod:`phdesign.sweep.automatic`; the choice is said on stderr).
     workers : int, optional
-        Workers of the local cluster.
+        Workers of the local cluster (given, a local cluster of that size starts).
     chunk_size : int, optional
-        Points per chunk (default: about half a second of the job's work).
+        Points per chunk (default: from the grid and the workers,
+        :func:`~phdesign.sweep.plan.chunk_points`).
     progress : bool, optional
         Progress bar on stderr (default: when stderr is a terminal).
 

@@ -32,16 +32,22 @@ from phdesign.core.errors import PhdesignError, SweepError
 from phdesign.sweep.dataset import RUN_ATTRIBUTE, template
 from phdesign.sweep.description import SweepDescription
 from phdesign.sweep.export import output_format, write_export
-from phdesign.sweep.plan import ChunkPlan, check_chunk_size
+from phdesign.sweep.plan import ChunkPlan, check_chunk_size, chunk_points
 
 __all__ = ["default_chunk_size", "run", "run_chunk"]
 
 
-def default_chunk_size(description: SweepDescription) -> int:
-    """Return the points per chunk: about half a second of the job's work."""
+def default_chunk_size(description: SweepDescription, workers: int = 1) -> int:
+    """Return the points per chunk for ``workers`` workers.
+
+    The size is :func:`~phdesign.sweep.plan.chunk_points`'s, from the job's nominal chunk
+    (about 0.4 s of its work): :attr:`~phdesign.sweep.jobs.Job.points_per_chunk` when
+    gains vary inside a setting, :attr:`~phdesign.sweep.jobs.Job.settings_per_chunk`
+    otherwise.
+    """
     job = description.job_spec
-    size = job.points_per_chunk if description.has_gain_axes else job.settings_per_chunk
-    return max(1, min(size, description.size))
+    nominal = job.points_per_chunk if description.has_gain_axes else job.settings_per_chunk
+    return chunk_points(description.size, workers, nominal)
 
 
 @lru_cache(maxsize=4)
@@ -133,10 +139,13 @@ def run(
     workers: int | None = None,
     chunk_size: int | None = None,
     progress: bool | None = None,
+    notify: Callable[[str], None] | None = None,
 ) -> Any:
     """Compute a described sweep and return its :class:`xarray.Dataset`.
 
-    See :func:`phdesign.sweep.sweep` for the parameters.  Everything that can be refused
+    See :func:`phdesign.sweep.sweep` for the parameters; ``notify`` receives the automatic
+    choice of where the chunks run (:mod:`phdesign.sweep.automatic`), one line each
+    (default: on stderr).  Everything that can be refused
     (the output, the scheduler) is checked before anything is written.  A Zarr store is
     written under its lock (:class:`~phdesign.sweep.lock.StoreLock`): a second sweep on
     the same store is refused while the first runs.  When a point is refused (a
@@ -160,7 +169,7 @@ def run(
                 else f"{str(output)!r} is written once, at the end"
             )
         )
-    where = _Where(scheduler, workers, progress)
+    where = _Where(scheduler, workers, progress, notify)
     if kind != "zarr" or output is None:
         if output is not None:
             from phdesign.io import check_output_path
@@ -185,10 +194,33 @@ class _Where:
     scheduler: Any
     workers: int | None
     progress: bool | None
+    notify: Callable[[str], None] | None
+
+    def executor(self) -> Any:
+        """Open the executor (:func:`~phdesign.sweep.schedulers.executor`)."""
+        from phdesign.sweep.schedulers import executor
+
+        return executor(self.scheduler, self.workers, _beside_the_bar(self.notify))
 
 
-def _new_plan(description: SweepDescription, chunk_size: int | None) -> ChunkPlan:
-    size = default_chunk_size(description) if chunk_size is None else chunk_size
+def _beside_the_bar(notify: Callable[[str], None] | None) -> Callable[[str], None] | None:
+    """``notify``, with the progress bar cleared while it writes (it writes on stderr too)."""
+    if notify is None:
+        from phdesign.sweep.schedulers import notify_on_stderr
+
+        notify = notify_on_stderr
+
+    def write(text: str) -> None:
+        from tqdm import tqdm
+
+        with tqdm.external_write_mode(file=sys.stderr):
+            notify(text)
+
+    return write
+
+
+def _new_plan(description: SweepDescription, chunk_size: int | None, workers: int) -> ChunkPlan:
+    size = default_chunk_size(description, workers) if chunk_size is None else chunk_size
     return ChunkPlan.for_grid(description.shape, size)
 
 
@@ -218,7 +250,8 @@ def _compute(
     text = description.to_json()
     todo = [(plan.chunk_shape, i) for i in range(plan.n_chunks) if i not in done]
     record["reused"] = len(done)
-    record["scheduler"] = ex.describe()
+    if ex.client is None:  # chunks run here: the job's imports before the first is timed
+        description.job_spec.evaluator_factory()
     results = ex.map_unordered(run_chunk, text, todo)
     # closed at once on an error or Ctrl-C (its finally cancels the futures and releases the
     # scattered description), not when a traceback that holds it is collected
@@ -228,13 +261,12 @@ def _compute(
             record["computed"] += 1
             record["compute_seconds"] += result["seconds"]
             bar.update(1)
+    record["scheduler"] = ex.describe()
+    if getattr(ex, "choice", None):
+        record["choice"] = ex.choice
 
 
 def _run_in_memory(description: SweepDescription, chunk_size: int | None, where: _Where) -> Any:
-    from phdesign.sweep.schedulers import executor
-
-    plan = _new_plan(description, chunk_size)
-    record = _record(plan, None)
     started = time.perf_counter()
     arrays = template(description)
 
@@ -242,7 +274,9 @@ def _run_in_memory(description: SweepDescription, chunk_size: int | None, where:
         for name, block in result["arrays"].items():
             arrays[name].values[region] = block
 
-    with executor(where.scheduler, where.workers) as ex:
+    with where.executor() as ex:
+        plan = _new_plan(description, chunk_size, ex.workers)
+        record = _record(plan, None)
         _compute(description, plan, ex, set(), write, record, where.progress)
     record["seconds"] = time.perf_counter() - started
     arrays.attrs[RUN_ATTRIBUTE] = json.dumps(record)
@@ -253,16 +287,16 @@ def _run_in_store(
     description: SweepDescription, store: Any, action: str, chunk_size: int | None, where: _Where
 ) -> Any:
     """Create, replace, resume or reopen ``store`` (its lock held) and fill it."""
-    from phdesign.sweep.schedulers import executor
-
-    plan = store.plan() if action in ("resume", "complete") else _new_plan(description, chunk_size)
-    record = _record(plan, store.path)
     if action == "complete":
+        plan = store.plan()
+        record = _record(plan, store.path)
         record["reused"] = plan.n_chunks
         return _finished(store, record)
     started = time.perf_counter()
-    with executor(where.scheduler, where.workers) as ex:
+    with where.executor() as ex:
         created = action in ("create", "replace")
+        plan = _new_plan(description, chunk_size, ex.workers) if created else store.plan()
+        record = _record(plan, store.path)
         if created:
             store.create(template(description, plan, lazy=True), description, plan, action)
         else:

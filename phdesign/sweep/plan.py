@@ -4,9 +4,14 @@ A chunk is a block of the grid (one slice per axis), at most ``chunk_size`` poin
 filled from the last axis outwards, with blocks of even size along each axis: a gain
 map's chunk is a run of rows of gains at one model and sensor set.  Chunks are numbered
 in C order over the grid of blocks.  The layout depends on the grid and the chunk size
-only (never on the scheduler or the number of workers), and each point's figures depend
-on the point only, so a sweep's results are the same however its chunks are scheduled,
-and a stored sweep can be resumed chunk by chunk.
+only, and each point's figures depend on the point only, so a sweep's results are the
+same however its chunks are scheduled, and a stored sweep (which keeps the layout it was
+written with) can be resumed chunk by chunk.
+
+The default chunk size (:func:`chunk_points`) is sized from the grid and the workers
+that will run it: enough chunks that every worker takes several (the last chunks to
+finish leave workers idle), none so small that the round trip of a task or the client's
+writes count.
 
 Examples
 --------
@@ -17,6 +22,10 @@ Examples
 (slice(0, 1, None), slice(2, 4, None), slice(0, 20, None))
 >>> ChunkPlan.for_grid((36, 36), 32).chunk_shape
 (1, 18)
+>>> chunk_points(36, workers=2, nominal=32)  # a 6 x 6 map on 2 workers: 6 chunks of 6
+8
+>>> ChunkPlan.for_grid((6, 6), chunk_points(36, workers=2, nominal=32)).n_chunks
+6
 """
 
 from __future__ import annotations
@@ -27,7 +36,12 @@ from dataclasses import dataclass
 
 from phdesign.core.errors import SweepError
 
-__all__ = ["ChunkPlan", "check_chunk_size"]
+__all__ = ["CHUNKS_PER_WORKER", "ChunkPlan", "check_chunk_size", "chunk_points"]
+
+#: Chunks per worker that the default chunk size aims at.  With chunks handed out as
+#: workers free up, the last ones to finish leave the others idle for about half a chunk
+#: each: 1/16 of a worker's share at 8 chunks per worker.
+CHUNKS_PER_WORKER = 8
 
 
 def check_chunk_size(chunk_size: object) -> int:
@@ -41,6 +55,43 @@ def check_chunk_size(chunk_size: object) -> int:
     if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
         raise SweepError(f"chunk size must be a positive integer; found {chunk_size!r}")
     return chunk_size
+
+
+def chunk_points(points: int, workers: int, nominal: int) -> int:
+    """Return the default points per chunk of a grid of ``points`` run by ``workers``.
+
+    Parameters
+    ----------
+    points : int
+        Points of the grid.
+    workers : int
+        Processes that will run the chunks (1 in this process).
+    nominal : int
+        Points of about 0.4 s of the job's work
+        (:attr:`~phdesign.sweep.jobs.Job.points_per_chunk`, or
+        :attr:`~phdesign.sweep.jobs.Job.settings_per_chunk` without a gain axis).
+
+    Returns
+    -------
+    int
+        :data:`CHUNKS_PER_WORKER` chunks per worker where the grid allows, within
+        ``nominal / 4`` (about 0.1 s of work, against a task's round trip of 6 to 8 ms)
+        and ``4 nominal`` (about 1.6 s: what a killed sweep recomputes, what the progress
+        bar waits for); never under ``workers nominal / 8`` (about 50 ms of work per
+        worker), so that the client, which writes every chunk (about 30 ms each to a
+        Zarr store), keeps up with the workers.
+
+    Examples
+    --------
+    >>> [chunk_points(p, 2, 32) for p in (4, 36, 400, 10**6)]
+    [4, 8, 25, 128]
+    >>> chunk_points(10**6, workers=128, nominal=32)  # the client's writes decide
+    512
+    """
+    floor = max(math.ceil(nominal / 4), math.ceil(workers * nominal / 8), 1)
+    ceiling = max(4 * nominal, floor)
+    balanced = math.ceil(points / (CHUNKS_PER_WORKER * max(workers, 1)))
+    return max(1, min(points, max(floor, min(balanced, ceiling))))
 
 
 @dataclass(frozen=True)

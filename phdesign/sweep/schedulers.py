@@ -2,10 +2,14 @@
 
 ``scheduler`` is one of
 
-``None`` or ``"local"``
-    ``None`` uses the cluster named by ``DASK_SCHEDULER_ADDRESS`` when it is set; otherwise
-    (and always for ``"local"``) a :class:`dask.distributed.LocalCluster` of one
-    single-threaded worker process per core this process may use, closed at the end.
+``None``
+    the cluster named by ``DASK_SCHEDULER_ADDRESS`` when it is set; otherwise the chunks
+    run in this process until a local cluster would repay its start, and the rest on one
+    (:mod:`phdesign.sweep.automatic`: a small grid never waits for workers to start).
+    With ``workers``, a local cluster of that many workers.
+``"local"``
+    a :class:`dask.distributed.LocalCluster` of one single-threaded worker process per
+    core this process may use (or ``workers``), closed at the end.
 ``"synchronous"``
     every chunk in this process, one after the other (for debugging; no Dask needed).
 ``"tcp://HOST:PORT"`` (or any Dask address)
@@ -26,15 +30,17 @@ from __future__ import annotations
 import os
 import signal
 import socket
+import sys
 import threading
 from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from typing import Any
 from urllib.parse import urlsplit
 
 from phdesign.core.errors import SweepError
 from phdesign.core.limits import check_local_workers
+from phdesign.sweep.automatic import Automatic
 
 __all__ = [
     "CONNECT_TIMEOUT",
@@ -43,6 +49,7 @@ __all__ = [
     "check_address",
     "check_scheduler",
     "executor",
+    "notify_on_stderr",
     "usable_cores",
 ]
 
@@ -271,15 +278,19 @@ def _workers_ignore_sigint() -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
 
 
+def _refuse_in_a_spawned_worker() -> None:
+    """Refuse a sweep that a worker process reached by importing the user's script again."""
+    import multiprocessing
+
+    if getattr(multiprocessing.current_process(), "_inheriting", False):
+        raise SweepError(_GUARD)
+
+
 def _local_cluster(n_workers: int) -> Any:
     """Start a LocalCluster of single-threaded worker processes (spawned, as Dask does)."""
     import logging
-    import multiprocessing
-    import sys
 
-    if getattr(multiprocessing.current_process(), "_inheriting", False):
-        # a worker process importing the user's script again reached its unguarded sweep
-        raise SweepError(_GUARD)
+    _refuse_in_a_spawned_worker()
     from dask.distributed import LocalCluster
 
     try:
@@ -298,8 +309,17 @@ def _local_cluster(n_workers: int) -> Any:
         raise
 
 
+def notify_on_stderr(text: str) -> None:
+    """Print one line of a sweep's (``phdesign: sweep: ...``) on stderr."""
+    print(f"phdesign: {text}", file=sys.stderr)
+
+
 @contextmanager
-def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Executor]:
+def executor(
+    scheduler: Any = None,
+    workers: int | None = None,
+    notify: Callable[[str], None] | None = None,
+) -> Iterator[Executor | Automatic]:
     """Open the executor named by ``scheduler`` (see the module docstring).
 
     Parameters
@@ -307,6 +327,9 @@ def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Exec
     scheduler : None, str or distributed.Client
     workers : int, optional
         Workers of a local cluster (default: :func:`usable_cores`).
+    notify : callable, optional
+        Receives the automatic choice's decisions, one line each (default: printed on
+        stderr after ``phdesign:``).
 
     Raises
     ------
@@ -316,6 +339,12 @@ def executor(scheduler: Any = None, workers: int | None = None) -> Iterator[Exec
     check_scheduler(scheduler, workers)
     if scheduler == "synchronous":
         yield Executor("synchronous", 1)
+        return
+    if scheduler is None and workers is None and not os.environ.get("DASK_SCHEDULER_ADDRESS"):
+        _refuse_in_a_spawned_worker()
+        with ExitStack() as stack:
+            say = notify or notify_on_stderr
+            yield Automatic(usable_cores(), lambda: executor("local"), say, stack)
         return
     if scheduler is not None and not isinstance(scheduler, str):
         n = len(scheduler.scheduler_info().get("workers", {}))
