@@ -118,7 +118,8 @@ def sweep(
     scheduler : None, "local", "synchronous", address or distributed.Client
         Where the chunks run (:mod:`phdesign.sweep.schedulers`); default: the cluster of
         ``DASK_SCHEDULER_ADDRESS``, else this process until a local cluster would repay
-        its start (:mod:`phdesign.sweep.automatic`; the choice is said on stderr).
+        its start (:mod:`phdesign.sweep.automatic`; the choice is the run record's
+        ``notes``, and ``phdesign sweep`` prints it on stderr).
     workers : int, optional
         Workers of the local cluster (given, a local cluster of that size starts).
     chunk_size : int, optional
@@ -132,7 +133,9 @@ def sweep(
     xarray.Dataset
         One variable per figure over the axes; attributes ``model``, ``job``,
         ``sensors``, ``gain``, ``options``, ``phdesign_version``, ``phdesign_sweep``
-        (the description as JSON) and ``phdesign_run`` (the run's record).
+        (the description as JSON) and ``phdesign_run`` (the run's record, JSON: chunks,
+        seconds, ``scheduler``; after an automatic choice, ``choice`` and ``notes``, the
+        lines that say where the chunks ran and why).
 
     Raises
     ------

@@ -4,20 +4,28 @@ A local cluster costs seconds to start (its worker processes import Dask, then p
 and scipy), and a small grid is done in this process before the workers are up.  So
 without a scheduler (no ``scheduler``, no ``workers``, no ``DASK_SCHEDULER_ADDRESS``) a
 sweep runs its first chunk here, which measures what a chunk costs, and starts a local
-cluster only when the chunks left finish sooner there, its start included:
+cluster only when the chunks left finish sooner there by more than its start once again:
 
 .. math::
 
-    S + \left\lceil R / N \right\rceil \frac{t}{\eta} < R\, t,
+    2 S + \left\lceil \frac{R}{N} \right\rceil \frac{N}{F} \frac{t}{\eta} < R\, t,
+    \qquad F = \min\bigl(N,\; P - (L - 1)\bigr),
 
-with R the chunks left, t the mean time of the chunks run here so far, N the workers a
-local cluster would have (one per usable core), :math:`\eta` = :data:`PARALLEL_EFFICIENCY`
-and S = :data:`LOCAL_CLUSTER_START`.  The rule is asked again after every chunk run here
-(a grid whose later points cost more can still start a cluster half-way), and its answer
-is said on stderr and kept in the run's record (``scheduler``, ``choice``).  On two cores
-the cluster repays its start from about 7 s of work: a 6 x 6 map of the beam (0.5 s)
-runs here, a 40 x 40 one (about 19 s) on the cluster.  Every chunk's figures are the same
-wherever it runs, so the choice moves no number.
+with R the chunks left, t the mean wall time of the chunks run here so far, N the workers
+a local cluster would have (one per usable core), F the cores they would find free (L the
+load average of the last minute, this sweep counted once, over the P processors it
+counts; F is at most this process's CPU share when that is under
+:data:`FREE_CORE_SHARE`), :math:`\eta` = :data:`PARALLEL_EFFICIENCY` and
+S = :data:`LOCAL_CLUSTER_START`, counted twice: a start costs more on a loaded machine
+(15 s instead of 3 at a load average of 5 on two cores).  The rule is asked again after
+every chunk run here (a grid whose later points cost more can still start a cluster
+half-way), and its answer is one line, kept in the run's record (``notes``, beside
+``scheduler`` and the figures it used, ``choice``) and said as it is made to whoever
+asked (``notify``: the command line prints it on stderr).  On two free cores a cluster
+starts from about 14 s of work: a 6 x 6 map of the beam (0.5 s) and the 20 x 20 one
+(5 s) run here, a 40 x 40 one (about 19 s) on the cluster; with one core's worth of
+other work on two cores, never.  Every chunk's figures are the same wherever it runs, so
+the choice moves no number.
 
 An existing cluster (an address, a :class:`distributed.Client`, ``DASK_SCHEDULER_ADDRESS``)
 has no start to repay (a connection is about 10 ms), and a named scheduler or a worker
@@ -29,11 +37,14 @@ Examples
 False
 >>> cluster_repays(remaining=19, chunk_seconds=0.96, workers=2)  # 1600 points
 True
+>>> cluster_repays(19, 0.96, workers=2, free=free_workers(2, load=2.0))  # one core busy
+False
 """
 
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import AbstractContextManager, ExitStack
@@ -41,11 +52,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 __all__ = [
+    "FREE_CORE_SHARE",
     "LOCAL_CLUSTER_START",
     "PARALLEL_EFFICIENCY",
     "Automatic",
     "cluster_repays",
     "estimated_seconds",
+    "free_workers",
+    "load_average",
 ]
 
 #: Seconds from asking for a local cluster to its workers computing (processes spawned,
@@ -57,9 +71,59 @@ LOCAL_CLUSTER_START = 3.0
 #: 2 workers (the task round trips, the scheduling, the client's writes).
 PARALLEL_EFFICIENCY = 0.9
 
+#: The share of its wall time that a process computing alone on a core gets as CPU time
+#: (at least 0.97 measured on an idle core); less means another process wanted the core.
+FREE_CORE_SHARE = 0.9
+
+
+def load_average() -> float | None:
+    """Return the load average of the last minute (``None`` where the system has none)."""
+    try:
+        return os.getloadavg()[0]
+    except (AttributeError, OSError):  # pragma: no cover - Windows
+        return None
+
+
+def free_workers(
+    workers: int,
+    cpu_share: float = 1.0,
+    load: float | None = None,
+    processors: int | None = None,
+) -> float:
+    """Return the cores a local cluster of ``workers`` would find free now (0 to ``workers``).
+
+    Parameters
+    ----------
+    workers : int
+        Workers of the cluster (one per usable core).
+    cpu_share : float
+        This process's CPU time over its wall time while it computed.
+    load : float, optional
+        The load average of the last minute, this sweep's own process in it.
+    processors : int, optional
+        The processors that load is spread over (:func:`os.cpu_count`: a container's
+        load average is often its host's; default ``workers``).
+
+    Examples
+    --------
+    >>> free_workers(2), free_workers(2, load=1.4), free_workers(2, cpu_share=0.6)
+    (2.0, 1.6, 0.6)
+    """
+    free = float(workers)
+    if load is not None:
+        idle = (workers if processors is None else processors) - max(0.0, load - 1.0)
+        free = min(free, idle)
+    if cpu_share < FREE_CORE_SHARE:  # this process itself did not have a core
+        free = min(free, cpu_share)
+    return max(0.0, free)
+
 
 def estimated_seconds(
-    remaining: int, chunk_seconds: float, workers: int, start: float | None = None
+    remaining: int,
+    chunk_seconds: float,
+    workers: int,
+    free: float | None = None,
+    start: float | None = None,
 ) -> tuple[float, float]:
     """Return the seconds ``remaining`` chunks take here and on a local cluster (its start in).
 
@@ -71,27 +135,37 @@ def estimated_seconds(
         Mean time of a chunk in this process.
     workers : int
         Workers of the local cluster.
+    free : float, optional
+        The cores they would find free (:func:`free_workers`; default ``workers``).
     start : float, optional
         Seconds to start the cluster (default :data:`LOCAL_CLUSTER_START`).
     """
     start = LOCAL_CLUSTER_START if start is None else start
+    free = float(workers) if free is None else free
     here = remaining * chunk_seconds
-    there = start + math.ceil(remaining / workers) * chunk_seconds / PARALLEL_EFFICIENCY
-    return here, there
+    if free <= 0:
+        return here, math.inf
+    rounds = math.ceil(remaining / workers) * workers / free
+    return here, start + rounds * chunk_seconds / PARALLEL_EFFICIENCY
 
 
 def cluster_repays(
-    remaining: int, chunk_seconds: float, workers: int, start: float | None = None
+    remaining: int,
+    chunk_seconds: float,
+    workers: int,
+    free: float | None = None,
+    start: float | None = None,
 ) -> bool:
-    """Whether ``remaining`` chunks finish sooner on a local cluster, its start included.
+    """Whether a local cluster finishes ``remaining`` chunks sooner by more than its start.
 
     The arguments are those of :func:`estimated_seconds`; one worker or one chunk never
     repays a cluster.
     """
     if workers < 2 or remaining < 2:
         return False
-    here, there = estimated_seconds(remaining, chunk_seconds, workers, start)
-    return there < here
+    start = LOCAL_CLUSTER_START if start is None else start
+    here, there = estimated_seconds(remaining, chunk_seconds, workers, free, start)
+    return there + start < here
 
 
 @dataclass
@@ -105,21 +179,35 @@ class Automatic:
     start : callable
         Returns the context manager of that cluster's executor
         (:func:`phdesign.sweep.schedulers.executor` with ``scheduler="local"``).
-    notify : callable
-        Receives each decision as one line (``sweep: ...``).
+    notify : callable or None
+        Receives each decision as one line (``sweep: ...``) as it is made.
     stack : ExitStack
         Holds the cluster once started; closed by the caller (the cluster with it).
-    clock : callable
-        Seconds, for the chunks' times (:func:`time.perf_counter`).
+    clock, cpu_clock : callable
+        Wall and CPU seconds of this process, for the chunks run here
+        (:func:`time.perf_counter`, :func:`time.process_time`).
+    load : callable
+        The machine's load average of the last minute (:func:`load_average`).
+    processors : int, optional
+        The processors that load average counts (default :func:`os.cpu_count`).
+
+    Attributes
+    ----------
+    notes : list of str
+        Every line given to ``notify``, in order: the run record's ``notes``.
     """
 
     workers: int
     start: Callable[[], AbstractContextManager[Any]]
-    notify: Callable[[str], None]
+    notify: Callable[[str], None] | None
     stack: ExitStack
     clock: Callable[[], float] = time.perf_counter
+    cpu_clock: Callable[[], float] = time.process_time
+    load: Callable[[], float | None] = field(default=lambda: load_average())
+    processors: int | None = field(default_factory=os.cpu_count)
     started: Any = None
     choice: dict[str, Any] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
 
     @property
     def client(self) -> Any:
@@ -131,38 +219,55 @@ class Automatic:
     ) -> Iterator[Any]:
         """Yield ``function(shared, *task)`` for every task: here, then maybe on a cluster."""
         tasks = list(tasks)
-        if self.workers < 2 or len(tasks) < 3:  # the first chunk measures; one left never repays
-            self.notify(self._alone(len(tasks)))
-        seconds = 0.0
+        can_share = self.workers >= 2 and len(tasks) >= 3  # one left never repays
+        if not can_share:
+            self._say(self._alone(len(tasks)))
+        wall = cpu = 0.0
         for done, task in enumerate(tasks):
-            mean = seconds / done if done else 0.0
-            remaining = len(tasks) - done
-            if done and cluster_repays(remaining, mean, self.workers):
-                self._record(done, mean, remaining)
-                self.notify(self._starting(remaining, mean))
-                self.started = self.stack.enter_context(self.start())
-                yield from self.started.map_unordered(function, shared, tasks[done:])
-                return
-            if done == 1 and self.workers >= 2 and len(tasks) >= 3:
-                self.notify(self._staying(remaining, mean))
-            began = self.clock()
+            if done:
+                mean, free = self._record(done, wall, cpu)
+                remaining = len(tasks) - done
+                if cluster_repays(remaining, mean, self.workers, free):
+                    self.choice["chunks_on_cluster"] = remaining
+                    self._say(self._starting(remaining, mean, free))
+                    self.started = self.stack.enter_context(self.start())
+                    yield from self.started.map_unordered(function, shared, tasks[done:])
+                    return
+                if done == 1 and can_share:
+                    self._say(self._staying(remaining, mean, free))
+            began, began_cpu = self.clock(), self.cpu_clock()
             result = function(shared, *task)
-            seconds += self.clock() - began
-            self._record(done + 1, seconds / (done + 1), 0)
+            wall += self.clock() - began
+            cpu += self.cpu_clock() - began_cpu
             yield result
+        if tasks:
+            self._record(len(tasks), wall, cpu)
 
-    def _record(self, here: int, mean: float, remaining: int) -> None:
+    def _say(self, line: str) -> None:
+        self.notes.append(line)
+        if self.notify is not None:
+            self.notify(line)
+
+    def _record(self, here: int, wall: float, cpu: float) -> tuple[float, float]:
+        """Keep what ``here`` chunks measured; return their mean wall time and the free cores."""
+        mean, share = wall / here, min(1.0, cpu / wall) if wall > 0 else 1.0
+        load = self.load()
+        free = free_workers(self.workers, share, load, self.processors)
         self.choice = {
             "automatic": True,
             "chunks_in_process": here,
             "chunk_seconds": mean,
+            "cpu_share": share,
+            "load_average": load,
+            "free_cores": free,
             "cluster_workers": self.workers,
             "cluster_start_seconds": LOCAL_CLUSTER_START,
-            "chunks_on_cluster": remaining,
+            "chunks_on_cluster": 0,
         }
+        return mean, free
 
-    def _starting(self, remaining: int, mean: float) -> str:
-        here, there = estimated_seconds(remaining, mean, self.workers)
+    def _starting(self, remaining: int, mean: float, free: float) -> str:
+        here, there = estimated_seconds(remaining, mean, self.workers, free)
         return (
             f"sweep: starting a local cluster of {self.workers} workers: the {remaining} "
             f"chunks left take about {mean:.2g} s each, {here:.1f} s in this process "
@@ -170,13 +275,21 @@ class Automatic:
             "included"
         )
 
-    def _staying(self, remaining: int, mean: float) -> str:
-        return (
-            f"sweep: running in this process: the {remaining} chunks left take about "
-            f"{mean:.2g} s each ({remaining * mean:.1f} s), too little for a local cluster "
-            f"of {self.workers} workers to repay its start (about {LOCAL_CLUSTER_START:g} s); "
-            "pass `scheduler='local'` to start one anyway"
-        )
+    def _staying(self, remaining: int, mean: float, free: float) -> str:
+        if free * PARALLEL_EFFICIENCY <= 1:
+            load, share = self.choice["load_average"], self.choice["cpu_share"]
+            seen = f"load average {load:.1f}, " if load is not None else ""
+            why = (
+                f"the machine is busy ({seen}this process had {100 * share:.0f} % of a core): "
+                f"a local cluster's {self.workers} workers would find about {free:.1f} cores free"
+            )
+        else:
+            why = (
+                f"the {remaining} chunks left take about {mean:.2g} s each "
+                f"({remaining * mean:.1f} s): a local cluster of {self.workers} workers "
+                f"would not save twice its start (about {LOCAL_CLUSTER_START:g} s)"
+            )
+        return f"sweep: running in this process: {why}; pass `scheduler='local'` to start one"
 
     def _alone(self, count: int) -> str:
         if self.workers < 2:

@@ -144,8 +144,9 @@ def run(
     """Compute a described sweep and return its :class:`xarray.Dataset`.
 
     See :func:`phdesign.sweep.sweep` for the parameters; ``notify`` receives the automatic
-    choice of where the chunks run (:mod:`phdesign.sweep.automatic`), one line each
-    (default: on stderr).  Everything that can be refused
+    choice of where the chunks run (:mod:`phdesign.sweep.automatic`), one line each, as it
+    is made (the command line prints it on stderr); the lines are also the run record's
+    ``notes``, whoever is notified.  Everything that can be refused
     (the output, the scheduler) is checked before anything is written.  A Zarr store is
     written under its lock (:class:`~phdesign.sweep.lock.StoreLock`): a second sweep on
     the same store is refused while the first runs.  When a point is refused (a
@@ -206,9 +207,7 @@ class _Where:
 def _beside_the_bar(notify: Callable[[str], None] | None) -> Callable[[str], None] | None:
     """``notify``, with the progress bar cleared while it writes (it writes on stderr too)."""
     if notify is None:
-        from phdesign.sweep.schedulers import notify_on_stderr
-
-        notify = notify_on_stderr
+        return None
 
     def write(text: str) -> None:
         from tqdm import tqdm
@@ -264,6 +263,8 @@ def _compute(
     record["scheduler"] = ex.describe()
     if getattr(ex, "choice", None):
         record["choice"] = ex.choice
+    if getattr(ex, "notes", None):
+        record["notes"] = list(ex.notes)
 
 
 def _run_in_memory(description: SweepDescription, chunk_size: int | None, where: _Where) -> Any:

@@ -49,7 +49,6 @@ __all__ = [
     "check_address",
     "check_scheduler",
     "executor",
-    "notify_on_stderr",
     "usable_cores",
 ]
 
@@ -309,11 +308,6 @@ def _local_cluster(n_workers: int) -> Any:
         raise
 
 
-def notify_on_stderr(text: str) -> None:
-    """Print one line of a sweep's (``phdesign: sweep: ...``) on stderr."""
-    print(f"phdesign: {text}", file=sys.stderr)
-
-
 @contextmanager
 def executor(
     scheduler: Any = None,
@@ -328,8 +322,9 @@ def executor(
     workers : int, optional
         Workers of a local cluster (default: :func:`usable_cores`).
     notify : callable, optional
-        Receives the automatic choice's decisions, one line each (default: printed on
-        stderr after ``phdesign:``).
+        Receives the automatic choice's decisions, one line each, as they are made
+        (default: nobody; they are the :class:`~phdesign.sweep.automatic.Automatic`
+        executor's ``notes`` either way).
 
     Raises
     ------
@@ -343,8 +338,7 @@ def executor(
     if scheduler is None and workers is None and not os.environ.get("DASK_SCHEDULER_ADDRESS"):
         _refuse_in_a_spawned_worker()
         with ExitStack() as stack:
-            say = notify or notify_on_stderr
-            yield Automatic(usable_cores(), lambda: executor("local"), say, stack)
+            yield Automatic(usable_cores(), lambda: executor("local"), notify, stack)
         return
     if scheduler is not None and not isinstance(scheduler, str):
         n = len(scheduler.scheduler_info().get("workers", {}))
