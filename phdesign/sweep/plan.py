@@ -79,7 +79,8 @@ def chunk_points(points: int, workers: int, nominal: int) -> int:
         and ``4 nominal`` (about 1.6 s: what a killed sweep recomputes, what the progress
         bar waits for); never under ``workers nominal / 8`` (about 50 ms of work per
         worker), so that the client, which writes every chunk (about 30 ms each to a
-        Zarr store), keeps up with the workers.
+        Zarr store), keeps up with the workers, unless that would leave a worker
+        without a chunk (a small grid on many workers: a chunk each).
 
     Examples
     --------
@@ -87,8 +88,11 @@ def chunk_points(points: int, workers: int, nominal: int) -> int:
     [4, 8, 25, 128]
     >>> chunk_points(10**6, workers=128, nominal=32)  # the client's writes decide
     512
+    >>> chunk_points(400, workers=16, nominal=32)  # 16 chunks of 25, not 7 of 64
+    25
     """
-    floor = max(math.ceil(nominal / 4), math.ceil(workers * nominal / 8), 1)
+    writes = min(math.ceil(workers * nominal / 8), math.ceil(points / max(workers, 1)))
+    floor = max(math.ceil(nominal / 4), writes, 1)
     ceiling = max(4 * nominal, floor)
     balanced = math.ceil(points / (CHUNKS_PER_WORKER * max(workers, 1)))
     return max(1, min(points, max(floor, min(balanced, ceiling))))

@@ -41,6 +41,7 @@ WAVE = {"sensors": [2], "grid": {"l1": "0.1:0.9:9"}, "progress": False}
         ((20, 20), 1, 32, 10, (2, 20)),  # in this process: fewer, larger chunks
         ((1000, 1000), 2, 32, 8000, (1, 125)),  # 4 nominal (128) at most, in even blocks
         ((1000, 1000), 128, 32, 2000, (1, 500)),  # 128 nominal / 8 = 512: the client keeps up
+        ((20, 20), 16, 32, 20, (1, 20)),  # not 7 chunks of 64 for 16 workers: one each at least
         ((9,), 2, 4, 9, (1,)),  # no gain axis: a setting per point (nominal 4)
     ],
 )
@@ -326,10 +327,10 @@ def test_a_client_is_used_as_it_is_and_left_open(no_local_cluster):
 
 def test_chunks_on_an_existing_cluster_are_sized_for_its_workers():
     # 400 points, nominal 32: 8 chunks per worker within [8, 128] points, never under
-    # workers x 32 / 8 points (plan.chunk_points)
+    # workers x 32 / 8 points unless a worker would go without a chunk (plan.chunk_points)
     grid = {"l1": "0.1:0.9:20", "l2": "0.1:0.9:20"}
     description = describe(load_builtin("euler-bernoulli"), sensors=[3, 4], grid=grid)
-    assert [default_chunk_size(description, n) for n in (1, 2, 4, 16)] == [50, 25, 16, 64]
+    assert [default_chunk_size(description, n) for n in (1, 2, 4, 16)] == [50, 25, 16, 25]
 
 
 def test_a_cluster_started_half_way_gives_the_same_store(two_cores, monkeypatch, tmp_path):
