@@ -1,48 +1,67 @@
-"""Sweep benchmark: a 400-point gain map of the beam, synchronous against 2 Dask workers.
+"""Sweep benchmark: the beam's gain maps in this process, on 2 Dask workers, on a plain Pool(2).
 
-Usage: ``python benchmarks/sweep.py [--repeat 2] [--pair]`` (about a minute on 2 cores).
+Usage: ``python benchmarks/sweep.py [--repeat 3] [--pair] [--large]`` (about two minutes on
+2 cores; ``--large`` adds a 1600-point map, about a minute more per round).
 
-The map is the README gallery's: the error system's spectral abscissa over a 20 x 20 log
-grid of (l1, l2), sensors y3, y4, in chunks of the default size.  Measured in one
-invocation, alternating the two so that a change of the machine's load hits both:
+The maps are the README gallery's: the error system's spectral abscissa over a log grid
+of (l1, l2), sensors y3, y4, in chunks of the default size (sized from the grid and the
+workers).  Measured in one invocation, in interleaved rounds (a change of the machine's
+load hits every route), medians over the rounds:
 
-* the synchronous run (this process): wall time, and the per-point cost (the chunks'
-  own compute time over the points; a point that converges at the pair (20, 30), its
-  discretizations shared by the chunk, separately as a median over single points);
-* the same sweep on a ``LocalCluster`` of 2 single-threaded worker processes (started and
-  warmed before the timing; its start-up is printed apart): wall time and speed-up over
-  the synchronous run (target >= 1.6x on 2 cores);
-* the task overhead: the round trip of a chunk that does nothing, against the mean
-  chunk compute time (target < 5 %), and the parallel efficiency (chunk compute over
-  workers x wall time);
-* the Zarr store's cost per chunk (a synchronous run written to a store, against the same
-  in memory);
-* the cores the machine gives two workers at that moment (a fixed workload, two copies at
-  once against one alone): on a shared machine, the ceiling of the speed-up.
+* 400 points (20 x 20): synchronous; on a ``LocalCluster`` of 2 single-threaded worker
+  processes started before the timing (target >= 1.6x synchronous, the median of the
+  rounds' paired ratios, judged when the machine gives the two workers their cores); on
+  the same cluster by its address, as ``--scheduler tcp://...`` uses an existing cluster
+  (a connection per sweep; target: within 0.2 s of its ``Client``); on a
+  ``multiprocessing.Pool(2)`` started
+  before the timing, over the same calls (``run_chunk`` on the same chunks; target: the
+  Dask route within 1.15x the Pool); the default route (no scheduler: the automatic
+  choice of :mod:`phdesign.sweep.automatic`; target: never slower than synchronous,
+  1.10x allowed for noise); and the cold routes, a local cluster and a Pool started,
+  used and closed inside the timing (printed, with the start cost they measure against
+  the rule's constant);
+* 36 points (6 x 6): synchronous and the default route, three pairs a round, which must
+  choose this process (target: the choice, and a ratio within 1.10x);
+* ``--large``, 1600 points (40 x 40): synchronous and the default route, which should
+  start a cluster and beat synchronous (judged when the cores are free).
 
-Both runs must give identical arrays (checked).  BLAS runs one thread per process (the
-chunk function limits it, and the workers are started with one thread).  ``--pair``
-sweeps the single resolution pair (20, 30) of notebook 02 instead of the converged
-default.  The load average before and after is printed: quote it with the numbers.
+Also: the per-point cost, the task overhead (the round trip of a chunk that does nothing,
+against the mean chunk; target < 5 %), the parallel efficiency, the Zarr store's cost per
+chunk, and the cores the machine gives two workers (a fixed workload, two copies at once
+against one alone: on a shared machine, the ceiling of any speed-up).  Every route must
+give identical arrays (checked).  BLAS runs one thread per process.  ``--pair`` sweeps the
+single resolution pair (20, 30) of notebook 02.  The load average before and after is
+printed, and at the start of every round: quote it with the numbers.  Wall and CPU times
+come from ``_timing.timed``.  Exit status 1 when a judged target is missed.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import multiprocessing
 import os
 import shutil
 import statistics
 import sys
 import tempfile
 import time
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
+from _timing import timed
 
-import phdesign
 from phdesign.models import load_builtin
+from phdesign.sweep import describe
+from phdesign.sweep.automatic import LOCAL_CLUSTER_START
+from phdesign.sweep.execute import run, run_chunk
+from phdesign.sweep.plan import ChunkPlan
 
-GRID = {"l1": "0.01:3:20:log", "l2": "0.1:10:20:log"}
+MAP = {"l1": "0.01:3:20:log", "l2": "0.1:10:20:log"}
+SMALL = {"l1": "0.01:3:6:log", "l2": "0.1:10:6:log"}
+LARGE = {"l1": "0.01:3:40:log", "l2": "0.1:10:40:log"}
+FREE_CORES = 1.8  # the speed-up targets are judged when two workers get this many cores
 
 
 def _noop(text: str, chunk_shape: tuple[int, ...], index: int) -> dict:
@@ -76,6 +95,10 @@ def _warm() -> None:
     import phdesign.sweep.spectrum_job  # noqa: F401
 
 
+def _pool_chunk(task: tuple[str, tuple[int, ...], int]) -> dict:
+    return run_chunk(*task)
+
+
 def record(ds) -> dict:
     return json.loads(ds.attrs["phdesign_run"])
 
@@ -84,6 +107,28 @@ def identical(a, b) -> bool:
     return all(
         np.array_equal(a[n].values, b[n].values, equal_nan=a[n].dtype.kind == "f")
         for n in a.data_vars
+    )
+
+
+def on_pool(pool, description, chunk_shape) -> dict[str, np.ndarray]:
+    """The same chunks through ``pool.imap_unordered(run_chunk)``: the figures' arrays."""
+    plan = ChunkPlan(description.shape, tuple(chunk_shape))
+    text = description.to_json()
+    arrays = {
+        f.name: np.full(description.shape, f.fill, dtype=f.dtype)
+        for f in description.job_spec.figures
+    }
+    tasks = [(text, plan.chunk_shape, i) for i in range(plan.n_chunks)]
+    for result in pool.imap_unordered(_pool_chunk, tasks):
+        for name, block in result["arrays"].items():
+            arrays[name][plan.region(result["index"])] = block
+    return arrays
+
+
+def same_as_pool(ds, arrays: dict[str, np.ndarray]) -> bool:
+    return all(
+        np.array_equal(ds[n].values, arrays[n], equal_nan=ds[n].dtype.kind == "f")
+        for n in ds.data_vars
     )
 
 
@@ -107,49 +152,101 @@ def fast_path_ms() -> float:
     return 1e3 * statistics.median(times)
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=2, help="runs of each (default 2)")
-    parser.add_argument("--pair", action="store_true", help="the single pair (20, 30)")
-    args = parser.parse_args(argv)
-    load_before = os.getloadavg()
-    beam = load_builtin("euler-bernoulli")
-    options = {"resolution": 20, "max_resolution": 30} if args.pair else {}
-    kwargs = {"sensors": [3, 4], "grid": GRID, "options": options, "progress": False}
-    points = 400
+class Rounds:
+    """Wall times by route, and the checks and choices seen, over interleaved rounds."""
 
-    # warm this process: imports, the first discretizations
-    phdesign.sweep(beam, sensors=[3, 4], grid={"l1": "0.1,1"}, scheduler="synchronous")
+    def __init__(self) -> None:
+        self.walls: dict[str, list[float]] = {}
+        self.compute: dict[str, list[float]] = {}
+        self.records: dict[str, dict] = {}
+        self.loads: list[float] = []
+        self.same = True
 
-    from dask.distributed import Client, LocalCluster
+    def time(self, route: str, call: Callable[[], Any]) -> Any:
+        out, walls, _cpus = timed(call, repeat=1)
+        self.walls.setdefault(route, []).append(walls[0])
+        if hasattr(out, "attrs"):
+            self.records[route] = record(out)
+            self.compute.setdefault(route, []).append(record(out)["compute_seconds"])
+        return out
 
-    start = time.perf_counter()
-    cluster = LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+    def median(self, route: str) -> float:
+        return statistics.median(self.walls[route])
+
+    def runs(self, route: str) -> str:
+        return ", ".join(f"{t:.2f}" for t in self.walls[route])
+
+    def paired(self, slow: str, fast: str) -> list[float]:
+        """``slow / fast`` round by round (the two ran minutes apart at most)."""
+        return [a / b for a, b in zip(self.walls[slow], self.walls[fast], strict=True)]
+
+
+def pair(rounds: Rounds, names: tuple[str, str], calls: tuple, flip: bool) -> tuple:
+    """Time two routes one after the other, in the order ``flip`` says (A B, then B A)."""
+    order = (1, 0) if flip else (0, 1)
+    out = [None, None]
+    for i in order:
+        out[i] = rounds.time(names[i], calls[i])
+    return tuple(out)
+
+
+def one_round(rounds: Rounds, grids: dict, client, pool, large: bool, flip: bool) -> None:
+    """Every route once, in turn; arrays compared with the synchronous run's.
+
+    The running cluster is used twice: through its ``Client`` and through its address, as
+    ``--scheduler tcp://...`` would (a connection per sweep).
+    """
+    rounds.loads.append(os.getloadavg()[0])
+    sync = {"scheduler": "synchronous", "progress": False}
+    local = {"progress": False}  # the default route: its choice is in the record's notes
+    d = grids["map"]
+    ds_sync, ds_auto = pair(
+        rounds, ("sync", "auto"), (lambda: run(d, **sync), lambda: run(d, **local)), flip
     )
-    client = Client(cluster)
-    client.run(_warm)
-    startup = time.perf_counter() - start
-    phdesign.sweep(beam, sensors=[3, 4], grid={"l1": "0.1,1"}, scheduler=client)
+    ds_dask = rounds.time("dask", lambda: run(d, scheduler=client, progress=False))
+    address = client.scheduler.address
+    ds_address = rounds.time("address", lambda: run(d, scheduler=address, progress=False))
+    chunks = record(ds_dask)["chunk_shape"]
+    arrays = rounds.time("pool", lambda: on_pool(pool, d, chunks))
+    ds_cold = rounds.time("dask cold", lambda: run(d, scheduler="local", progress=False))
 
-    capacity_before = capacity(client)
-    sync_wall, dask_wall, sync_compute, dask_compute = [], [], [], []
-    chunks = 0
-    for _ in range(args.repeat):
-        ds_sync = phdesign.sweep(beam, scheduler="synchronous", **kwargs)
-        ds_dask = phdesign.sweep(beam, scheduler=client, **kwargs)
-        assert identical(ds_sync, ds_dask), "the two runs differ"
-        for ds, wall, compute in (
-            (ds_sync, sync_wall, sync_compute),
-            (ds_dask, dask_wall, dask_compute),
-        ):
-            run = record(ds)
-            wall.append(run["seconds"])
-            compute.append(run["compute_seconds"])
-            chunks = run["chunks"]
-    converged = int(ds_sync.converged.sum())
+    def cold_pool() -> dict[str, np.ndarray]:
+        with multiprocessing.Pool(2) as fresh:
+            return on_pool(fresh, d, chunks)
 
-    capacity_after = capacity(client)
+    cold_arrays = rounds.time("pool cold", cold_pool)
+    s = grids["small"]
+    for again in range(3):  # a 36-point sweep is a fraction of a second: three pairs
+        small_sync, small_auto = pair(
+            rounds,
+            ("small sync", "small auto"),
+            (lambda: run(s, **sync), lambda: run(s, **local)),
+            flip ^ (again == 1),
+        )
+    rounds.same &= all(identical(ds_sync, ds) for ds in (ds_dask, ds_address, ds_auto, ds_cold))
+    rounds.same &= same_as_pool(ds_sync, arrays) and same_as_pool(ds_sync, cold_arrays)
+    rounds.same &= identical(small_sync, small_auto)
+    if large:
+        g = grids["large"]
+        big_sync, big_auto = pair(
+            rounds,
+            ("large sync", "large auto"),
+            (lambda: run(g, **sync), lambda: run(g, **local)),
+            flip,
+        )
+        rounds.same &= identical(big_sync, big_auto)
+
+
+def verdict(ok: bool | None) -> str:
+    return (
+        "not judged (the machine does not give 2 workers their cores)"
+        if ok is None
+        else ("met" if ok else "MISSED")
+    )
+
+
+def overhead_and_store(client, d, chunks: int) -> tuple[float, float]:
+    """Seconds per empty task on the cluster, and the Zarr store's seconds per chunk."""
     from phdesign.sweep.schedulers import Executor
 
     executor = Executor("LocalCluster", 2, client)
@@ -158,56 +255,175 @@ def main(argv: list[str] | None = None) -> int:
     for _ in executor.map_unordered(_noop, "", tasks):
         pass
     per_task = (time.perf_counter() - start) / len(tasks)
-    client.close()
-    cluster.close()
-
     folder = tempfile.mkdtemp()
     try:
-        stored = phdesign.sweep(
-            beam, scheduler="synchronous", output=os.path.join(folder, "m.zarr"), **kwargs
+        memory = record(run(d, scheduler="synchronous", progress=False))
+        stored = record(
+            run(d, scheduler="synchronous", progress=False, output=os.path.join(folder, "m.zarr"))
         )
-        store_run = record(stored)
     finally:
         shutil.rmtree(folder)
-    fast = fast_path_ms()
-    load_after = os.getloadavg()
+    extra = (stored["seconds"] - stored["compute_seconds"]) - (
+        memory["seconds"] - memory["compute_seconds"]
+    )
+    return per_task, extra / chunks
 
-    s, d = statistics.median(sync_wall), statistics.median(dask_wall)
-    mean_point = 1e3 * statistics.median(sync_compute) / points
-    mean_chunk = statistics.median(sync_compute) / chunks
-    print(f"beam gain map, {points} points in {chunks} chunks, options {options or 'default'}")
-    print(f"converged: {converged} of {points} points")
-    print(f"per point: {mean_point:.1f} ms on average; {fast:.1f} ms (median) at (20, 30)")
-    print(f"synchronous: {s:.2f} s (runs: {', '.join(f'{t:.2f}' for t in sync_wall)})")
+
+def report(rounds: Rounds, cores: tuple[float, float], per_task: float, store: float) -> bool:
+    """Print every figure and judge the targets; return whether all judged ones hold."""
+    r = rounds.records
+    points, chunks = 400, r["sync"]["chunks"]
+    dask = rounds.median("dask")
+    free = min(cores) >= FREE_CORES
+    compute = statistics.median(rounds.compute["sync"])
     print(
-        f"2 workers:   {d:.2f} s (runs: {', '.join(f'{t:.2f}' for t in dask_wall)}); "
-        f"speed-up {s / d:.2f}x (target >= 1.6x: {'met' if s / d >= 1.6 else 'MISSED'})"
+        f"beam gain map, {points} points: {chunks} chunks of {r['sync']['chunk_shape']} in this "
+        f"process, {r['dask']['chunks']} of {r['dask']['chunk_shape']} on 2 workers"
     )
+    fast = fast_path_ms()
+    print(f"per point: {1e3 * compute / points:.1f} ms on average; {fast:.1f} ms at (20, 30)")
+    print(f"cores free for 2 workers: {cores[0]:.2f} before, {cores[1]:.2f} after (the ceiling)")
+    for route in ("sync", "dask", "address", "pool", "auto", "dask cold", "pool cold"):
+        print(f"  {route:>10}: {rounds.median(route):6.2f} s  (runs {rounds.runs(route)})")
+    ok_speed, ok_address, ok_pool = report_running(rounds, free)
+    ok_auto, ok_small = report_default(rounds)
+    ok_large = report_large(rounds, free)
+    efficiency = statistics.median(rounds.compute["dask"]) / (2 * dask)
+    ok_task = per_task < 0.05 * compute / chunks
     print(
-        f"cores free for 2 workers (a fixed load, 2 copies against 1): "
-        f"{capacity_before:.2f} before, {capacity_after:.2f} after: the speed-up's ceiling now"
+        f"task overhead: {1e3 * per_task:.1f} ms per task against {1e3 * compute / chunks:.0f} ms "
+        f"per chunk ({100 * per_task * chunks / compute:.1f} %, target < 5 %: "
+        f"{verdict(ok_task)}); parallel efficiency {100 * efficiency:.0f} %"
     )
-    print(f"local cluster start-up and warm-up: {startup:.2f} s (not in the 2-worker time)")
-    efficiency = statistics.median(dask_compute) / (2 * d)
+    print(f"Zarr store: {1e3 * store:.1f} ms per chunk (creation, writes and markers)")
+    print(f"identical arrays on every route: {rounds.same}")
+    checks = (ok_speed, ok_address, ok_pool, ok_auto, ok_small, ok_large, ok_task, rounds.same)
+    return all(ok is not False for ok in checks)
+
+
+def rounds_text(ratios: list[float]) -> str:
+    return ", ".join(f"{x:.2f}" for x in ratios)
+
+
+def report_running(rounds: Rounds, free: bool) -> tuple[bool | None, bool, bool | None]:
+    """The running cluster, by its Client and by its address, against synchronous and Pool."""
+    s, dask, pool = rounds.median("sync"), rounds.median("dask"), rounds.median("pool")
+    paired = rounds.paired("sync", "dask")
+    speedup = statistics.median(paired)
+    ok_speed = (speedup >= 1.6) if free else None
     print(
-        f"task overhead: {1e3 * per_task:.1f} ms per task against {1e3 * mean_chunk:.0f} ms "
-        f"per chunk ({100 * per_task / mean_chunk:.1f} %, target < 5 %); parallel "
-        f"efficiency {100 * efficiency:.0f} %"
+        f"2 Dask workers: {speedup:.2f}x synchronous, median of the rounds "
+        f"({rounds_text(paired)}; ratio of the medians {s / dask:.2f}x; "
+        f"target >= 1.6x: {verdict(ok_speed)})"
     )
-    # what is not chunk compute, in the store run against the in-memory runs
-    store_extra = store_run["seconds"] - store_run["compute_seconds"]
-    memory_extra = statistics.median(w - c for w, c in zip(sync_wall, sync_compute, strict=True))
+    address = rounds.median("address")
+    ok_address = address - dask <= 0.2
     print(
-        f"Zarr store: {1e3 * (store_extra - memory_extra) / chunks:.1f} ms per chunk "
-        f"(creation, writes and markers; {store_extra:.2f} s outside the chunks against "
-        f"{memory_extra:.2f} s in memory)"
+        f"the running cluster by its address (a connection per sweep): "
+        f"{statistics.median(rounds.paired('sync', 'address')):.2f}x synchronous (rounds "
+        f"{rounds_text(rounds.paired('sync', 'address'))}); {address - dask:+.2f} s against "
+        f"its Client (target <= 0.2 s per sweep: {verdict(ok_address)})"
+    )
+    ok_pool = (dask / pool <= 1.15) if free else None
+    print(
+        f"Dask route: {dask / pool:.2f}x the Pool(2) over the same chunks "
+        f"(target <= 1.15x: {verdict(ok_pool)}); Pool {s / pool:.2f}x synchronous"
+    )
+    cold = rounds.median("dask cold")
+    print(
+        f"cold routes: a local cluster started, used and closed {cold:.2f} s "
+        f"({cold / rounds.median('pool cold'):.2f}x a fresh Pool(2)): its start costs "
+        f"{cold - dask:.2f} s here (the rule assumes {LOCAL_CLUSTER_START:g} s)"
+    )
+    return ok_speed, ok_address, ok_pool
+
+
+def report_default(rounds: Rounds) -> tuple[bool, bool]:
+    """The default route (the automatic choice) against synchronous, round by round."""
+    r = rounds.records
+    auto = statistics.median(rounds.paired("auto", "sync"))
+    ok_auto = auto <= 1.10
+    print(
+        f"default route, 400 points: {auto:.2f}x synchronous (rounds "
+        f"{rounds_text(rounds.paired('auto', 'sync'))}), on {r['auto']['scheduler']} "
+        f"(target <= 1.10x: {verdict(ok_auto)})"
+    )
+    small = statistics.median(rounds.paired("small auto", "small sync"))
+    ok_small = small <= 1.10 and r["small auto"]["scheduler"].startswith("synchronous")
+    print(
+        f"default route, 36 points: {small:.2f}x synchronous (rounds "
+        f"{rounds_text(rounds.paired('small auto', 'small sync'))}), on "
+        f"{r['small auto']['scheduler']} (target: this process, <= 1.10x: {verdict(ok_small)})"
+    )
+    return ok_auto, ok_small
+
+
+def report_large(rounds: Rounds, free: bool) -> bool | None:
+    if "large sync" not in rounds.walls:
+        return None
+    ratio = rounds.median("large sync") / rounds.median("large auto")
+    where = rounds.records["large auto"]["scheduler"]
+    ok = (ratio >= 1.2 and "LocalCluster" in where) if free else None
+    print(
+        f"default route, 1600 points: {ratio:.2f}x faster than synchronous "
+        f"({rounds.median('large sync'):.2f} s), on {where} (target >= 1.2x: {verdict(ok)})"
+    )
+    return ok
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=3, help="rounds (default 3)")
+    parser.add_argument("--pair", action="store_true", help="the single pair (20, 30)")
+    parser.add_argument("--large", action="store_true", help="also a 1600-point map")
+    args = parser.parse_args(argv)
+    os.environ.pop("DASK_SCHEDULER_ADDRESS", None)  # the default route decides by itself
+    load_before = os.getloadavg()
+    beam = load_builtin("euler-bernoulli")
+    options = {"resolution": 20, "max_resolution": 30} if args.pair else {}
+    grids = {
+        name: describe(beam, job="spectrum", sensors=[3, 4], grid=grid, options=options)
+        for name, grid in (("map", MAP), ("small", SMALL), ("large", LARGE))
+    }
+    warm = describe(beam, job="spectrum", sensors=[3, 4], grid={"l1": "0.1,1"})
+    run(warm, scheduler="synchronous", progress=False)  # imports, first discretizations
+
+    from dask.distributed import Client, LocalCluster
+
+    pool = multiprocessing.Pool(2)  # forked now: warm, without the maps' evaluators
+    pool.map(_burn, [0.01, 0.01])
+    cluster = LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+    )
+    client = Client(cluster)
+    client.run(_warm)
+    run(warm, scheduler=client, progress=False)
+    cores_before = capacity(client)
+    rounds = Rounds()
+    for index in range(args.repeat):
+        one_round(rounds, grids, client, pool, args.large, flip=index % 2 == 1)
+    cores_after = capacity(client)
+    per_task, store = overhead_and_store(client, grids["map"], rounds.records["sync"]["chunks"])
+    client.close()
+    cluster.close()
+    pool.close()
+    pool.join()
+    print(f"options {options or 'default'}; {args.repeat} rounds")
+    ok = report(rounds, (cores_before, cores_after), per_task, store)
+    for route in ("auto", "small auto", "large auto"):  # the last round's choices
+        for note in rounds.records.get(route, {}).get("notes", []):
+            print(f"the default route said ({route}): {note}")
+    load_after = os.getloadavg()
+    print(
+        "load average (1 min) at each round's start: "
+        + ", ".join(f"{x:.2f}" for x in rounds.loads)
     )
     print(
         f"load average (1, 5, 15 min): before {load_before[0]:.2f}, {load_before[1]:.2f}, "
         f"{load_before[2]:.2f}; after {load_after[0]:.2f}, {load_after[1]:.2f}, "
         f"{load_after[2]:.2f}; {os.cpu_count()} cores"
     )
-    return 0
+    return 0 if ok else 1
 
 
 if __name__ == "__main__":
