@@ -254,12 +254,13 @@ for ax, (name, g) in zip(axes7, designs.items(), strict=True):
 # `phdesign.sweep` evaluates the `spectrum` job at every gain, in chunks of gains, each
 # chunk discretizing the Galerkin degrees once and running `spectrum()`'s refinement and
 # rules at each gain. Here the chunks run in this process (`scheduler="synchronous"`, so
-# that the notebook also runs as a plain script); without it they run on a local Dask
-# cluster, one worker process per core (from a script, under `if __name__ == "__main__":`,
-# since the workers re-import it), and `scheduler="tcp://host:8786"` sends them to any
-# Dask cluster, with the same numbers. Every point carries its `converged` flag; the same
-# map is `phdesign sweep euler-bernoulli --sensors 3,4 --grid l1=... --grid l2=... -o
-# map.zarr`.
+# that the notebook also runs as a plain script); without it they run here too unless the
+# grid repays a local Dask cluster's start (one worker process per core; from a script,
+# under `if __name__ == "__main__":`, since the workers re-import it; the run record's
+# `notes` say which), and `scheduler="tcp://host:8786"` sends them to any running Dask
+# cluster, with the same numbers (see the scaling page of the documentation). Every point
+# carries its `converged` flag; the same map is `phdesign sweep euler-bernoulli --sensors
+# 3,4 --grid l1=... --grid l2=... -o map.zarr`.
 
 # %%
 import phdesign

@@ -22,10 +22,10 @@ every chunk run here (a grid whose later points cost more can still start a clus
 half-way), and its answer is one line, kept in the run's record (``notes``, beside
 ``scheduler`` and the figures it used, ``choice``) and said as it is made to whoever
 asked (``notify``: the command line prints it on stderr).  On two free cores a cluster
-starts from about 14 s of work: a 6 x 6 map of the beam (0.5 s) and the 20 x 20 one
-(5 s) run here, a 40 x 40 one (about 19 s) on the cluster; with one core's worth of
-other work on two cores, never.  Every chunk's figures are the same wherever it runs, so
-the choice moves no number.
+starts from about 14 s of work: a 6 x 6 map of the beam (0.3 s) and the 20 x 20 one
+(3 s) run here, a 40 x 40 one (12 to 13 s) is at the border, larger ones start a
+cluster; with one core's worth of other work on two cores, never.  Every chunk's figures
+are the same wherever it runs, so the choice moves no number.
 
 An existing cluster (an address, a :class:`distributed.Client`, ``DASK_SCHEDULER_ADDRESS``)
 has no start to repay (a connection is about 10 ms), and a named scheduler or a worker
@@ -33,9 +33,9 @@ count is obeyed as it is.
 
 Examples
 --------
->>> cluster_repays(remaining=19, chunk_seconds=0.24, workers=2)  # 400 points of the beam
+>>> cluster_repays(remaining=19, chunk_seconds=0.15, workers=2)  # 400 points of the beam
 False
->>> cluster_repays(remaining=19, chunk_seconds=0.96, workers=2)  # 1600 points
+>>> cluster_repays(remaining=19, chunk_seconds=0.96, workers=2)  # 20 s of work
 True
 >>> cluster_repays(19, 0.96, workers=2, free=free_workers(2, load=2.0))  # one core busy
 False
