@@ -9,13 +9,15 @@ cluster only when the chunks left finish sooner there by more than its start onc
 .. math::
 
     2 S + \left\lceil \frac{R}{N} \right\rceil \frac{N}{F} \frac{t}{\eta} < R\, t,
-    \qquad F = \min\bigl(N,\; P - (L - 1)\bigr),
+    \qquad F = \min\bigl(N,\; P - B\bigr),
 
 with R the chunks left, t the mean wall time of the chunks run here so far, N the workers
-a local cluster would have (one per usable core), F the cores they would find free (L the
-load average of the last minute, this sweep counted once, over the P processors it
-counts; F is at most this process's CPU share when that is under
-:data:`FREE_CORE_SHARE`), :math:`\eta` = :data:`PARALLEL_EFFICIENCY` and
+a local cluster would have (one per usable core), F the cores they would find free: B is
+what other processes kept busy of the P processors while the chunks ran here (the
+machine's CPU time, :func:`cpu_ticks`, less this process's), or where that is not known
+L - 1 (L the load average of the last minute, which lags a minute behind: the workers of
+a sweep that has just ended are still in it); F is at most this process's CPU share when
+that is under :data:`FREE_CORE_SHARE`, :math:`\eta` = :data:`PARALLEL_EFFICIENCY` and
 S = :data:`LOCAL_CLUSTER_START`, counted twice: a start costs more on a loaded machine
 (15 s instead of 3 at a load average of 5 on two cores).  The rule is asked again after
 every chunk run here (a grid whose later points cost more can still start a cluster
@@ -57,6 +59,7 @@ __all__ = [
     "PARALLEL_EFFICIENCY",
     "Automatic",
     "cluster_repays",
+    "cpu_ticks",
     "estimated_seconds",
     "free_workers",
     "load_average",
@@ -84,11 +87,30 @@ def load_average() -> float | None:
         return None
 
 
+def cpu_ticks() -> tuple[float, float] | None:
+    """Return the machine's busy and total CPU time so far, in ticks (``None`` off Linux).
+
+    Read from the first line of ``/proc/stat`` (every processor's user, nice, system, idle,
+    iowait, irq, softirq and steal time); idle and iowait are not busy.
+    """
+    try:
+        with open("/proc/stat", encoding="ascii") as stat:
+            fields = stat.readline().split()
+        values = [float(x) for x in fields[1:9]]
+    except (OSError, ValueError):  # pragma: no cover - not Linux
+        return None
+    if not fields or fields[0] != "cpu" or len(values) < 5:  # pragma: no cover
+        return None
+    total = sum(values)
+    return total - values[3] - values[4], total
+
+
 def free_workers(
     workers: int,
     cpu_share: float = 1.0,
     load: float | None = None,
     processors: int | None = None,
+    others: float | None = None,
 ) -> float:
     """Return the cores a local cluster of ``workers`` would find free now (0 to ``workers``).
 
@@ -103,16 +125,21 @@ def free_workers(
     processors : int, optional
         The processors that load is spread over (:func:`os.cpu_count`: a container's
         load average is often its host's; default ``workers``).
+    others : float, optional
+        The processors that other processes kept busy while this one computed, measured
+        (:func:`cpu_ticks`); given, it stands for ``load - 1``, which lags a minute behind.
 
     Examples
     --------
     >>> free_workers(2), free_workers(2, load=1.4), free_workers(2, cpu_share=0.6)
     (2.0, 1.6, 0.6)
+    >>> free_workers(2, load=3.0, others=0.25)  # the load of a sweep that has ended
+    1.75
     """
     free = float(workers)
-    if load is not None:
-        idle = (workers if processors is None else processors) - max(0.0, load - 1.0)
-        free = min(free, idle)
+    busy = max(0.0, load - 1.0) if others is None and load is not None else others
+    if busy is not None:
+        free = min(free, (workers if processors is None else processors) - busy)
     if cpu_share < FREE_CORE_SHARE:  # this process itself did not have a core
         free = min(free, cpu_share)
     return max(0.0, free)
@@ -190,6 +217,9 @@ class Automatic:
         The machine's load average of the last minute (:func:`load_average`).
     processors : int, optional
         The processors that load average counts (default :func:`os.cpu_count`).
+    ticks : callable
+        The machine's busy and total CPU ticks (:func:`cpu_ticks`; ``None``: not known),
+        read when the first chunk starts and at every decision.
 
     Attributes
     ----------
@@ -205,9 +235,11 @@ class Automatic:
     cpu_clock: Callable[[], float] = time.process_time
     load: Callable[[], float | None] = field(default=lambda: load_average())
     processors: int | None = field(default_factory=os.cpu_count)
+    ticks: Callable[[], tuple[float, float] | None] = field(default=lambda: cpu_ticks())
     started: Any = None
     choice: dict[str, Any] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    _since: tuple[float, float] | None = field(default=None, repr=False)
 
     @property
     def client(self) -> Any:
@@ -235,6 +267,8 @@ class Automatic:
                     return
                 if done == 1 and can_share:
                     self._say(self._staying(remaining, mean, free))
+            if not done:
+                self._since = self.ticks()
             began, began_cpu = self.clock(), self.cpu_clock()
             result = function(shared, *task)
             wall += self.clock() - began
@@ -251,20 +285,29 @@ class Automatic:
     def _record(self, here: int, wall: float, cpu: float) -> tuple[float, float]:
         """Keep what ``here`` chunks measured; return their mean wall time and the free cores."""
         mean, share = wall / here, min(1.0, cpu / wall) if wall > 0 else 1.0
-        load = self.load()
-        free = free_workers(self.workers, share, load, self.processors)
+        load, others = self.load(), self._others(share)
+        free = free_workers(self.workers, share, load, self.processors, others)
         self.choice = {
             "automatic": True,
             "chunks_in_process": here,
             "chunk_seconds": mean,
             "cpu_share": share,
             "load_average": load,
+            "other_processors_busy": others,
             "free_cores": free,
             "cluster_workers": self.workers,
             "cluster_start_seconds": LOCAL_CLUSTER_START,
             "chunks_on_cluster": 0,
         }
         return mean, free
+
+    def _others(self, share: float) -> float | None:
+        """Processors that other processes kept busy since the first chunk (None: unknown)."""
+        now, since = self.ticks(), self._since
+        if now is None or since is None or now[1] <= since[1]:
+            return None
+        busy = (now[0] - since[0]) / (now[1] - since[1])
+        return max(0.0, (self.processors or self.workers) * busy - share)
 
     def _starting(self, remaining: int, mean: float, free: float) -> str:
         here, there = estimated_seconds(remaining, mean, self.workers, free)
@@ -278,7 +321,12 @@ class Automatic:
     def _staying(self, remaining: int, mean: float, free: float) -> str:
         if free * PARALLEL_EFFICIENCY <= 1:
             load, share = self.choice["load_average"], self.choice["cpu_share"]
-            seen = f"load average {load:.1f}, " if load is not None else ""
+            others = self.choice["other_processors_busy"]
+            seen = (
+                f"other processes kept {others:.1f} of {self.processors} processors busy, "
+                if others is not None
+                else (f"load average {load:.1f}, " if load is not None else "")
+            )
             why = (
                 f"the machine is busy ({seen}this process had {100 * share:.0f} % of a core): "
                 f"a local cluster's {self.workers} workers would find about {free:.1f} cores free"

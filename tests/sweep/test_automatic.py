@@ -91,13 +91,19 @@ class StandIn(Executor):
         return "stand-in cluster (2 workers)"
 
 
-def automatic_run(costs, workers=2, cpu_share=1.0, load=None, processors=None):
+def automatic_run(costs, workers=2, cpu_share=1.0, load=None, processors=None, others=None):
     """Run chunks of the given wall times through :class:`Automatic`; return what it did.
 
-    The process gets ``cpu_share`` of each chunk's wall time as CPU time, and the
-    machine's load average is ``load`` (``None``: not known).
+    The process gets ``cpu_share`` of each chunk's wall time as CPU time, the machine's
+    load average is ``load`` and other processes keep ``others`` processors busy
+    (``None``: not known; the machine's CPU ticks then read ``None``).
     """
     wall, cpu, notes, ran = Clock(), Clock(cpu_share), [], []
+    cores = workers if processors is None else processors
+
+    def ticks():  # busy and total processor-seconds so far, at the wall clock's time
+        return None if others is None else ((cpu_share + others) * wall.now, cores * wall.now)
+
     elsewhere = StandIn()
 
     @contextmanager
@@ -120,7 +126,8 @@ def automatic_run(costs, workers=2, cpu_share=1.0, load=None, processors=None):
             clock=wall,
             cpu_clock=cpu,
             load=lambda: load,
-            processors=workers if processors is None else processors,
+            processors=cores,
+            ticks=ticks,
         )
         results = list(ex.map_unordered(chunk, None, [(i,) for i in range(len(costs))]))
     assert sorted(results) == list(range(len(costs)))  # every chunk once, wherever it ran
@@ -197,12 +204,30 @@ def test_a_load_average_counts_the_processors_it_is_spread_over():
     assert ran.index("start") == 1
 
 
+def test_measured_cpu_time_stands_for_a_load_average_that_lags():
+    # a sweep that ran on 2 workers a minute ago leaves a load average of 3, which alone
+    # would say "no core free"; the machine's CPU ticks while the chunks ran here say that
+    # other processes kept 0.1 processors busy: 1.9 free, and 1 s chunks start a cluster
+    assert free_workers(2, load=3.0) == 0.0
+    assert free_workers(2, load=3.0, others=0.1) == 1.9
+    ex, ran, _notes = automatic_run([1.0] * 20, load=3.0, others=0.1)
+    assert ran.index("start") == 1
+    assert ex.choice["other_processors_busy"] == pytest.approx(0.1)
+    assert ex.choice["free_cores"] == pytest.approx(1.9)
+    # and the other way round: a quiet load average, a processor busy now
+    ex, ran, notes = automatic_run([1.0] * 20, load=1.0, others=1.0)
+    assert "start" not in ran
+    assert "(other processes kept 1.0 of 2 processors busy, this process had 100 % of" in notes[0]
+
+
 def test_every_decision_is_kept_in_the_notes_whoever_is_told():
     ex, _ran, notes = automatic_run([0.1] * 10 + [4.0] * 30)
     assert ex.notes == notes
     assert len(notes) == 2
     with ExitStack() as stack:  # nobody told: the notes alone
-        quiet = Automatic(2, None, None, stack, clock=Clock(), load=lambda: None)
+        quiet = Automatic(
+            2, None, None, stack, clock=Clock(), load=lambda: None, ticks=lambda: None
+        )
         assert list(quiet.map_unordered(lambda shared, i: i, None, [(0,), (1,)])) == [0, 1]
     assert quiet.notes == [
         "sweep: running in this process: 2 chunks, too few to share with a local cluster"
@@ -340,6 +365,7 @@ def test_a_cluster_started_half_way_gives_the_same_store(two_cores, monkeypatch,
     monkeypatch.setattr(automatic, "LOCAL_CLUSTER_START", 0.0)
     monkeypatch.setattr(automatic, "FREE_CORE_SHARE", 0.0)
     monkeypatch.setattr(automatic, "load_average", lambda: None)
+    monkeypatch.setattr(automatic, "cpu_ticks", lambda: None)
     original = schedulers.executor
     opened = []
 
