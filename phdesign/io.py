@@ -17,9 +17,12 @@ expression strings in ``z`` and the parameters, and omitted ``P_k`` are zero::
     [ports]
     inputs  = ["e1(0)", "e1'(0)", "e2(1)", "e2'(1)"]
     outputs = ["e2'(0)", "-e2(0)", "e1'(1)", "-e1(1)"]   # or "conjugate" (or omitted)
-    [displacement]                             # optional
+    [displacement]                             # optional: w = two antiderivatives of x2
+    component = 2                              # (or terms = [{component = 1,
+    integrations = 2                           #   integrations = 1}, ...]: any sum)
+    [fields.curvature]                         # optional: named performance outputs
     component = 2
-    integrations = 2
+    integrations = 0
     [feedback]                                 # optional: u4 = -k y4, a tip damper
     inputs = [4]                               # 1-based indices into [ports].inputs
     gain = [["k"]]                             # K, K + K^T >= 0
@@ -49,10 +52,11 @@ import sympy
 import tomli_w
 
 from phdesign.core.checks import require_path
-from phdesign.core.errors import ModelFileError, PhdesignError
+from phdesign.core.errors import ExpressionError, ModelError, ModelFileError, PhdesignError
 from phdesign.core.files import atomic_write, check_output_path
 from phdesign.core.limits import MAX_MODEL_FILE_BYTES, check_file_size
-from phdesign.symbolic.definition import Displacement
+from phdesign.symbolic.expressions import exact_number, parse_scalar
+from phdesign.symbolic.fields import Displacement, Field, Term, field_from_table
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.printing import format_expression
 
@@ -70,7 +74,7 @@ __all__ = [
 ]
 
 _REQUIRED = ("name", "interval", "order", "matrices", "ports")
-_OPTIONAL = ("description", "states", "parameters", "displacement", "feedback", "units")
+_OPTIONAL = ("description", "states", "parameters", "displacement", "fields", "feedback", "units")
 
 
 def read_model(path: str | os.PathLike[str]) -> BCPHS:
@@ -140,6 +144,7 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
         displacement=_read_displacement(data, source),
         feedback=feedback,
         units=units,
+        fields=_read_fields(data, source),
     )
 
 
@@ -207,18 +212,39 @@ def _read_feedback(data: Mapping[str, Any], source: str) -> Mapping[str, Any] | 
 
 
 def _read_displacement(data: Mapping[str, Any], source: str) -> Displacement | None:
-    """Return the [displacement] table as a :class:`Displacement`, or None."""
+    """Return the [displacement] table as a :class:`~phdesign.symbolic.fields.Field`."""
     if "displacement" not in data:
         return None
-    table = _table(data, "displacement", source)
-    if set(table) != {"component", "integrations"} or not all(
-        isinstance(v, int) and not isinstance(v, bool) for v in table.values()
-    ):
-        raise ModelFileError(
-            f"{source}: [displacement] must hold integers component and integrations; "
-            f"found {dict(table)}"
+    return _read_field(data, _table(data, "displacement", source), "displacement", source)
+
+
+def _read_fields(data: Mapping[str, Any], source: str) -> dict[str, Field] | None:
+    """Return the named fields of [fields.<name>], or None."""
+    if "fields" not in data:
+        return None
+    tables = _table(data, "fields", source)
+    return {
+        name: _read_field(
+            data, _table(tables, name, source, f"fields.{name}"), f"fields.{name}", source
         )
-    return Displacement(table["component"], table["integrations"])
+        for name in tables
+    }
+
+
+def _read_field(data: Mapping[str, Any], table: Mapping[str, Any], key: str, source: str) -> Field:
+    """Read one field's table; coefficients are numbers or text in the parameters."""
+    parameters = data.get("parameters", {})
+    names = list(parameters) if isinstance(parameters, Mapping) else []
+
+    def coefficient(value: object, what: str) -> sympy.Expr:
+        if isinstance(value, str):
+            return parse_scalar(value, names, allow_z=False, what=what)
+        return exact_number(value, what)
+
+    try:
+        return field_from_table(table, key, coefficient)
+    except (ModelError, ExpressionError) as error:
+        raise ModelFileError(f"{source}: {error}") from None
 
 
 def _read_states(data: Mapping[str, Any], source: str) -> tuple[str, ...]:
@@ -231,11 +257,14 @@ def _read_states(data: Mapping[str, Any], source: str) -> tuple[str, ...]:
     return tuple(states)
 
 
-def _table(data: Mapping[str, Any], key: str, source: str) -> Mapping[str, Any]:
+def _table(
+    data: Mapping[str, Any], key: str, source: str, label: str | None = None
+) -> Mapping[str, Any]:
     value = data[key]
+    label = key if label is None else label
     if not isinstance(value, Mapping):
-        raise ModelFileError(f"{source}: {key} must be a table; found {value!r}")
-    _check_names(value, f"[{key}]", source)
+        raise ModelFileError(f"{source}: {label} must be a table; found {value!r}")
+    _check_names(value, f"[{label}]", source)
     return value
 
 
@@ -292,10 +321,9 @@ def model_to_dict(model: BCPHS) -> dict[str, Any]:
         else [format_expression(e, model.interval) for e in model.outputs],
     }
     if model.displacement is not None:
-        data["displacement"] = {
-            "component": model.displacement.component,
-            "integrations": model.displacement.integrations,
-        }
+        data["displacement"] = _field_to_dict(model.displacement)
+    if model.fields:
+        data["fields"] = {name: _field_to_dict(f) for name, f in model.fields}
     if model.feedback is not None:
         data["feedback"] = {
             "inputs": list(model.feedback.inputs),
@@ -304,6 +332,26 @@ def model_to_dict(model: BCPHS) -> dict[str, Any]:
     if model.units:
         data["units"] = dict(model.units)
     return data
+
+
+def _field_to_dict(f: Field) -> dict[str, Any]:
+    """Return the table of a field: the short form when it is one term with coefficient 1."""
+    out: dict[str, Any]
+    if f.short:
+        out = {"component": f.terms[0].component, "integrations": f.terms[0].integrations}
+    else:
+        out = {"terms": [_term_to_dict(t) for t in f.terms]}
+    if f.start != "a":
+        out["start"] = f.start
+    return out
+
+
+def _term_to_dict(t: Term) -> dict[str, Any]:
+    out: dict[str, Any] = {"component": t.component, "integrations": t.integrations}
+    if t.coefficient != 1:
+        c = t.coefficient
+        out["coefficient"] = _toml_number(c) if c.is_number else format_expression(c)
+    return out
 
 
 def model_to_toml(model: BCPHS) -> str:

@@ -45,14 +45,17 @@ __all__ = [
 
 @dataclass(frozen=True)
 class DisplacementSpec:
-    """Physical displacement: ``integrations`` integrals of state ``component`` from a.
+    r"""A field with numbers: :math:`f = \sum_j c_j \mathcal I_s^{k_j} x_{i_j}`.
 
-    ``component`` is 1-based (a component of x, not of e).  The beam has x2 = w_zz,
-    so ``DisplacementSpec(2, 2)`` gives w(z) = ∫_a^z ∫_a^s x2(r) dr ds.
+    ``terms`` are ``(component, integrations, coefficient)`` with 1-based components of x
+    (not of e); every integration runs from the end ``start`` (``"a"`` or ``"b"``) with
+    value zero there (:mod:`phdesign.symbolic.fields`).  The beam has
+    :math:`x_2 = w_{zz}`, so ``DisplacementSpec(((2, 2, 1.0),))`` gives
+    :math:`w(z) = \int_a^z \int_a^s x_2(r)\, dr\, ds`.
     """
 
-    component: int
-    integrations: int
+    terms: tuple[tuple[int, int, float], ...]
+    start: str = "a"
 
 
 @dataclass(frozen=True)
@@ -103,6 +106,8 @@ class NumericModel:
         Names used in exports and CSV headers.
     displacement : DisplacementSpec or None
         How to reconstruct a physical displacement, if the model has one.
+    fields : tuple of (str, DisplacementSpec)
+        The named fields (rotations, strains) of ``[fields.<name>]``.
     H_constant : bool
         True when H does not depend on z (lets discretizations skip quadrature work).
     feedback : PortFeedback or None
@@ -135,6 +140,13 @@ class NumericModel:
     P0: Callable[[np.ndarray], np.ndarray] | None = field(default=None, compare=False)
     units: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
     parameters: Mapping[str, float] = field(default_factory=dict, compare=False, repr=False)
+    fields: tuple[tuple[str, DisplacementSpec], ...] = ()
+
+    def field_spec(self, name: str) -> DisplacementSpec | None:
+        """Return the field ``name`` (``"w"`` is the displacement), or None."""
+        if name == "w":
+            return self.displacement
+        return dict(self.fields).get(name)
 
     def __post_init__(self) -> None:
         a, b = (float(s) for s in self.interval)
@@ -326,9 +338,8 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         input_labels=tuple(str(e) for e in inputs),
         output_labels=tuple(str(e) for e in outputs),
         state_names=tuple(model.state_names),
-        displacement=None
-        if d is None
-        else DisplacementSpec(int(d.component), int(d.integrations)),
+        displacement=None if d is None else _numeric_field(sub, d),
+        fields=tuple((name, _numeric_field(sub, f)) for name, f in getattr(model, "fields", ())),
         H_constant=H_constant,
         feedback=_numeric_feedback(sub, getattr(model, "feedback", None)),
         P0=P0fun,
@@ -384,6 +395,20 @@ def _numeric_P(
     if sub.depends_on_z(P0s):
         return (np.full((n, n), np.nan), *P), _matrix_function(P0s, n)
     return (sub.array(P0s), *P), None
+
+
+def _numeric_field(sub: _Substitution, f: Any) -> DisplacementSpec:
+    """Return a field with its coefficients as floats."""
+    import sympy
+
+    values = sub.array(
+        sub.matrix("field coefficients", sympy.Matrix([[t.coefficient for t in f.terms]]))
+    )
+    terms = tuple(
+        (int(t.component), int(t.integrations), float(c))
+        for t, c in zip(f.terms, values[0], strict=True)
+    )
+    return DisplacementSpec(terms, str(f.start))
 
 
 def _numeric_feedback(sub: _Substitution, feedback: Any) -> PortFeedback | None:

@@ -23,7 +23,6 @@ Matrix([
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import sympy
@@ -37,6 +36,7 @@ from phdesign.symbolic.expressions import (
     parameter_symbol,
     parse_scalar,
 )
+from phdesign.symbolic.fields import Displacement
 from phdesign.symbolic.parser import check_expression
 from phdesign.symbolic.printing import format_expression
 from phdesign.symbolic.traces import parse_trace_expression
@@ -50,20 +50,6 @@ __all__ = [
     "parse_ports",
     "parse_units",
 ]
-
-
-@dataclass(frozen=True)
-class Displacement:
-    r"""How to recover a physical displacement :math:`w(z, t)` from the state.
-
-    :math:`w` is ``integrations`` antiderivatives of state component ``component``
-    (1-based, of :math:`x`), each from :math:`z = a` with value zero there. For the
-    Euler-Bernoulli beam :math:`x_2 = \partial_z^2 w` and the beam is clamped at
-    :math:`a`, so ``Displacement(component=2, integrations=2)``.
-    """
-
-    component: int
-    integrations: int
 
 
 def parse_parameters(

@@ -43,6 +43,7 @@ from phdesign.symbolic.definition import (
 )
 from phdesign.symbolic.expressions import Z, exact_number, parameter_symbol
 from phdesign.symbolic.feedback import Feedback, external_indices, feedback_from_mapping
+from phdesign.symbolic.fields import Field
 from phdesign.symbolic.ports import Ports, derive_ports
 from phdesign.symbolic.system import PortedSystem
 from phdesign.symbolic.validation import validate
@@ -134,7 +135,9 @@ class BCPHS(PortedSystem):
     description : str
         Free text.
     displacement : Displacement or None
-        How to recover a displacement field, when the model has one.
+        How to recover the displacement :math:`w`, when the model has one: a linear
+        combination of state components and their antiderivatives
+        (:mod:`phdesign.symbolic.fields`).
     feedback : Feedback or None
         The plant's own boundary feedback :math:`u_c = -K y_c` (``[feedback]``); the
         external ports are then :attr:`external_inputs` and :attr:`external_outputs`.
@@ -142,6 +145,9 @@ class BCPHS(PortedSystem):
         Units stated for parameters, states and ``t``, ``z``, ``energy``, ``displacement``.
     derived_outputs : bool
         The outputs were derived from the inputs (``outputs = "conjugate"``).
+    fields : tuple of (str, Field)
+        Named performance outputs (``[fields.<name>]``: rotations, strains), in the form
+        of the displacement (:mod:`phdesign.symbolic.fields`).
     checks : tuple of str
         How each condition was verified (exactly, or at the defaults on a grid).
     """
@@ -161,6 +167,7 @@ class BCPHS(PortedSystem):
     feedback: Feedback | None = None
     units: tuple[tuple[str, str], ...] = ()
     derived_outputs: bool = False
+    fields: tuple[tuple[str, Field], ...] = ()
     checks: tuple[str, ...] = field(default=(), compare=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -198,6 +205,7 @@ class BCPHS(PortedSystem):
         displacement: Displacement | None = None,
         feedback: Feedback | Mapping[str, Any] | None = None,
         units: Mapping[str, str] | None = None,
+        fields: Mapping[str, Field] | None = None,
     ) -> BCPHS:
         r"""Build a model from numbers, strings and nested lists.
 
@@ -226,12 +234,16 @@ class BCPHS(PortedSystem):
         description : str, optional
             Free text.
         displacement : Displacement, optional
-            How to recover a displacement field.
+            How to recover the displacement :math:`w` (a :class:`~.fields.Field`:
+            :math:`w = \sum_j c_j \mathcal I_s^{k_j} x_{i_j}`).
         feedback : Feedback or {"inputs": [...], "gain": [[...]]}, optional
             Close inputs with :math:`u_c = -K y_c`, :math:`K + K^\top \succeq 0`
             (:mod:`phdesign.symbolic.feedback`).
         units : mapping {quantity: unit}, optional
-            Units of parameters, states, ``t``, ``z``, ``energy``, ``displacement``.
+            Units of parameters, states, ``t``, ``z``, ``energy``, ``displacement``
+            and the named fields.
+        fields : mapping {name: Field}, optional
+            Named performance outputs (rotations, strains), read as ``name(z0)``.
         """
         if not isinstance(order, int) or isinstance(order, bool) or order < 1:
             raise ModelError(f"order must be an integer N >= 1; found {order!r}")
@@ -257,6 +269,7 @@ class BCPHS(PortedSystem):
             feedback=None if feedback is None else feedback_from_mapping(feedback, names),
             units=parse_units(units),
             derived_outputs=derived,
+            fields=_named_fields(fields),
         )
 
     # ------------------------------------------------------------------ views
@@ -328,3 +341,14 @@ class BCPHS(PortedSystem):
             except ExpressionError as error:
                 raise ParameterError(str(error)) from None
         return replace(self, parameters=tuple(updated.items()))
+
+
+def _named_fields(fields: Mapping[str, Field] | None) -> tuple[tuple[str, Field], ...]:
+    """Return the named fields as ``(name, field)`` pairs (checked by the validation)."""
+    if fields is None:
+        return ()
+    if not isinstance(fields, Mapping):
+        raise ModelError(
+            f"fields must be a mapping {{name: Field}}; found {type(fields).__name__} {fields!r}"
+        )
+    return tuple(fields.items())

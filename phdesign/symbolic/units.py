@@ -7,7 +7,8 @@ may be given for
 * a state component, by its label or ``x<i>`` (``momentum = "kg/s"``),
 * the reserved quantities ``t`` (time), ``z`` (position), ``energy`` (the Hamiltonian
   :math:`H = \tfrac12\int x^\top \mathcal H x\,dz`) and ``displacement`` (the field
-  :math:`w` of ``[displacement]``).
+  :math:`w` of ``[displacement]``), and each named field of ``[fields.<name>]`` by its
+  name (:mod:`phdesign.symbolic.fields`).
 
 A model that states no unit for a quantity gets plain labels ("time t", not "time t [s]"):
 phdesign never claims a unit nobody gave.  Unit text is short and plain: letters (any
@@ -46,13 +47,15 @@ def check_units(
     units: Mapping[str, object] | Sequence[tuple[str, object]],
     parameters: Sequence[str],
     states: Sequence[str],
+    fields: Sequence[str] = (),
 ) -> tuple[tuple[str, str], ...]:
     """Validate ``units`` and return them as a tuple of ``(key, unit)`` pairs, in order.
 
     Raises
     ------
     ModelError
-        If a key is not a parameter, a state (label or ``x<i>``) or a reserved quantity,
+        If a key is not a parameter, a state (label or ``x<i>``), a named field
+        (``fields``, from ``[fields.<name>]``) or a reserved quantity,
         names a state twice, or a unit is not short plain text.
     """
     items = list(units.items()) if isinstance(units, Mapping) else list(units)
@@ -71,8 +74,8 @@ def check_units(
                     "give its unit once"
                 )
             seen_states[state] = key
-        elif key not in parameters and key not in RESERVED_QUANTITIES:
-            expected = ", ".join([*RESERVED_QUANTITIES, *parameters, *states])
+        elif key not in parameters and key not in RESERVED_QUANTITIES and key not in fields:
+            expected = ", ".join([*RESERVED_QUANTITIES, *fields, *parameters, *states])
             raise ModelError(
                 f"units: unknown quantity {key!r}; expected one of {expected} "
                 "(a parameter, a state or a reserved quantity)"

@@ -28,9 +28,9 @@ from phdesign.core.limits import check_model_dimensions, check_parameter_count
 from phdesign.symbolic.closing import closed_ports
 from phdesign.symbolic.conjugate import conjugate_outputs
 from phdesign.symbolic.definiteness import check_definite
-from phdesign.symbolic.definition import Displacement
 from phdesign.symbolic.expressions import Z, canonical, vanishes
 from phdesign.symbolic.feedback import check_feedback_indices
+from phdesign.symbolic.fields import check_fields
 from phdesign.symbolic.output_faults import outputs_fault_message
 from phdesign.symbolic.parser import brief, check_expression
 from phdesign.symbolic.traces import linear_coefficients, trace_of
@@ -49,11 +49,13 @@ def validate(model: BCPHS) -> list[str]:
     defaults = model.parameter_defaults
     _check_entries(model, symbols, defaults)
     checks = _check_matrices(model, defaults)
-    if model.displacement is not None:
-        _check_displacement(model.displacement, model.size)
+    names = tuple(name for name, _ in model.fields)
     object.__setattr__(
-        model, "units", check_units(model.units, model.parameter_names, model.state_names)
+        model,
+        "units",
+        check_units(model.units, model.parameter_names, model.state_names, fields=names),
     )
+    _check_fields(model)
     checks += _check_all_ports(model, symbols, defaults)
     if model.feedback is not None:
         checks += check_feedback(model, symbols, defaults)
@@ -175,20 +177,24 @@ def check_feedback(
     return [f"feedback {dissipative}", "closed-plant identities: exact"]
 
 
-def _check_displacement(d: object, n: int) -> None:
-    """Refuse a displacement that is not a Displacement of a component in 1..n."""
-    if not isinstance(d, Displacement) or not all(
-        type(v) is int for v in (d.component, d.integrations)
+def _check_fields(model: BCPHS) -> None:
+    """Refuse a displacement or named field that is not well-formed (:mod:`~.fields`)."""
+    fields = model.fields
+    if not isinstance(fields, tuple) or not all(
+        isinstance(item, tuple) and len(item) == 2 and isinstance(item[0], str) for item in fields
     ):
         raise ArgumentError(
-            "displacement must be a Displacement(component=i, integrations=k) of two "
-            f"integers; found {type(d).__name__} {brief(d, 60)}"
+            f"fields must be pairs (name, Field); found {type(fields).__name__} "
+            f"{brief(fields, 60)}"
         )
-    if not (1 <= d.component <= n) or d.integrations < 0:
-        raise ModelError(
-            f"displacement must name a component in 1..{n} and integrations >= 0; "
-            f"found component {d.component}, integrations {d.integrations}"
-        )
+    pairs = [("displacement", model.displacement)] if model.displacement is not None else []
+    check_fields(
+        [*pairs, *fields],
+        model.size,
+        [s for s, _ in model.parameters],
+        dict(model.units),
+        model.state_names,
+    )
 
 
 #: Characters a state label may not hold: they separate the items of an initial state.

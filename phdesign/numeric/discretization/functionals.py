@@ -8,6 +8,10 @@ figures report the steady-state variance of its estimation error
     The model's physical displacement at a point (the beam's deflection
     :math:`w(z_0) = \int_a^{z_0} (z_0 - s)\, x_2(s)\, ds`, two integrations of the
     curvature from the clamped end); needs a model that defines one.
+``"rotation(1)"`` (:func:`displacement_at` too)
+    A named field of the model (``[fields.rotation]``: a linear combination of state
+    components and their antiderivatives, :mod:`phdesign.symbolic.fields`) at a point,
+    e.g. the Timoshenko beam's rotation :math:`\phi(z_0) = \int_a^{z_0} x_3\, ds`.
 ``"e1(1)"``, ``"(e1(0) - e2(0))/sqrt(2)"`` (:func:`trace_functional`)
     A combination of boundary traces of the efforts, in the model-file syntax.
 ``"x2: sin(pi*z)"`` (:func:`integral_functional`)
@@ -46,7 +50,7 @@ __all__ = [
     "trace_functional",
 ]
 
-_DISPLACEMENT = re.compile(r"\s*w\s*\((?P<point>[^()]*)\)\s*\Z")
+_DISPLACEMENT = re.compile(r"\s*(?P<field>[^\W\d]\w*)\s*\((?P<point>[^()]*)\)\s*\Z")
 
 #: The displacement rows of each discretization (a Legendre-Vandermonde row of degree 159
 #: each, about 1 ms): the noise figures read them at every call.
@@ -63,7 +67,9 @@ class Functional:
         How reports name it: ``"w(1)"``, ``"e1(1)"``, ``"int(x2: sin(pi*z))"``.
     kind : {"displacement", "trace", "integral"}
     point : float or None
-        The point of a displacement.
+        The point of a displacement or named field.
+    field_name : str
+        ``"w"`` for the displacement, else the name of a field of ``[fields.<name>]``.
     trace : ndarray or None
         The row over the trace vector v of a trace combination.
     weight : callable or None
@@ -73,6 +79,7 @@ class Functional:
     name: str
     kind: str
     point: float | None = None
+    field_name: str = "w"
     trace: np.ndarray | None = field(default=None, compare=False, repr=False)
     weight: Callable[[np.ndarray], np.ndarray] | None = field(
         default=None, compare=False, repr=False
@@ -85,14 +92,10 @@ class Functional:
         (read-only).
         """
         if self.kind == "displacement":
-            if d.displacement_basis is None:
-                raise NumericError(
-                    f"{self.name}: the model {d.model.name!r} defines no displacement; "
-                    "give a trace or an integral of a state component instead"
-                )
-            basis, point = d.displacement_basis, self.point
+            basis = _basis(d, self.field_name, self.name)
+            point = self.point
             build = lambda: _read_only(basis(np.array([point])))  # noqa: E731
-            return _ROWS.get(d, ("displacement", point), build)
+            return _ROWS.get(d, ("displacement", self.field_name, point), build)
         if self.kind == "trace":
             T = d.info.get("T")
             if T is None or self.trace is None:
@@ -106,6 +109,21 @@ class Functional:
         raise NumericError(f"unknown kind of functional {self.kind!r}")  # pragma: no cover
 
 
+def _basis(d: DiscretePHS, name: str, label: str) -> Callable[[np.ndarray], np.ndarray]:
+    """Return the rows of the field ``name`` (``"w"``: the displacement) on a discretization."""
+    if name == "w":
+        if d.displacement_basis is None:
+            raise NumericError(
+                f"{label}: the model {d.model.name!r} defines no displacement; "
+                "give a trace or an integral of a state component instead"
+            )
+        return d.displacement_basis
+    spec = d.model.field_spec(name)
+    if spec is None or d.field_basis is None:
+        raise NumericError(f"{label}: the model {d.model.name!r} defines no field {name!r}")
+    return d.field_basis(spec)
+
+
 def _read_only(rows: np.ndarray) -> np.ndarray:
     """Return the first row of ``rows`` as a read-only float array (a shared cache entry)."""
     row = np.array(rows[0], dtype=float)
@@ -113,13 +131,14 @@ def _read_only(rows: np.ndarray) -> np.ndarray:
     return row
 
 
-def displacement_at(nm: NumericModel, point: float | str) -> Functional:
-    """Return the displacement ``w(point)`` of a model that defines one.
+def displacement_at(nm: NumericModel, point: float | str, name: str = "w") -> Functional:
+    """Return the displacement ``w(point)``, or the named field ``name(point)``.
 
     Raises
     ------
     NumericError
-        The model defines no displacement, or the point is not a number of [a, b].
+        The model defines no displacement (no such field), or the point is not a number
+        of [a, b].
     """
     a, b = nm.interval
     text = str(point).strip()
@@ -136,12 +155,18 @@ def displacement_at(nm: NumericModel, point: float | str) -> Functional:
             f"displacement point {text} is outside the interval [{a:g}, {b:g}]; "
             "expected a point of it"
         )
-    if nm.displacement is None:
+    if name != "w" and nm.field_spec(name) is None:
+        names = ", ".join(f for f, _ in nm.fields) or "none"
+        raise NumericError(
+            f"{name}({text}): the model {nm.name!r} defines no field {name!r}; its named "
+            f"fields are {names}"
+        )
+    if nm.displacement is None and name == "w":
         raise NumericError(
             f"w({text}): the model {nm.name!r} defines no displacement; give a boundary "
             "trace (e.g. e1(1)) or an integral of a state component (e.g. 'x2: 1') instead"
         )
-    return Functional(f"w({value:g})", "displacement", point=value)
+    return Functional(f"{name}({value:g})", "displacement", point=value, field_name=name)
 
 
 def trace_functional(nm: NumericModel, text: str, model: Any = None) -> Functional:
@@ -163,7 +188,7 @@ def integral_functional(nm: NumericModel, text: str, model: Any = None) -> Funct
 
 
 def parse_functional(text: str, nm: NumericModel, model: Any = None) -> Functional:
-    """Read a performance output from text: ``"w(1)"``, a trace, or ``"x2: weight"``.
+    """Read a performance output: ``"w(1)"``, a named field, a trace, or ``"x2: weight"``.
 
     Examples
     --------
@@ -176,8 +201,8 @@ def parse_functional(text: str, nm: NumericModel, model: Any = None) -> Function
     if not isinstance(text, str) or not text.strip():
         raise NumericError(f"performance output: expected text like 'w(1)'; found {text!r}")
     match = _DISPLACEMENT.match(text)
-    if match:
-        return displacement_at(nm, match.group("point"))
+    if match and (match.group("field") == "w" or nm.field_spec(match.group("field"))):
+        return displacement_at(nm, match.group("point"), match.group("field"))
     if ":" in text:
         return integral_functional(nm, text, model)
     return trace_functional(nm, text, model)

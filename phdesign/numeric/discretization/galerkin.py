@@ -65,7 +65,7 @@ from numpy.polynomial import legendre as leg
 
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError
-from phdesign.numeric.bridge import NumericModel, trace_index
+from phdesign.numeric.bridge import DisplacementSpec, NumericModel, trace_index
 from phdesign.numeric.discretization.base import Method
 from phdesign.numeric.discretization.distributed import galerkin_p0
 from phdesign.numeric.discretization.legendre import (
@@ -226,6 +226,7 @@ def galerkin(
         effort_basis=space.effort_basis,
         project=space.project,
         displacement_basis=None if nm.displacement is None else space.displacement,
+        field_basis=space.field,
         info=info,
     )
 
@@ -363,31 +364,38 @@ class _TrialSpace:
 
     @cached_property
     def _displacement(self) -> Any:
-        return _displacement_basis(self.nm, self.effort_basis, self.nm.interval)
+        assert self.nm.displacement is not None
+        return self.field(self.nm.displacement)
 
     def displacement(self, z: np.ndarray) -> np.ndarray:
         """``(m, dim)`` values: w(z) = displacement(z) @ ê (built on first use)."""
         return np.asarray(self._displacement(z))
 
+    def field(self, spec: DisplacementSpec) -> Any:
+        """``basis(z) -> (m, dim)`` of a field (:func:`_field_basis`)."""
+        return _field_basis(spec, self.nm, self.effort_basis, self.nm.interval)
 
-def _displacement_basis(nm: NumericModel, effort_basis, iv):
-    """w(z) = repeated integral from a of x_c = (H^-1 e)_c, as a linear map of ê.
 
-    x_c is sampled at Gauss points, expanded in Legendre polynomials by the (exact for
-    polynomials) discrete transform, and integrated exactly in that expansion: the rows
-    that do it at given points depend on the interval alone (:func:`_integration_rows`).
+def _field_basis(spec: DisplacementSpec, nm: NumericModel, effort_basis, iv):
+    r"""f(z) = Σ_j c_j I_s^{k_j} x_{i_j}, x = H⁻¹e, as a linear map of ê.
+
+    Each x_i is sampled at Gauss points, expanded in Legendre polynomials by the (exact
+    for polynomials) discrete transform, and integrated exactly in that expansion from the
+    end s: the rows that do it at given points depend on the interval alone
+    (:func:`_integration_rows`).
     """
-    spec = nm.displacement
-    assert spec is not None
-    c = spec.component - 1
     zq, _ = gauss_rule(DISPLACEMENT_POINTS, iv)
     Eq = effort_basis(zq)  # (nq, n, dim)
     Hinv = np.linalg.inv(nm.H_at(zq))
-    X = np.einsum("qk,qkd->qd", Hinv[:, c, :], Eq)  # x_c at Gauss points
+    X = {i: np.einsum("qk,qkd->qd", Hinv[:, i - 1, :], Eq) for i, _, _ in spec.terms}
 
     def basis(z: np.ndarray) -> np.ndarray:
         points = tuple(float(v) for v in np.atleast_1d(np.asarray(z, dtype=float)))
-        return np.asarray(_integration_rows(points, iv, spec.integrations) @ X)
+        return np.asarray(
+            sum(
+                c * (_integration_rows(points, iv, k, spec.start) @ X[i]) for i, k, c in spec.terms
+            )
+        )
 
     return basis
 
@@ -398,13 +406,13 @@ DISPLACEMENT_POINTS = 160
 
 @lru_cache(maxsize=256)
 def _integration_rows(
-    points: tuple[float, ...], iv: tuple[float, float], integrations: int
+    points: tuple[float, ...], iv: tuple[float, float], integrations: int, start: str = "a"
 ) -> np.ndarray:
     """Rows taking x_c at the Gauss points to its repeated integral at ``points`` (cached).
 
-    The discrete Legendre transform, integrated ``integrations`` times from a and read at
-    the points: it depends on the interval only, so every discretization and every run
-    shares it.
+    The discrete Legendre transform, integrated ``integrations`` times from the end
+    ``start`` (value zero there) and read at the points: it depends on the interval only,
+    so every discretization and every run shares it.
     """
     nq = DISPLACEMENT_POINTS
     zq, wq = gauss_rule(nq, iv)
@@ -413,7 +421,7 @@ def _integration_rows(
     coef = (leg.legvander(t, nq - 1) * (wq * 2.0 / (iv[1] - iv[0]))[:, None]).T / norms[:, None]
     half = 0.5 * (iv[1] - iv[0])
     for _ in range(integrations):
-        coef = leg.legint(coef, lbnd=-1, axis=0) * half
+        coef = leg.legint(coef, lbnd=-1 if start == "a" else 1, axis=0) * half
     tt = (2 * np.array(points) - iv[0] - iv[1]) / (iv[1] - iv[0])
     rows = leg.legvander(tt, coef.shape[0] - 1) @ coef
     rows.setflags(write=False)

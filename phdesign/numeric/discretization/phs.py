@@ -74,6 +74,10 @@ class DiscretePHS:
         ``project(x0) -> ê`` for a vectorized initial state ``x0(z) -> (m, n)``.
     displacement_basis : callable or None
         ``displacement_basis(z) -> (m, dim)``: w(z) = displacement_basis(z) @ ê.
+    field_basis : callable or None
+        ``field_basis(spec)(z) -> (m, dim)``: the same for any field
+        :math:`\sum_j c_j \mathcal I_s^{k_j} x_{i_j}` (a
+        :class:`~phdesign.numeric.bridge.DisplacementSpec`, e.g. a named rotation).
 
     Raises
     ------
@@ -96,6 +100,9 @@ class DiscretePHS:
     effort_basis: Callable[[np.ndarray], np.ndarray] = field(repr=False)
     project: Callable[[Callable[[np.ndarray], np.ndarray]], np.ndarray] = field(repr=False)
     displacement_basis: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
+    field_basis: Callable[[Any], Callable[[np.ndarray], np.ndarray]] | None = field(
+        default=None, repr=False
+    )
     info: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self) -> None:

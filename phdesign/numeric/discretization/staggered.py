@@ -31,6 +31,7 @@ B = B_nat S⁻¹ and skew feedthrough D = K_d S⁻¹.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -135,9 +136,8 @@ def staggered_fd(nm: NumericModel, m: int) -> DiscretePHS:
     B, D = _model_ports(nm, _native_inputs(nm, grids, len(p), G), p, q, G)
     space = _NodalSpace(n, grids, p, q, Hp, Hq)
     r, dim = len(p), n * m
-    disp = None
-    if nm.displacement is not None:
-        disp = _fd_displacement(nm, p, q, grids.zp, grids.zq, Hp, Hq, r, m, dim)
+    fields = functools.partial(_fd_field, nm, p, q, grids.zp, grids.zq, Hp, Hq, r, m, dim)
+    disp = None if nm.displacement is None else fields(nm.displacement)
     return DiscretePHS(
         model=nm,
         method=StaggeredFD.name,
@@ -150,6 +150,7 @@ def staggered_fd(nm: NumericModel, m: int) -> DiscretePHS:
         effort_basis=space.effort_basis,
         project=space.project,
         displacement_basis=disp,
+        field_basis=fields,
         info={
             "h": grids.h,
             "groups": (p, q),
@@ -346,10 +347,24 @@ def _linear_interp_matrix(grid: np.ndarray, z: np.ndarray) -> np.ndarray:
     return W
 
 
-def _fd_displacement(nm, p, q, zp, zq, Hp, Hq, r, m, dim):
-    """w(z): repeated trapezoidal integration from a of the nodal x_c (x = H⁻¹ e)."""
-    spec = nm.displacement
-    c = spec.component - 1
+def _fd_field(nm, p, q, zp, zq, Hp, Hq, r, m, dim, spec):
+    """f(z) = Σ_j c_j I_s^{k_j} x_{i_j}: repeated trapezoidal integration of nodal x_i."""
+    parts = [
+        (c, _fd_term(nm, p, q, zp, zq, Hp, Hq, r, m, dim, i - 1, k, spec.start))
+        for i, k, c in spec.terms
+    ]
+
+    def basis(z: np.ndarray) -> np.ndarray:
+        zz = np.atleast_1d(np.asarray(z, dtype=float))
+        return np.asarray(
+            sum(c * (_linear_interp_matrix(pts, zz) @ vals) for c, (pts, vals) in parts)
+        )
+
+    return basis
+
+
+def _fd_term(nm, p, q, zp, zq, Hp, Hq, r, m, dim, c, integrations, start):
+    """Nodes and values (as maps of ê) of I_s^k x_c, x = H⁻¹ e, from the end ``start``."""
     in_p = c in p
     grid, Hg, comps, off = (zp, Hp, p, 0) if in_p else (zq, Hq, q, r * m)
     cc = comps.index(c)
@@ -364,14 +379,13 @@ def _fd_displacement(nm, p, q, zp, zq, Hp, Hq, r, m, dim):
     vals = np.vstack([X[:1], X, X[-1:]]) if grid[-1] < b else np.vstack([X[:1], X])
     if grid[0] == a:
         pts, vals = pts[1:], vals[1:]
-    for _ in range(spec.integrations):
+    if start == "b":  # integrate from b: the same rule on the reversed nodes
+        pts, vals = pts[::-1], vals[::-1]
+    for _ in range(integrations):
         dz = np.diff(pts)[:, None]
         vals = np.vstack(
             [np.zeros((1, dim)), np.cumsum(0.5 * dz * (vals[1:] + vals[:-1]), axis=0)]
         )
-
-    def basis(z: np.ndarray) -> np.ndarray:
-        zz = np.atleast_1d(np.asarray(z, dtype=float))
-        return np.asarray(_linear_interp_matrix(pts, zz) @ vals)
-
-    return basis
+    if start == "b":
+        pts, vals = pts[::-1], vals[::-1]
+    return pts, vals
