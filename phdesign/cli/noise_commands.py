@@ -73,7 +73,10 @@ def add_noise_arguments(
 
 def _add_performance_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--at", metavar="Z", help="performance: the displacement at these points, e.g. 1 or 0.5,1"
+        "--at",
+        metavar="Z",
+        help="performance: the displacement at these points, e.g. 1 or 0.5,1, or a named "
+        "field of the model at a point, e.g. rotation(1)",
     )
     parser.add_argument(
         "--trace",
@@ -161,7 +164,8 @@ def _intensities(text: str | None, flag: str) -> list[float] | None:
 
 def _performance(args: argparse.Namespace) -> list[str] | None:
     """Return the performance outputs of ``--at``, ``--trace`` and ``--integral`` as text."""
-    items = [f"w({z})" for z in split_items(args.at)] if args.at is not None else []
+    points = split_items(args.at) if args.at is not None else []
+    items = [z if "(" in z else f"w({z})" for z in points]  # rotation(1): a named field
     items += args.trace
     for weights in args.integral:
         if ":" not in weights:  # a weight without its component would read as a trace

@@ -240,14 +240,16 @@ def _check_units(f: Field, name: str, units: Mapping[str, str], states: Sequence
     for term, unit in found:
         reference = found[0][1]
         if sympy.simplify(unit - reference) != 0:
+            first = found[0][0]
             raise ModelError(
-                f"{name}: the terms' units disagree: x{term.component} integrated "
-                f"{term.integrations} times has {unit}, x{found[0][0].component} {reference}"
+                f"{name}: the terms' units disagree: expected {reference} (x{first.component} "
+                f"integrated {first.integrations} times), found {unit} for x{term.component} "
+                f"integrated {term.integrations} times"
             )
     if stated is not None and found:
         expected = dimension(stated)
         if expected is not None and sympy.simplify(found[0][1] - expected) != 0:
             raise ModelError(
-                f"{name}: units.{name} = {stated!r} is {expected}, but its terms have "
-                f"{found[0][1]}"
+                f"{name}: units.{name} = {stated!r}: expected its terms in {expected}, "
+                f"found {found[0][1]}"
             )

@@ -201,7 +201,7 @@ def parse_functional(text: str, nm: NumericModel, model: Any = None) -> Function
     if not isinstance(text, str) or not text.strip():
         raise NumericError(f"performance output: expected text like 'w(1)'; found {text!r}")
     match = _DISPLACEMENT.match(text)
-    if match and (match.group("field") == "w" or nm.field_spec(match.group("field"))):
+    if match and not re.fullmatch(r"e[0-9]+", match.group("field")):
         return displacement_at(nm, match.group("point"), match.group("field"))
     if ":" in text:
         return integral_functional(nm, text, model)

@@ -73,7 +73,7 @@ def test_timoshenko_deflection_on_the_staggered_grid_converges_at_rate_two() -> 
     sizes = np.array([10, 20, 40])
     errors = []
     for m in sizes:
-        nm, d, e_hat = _static(model, "fd", int(m))
+        _nm, d, e_hat = _static(model, "fd", int(m))
         errors.append(abs(float(d.displacement_basis(np.array([1.0]))[0] @ e_hat) - exact))
     rate = -np.polyfit(np.log(sizes), np.log(errors), 1)[0]
     assert rate > 1.8, f"observed rate {rate:.2f}, errors {errors}"
