@@ -95,3 +95,55 @@ def test_a_field_from_b_with_a_coefficient() -> None:
     basis = d.field_basis(nm.field_spec("shear_from_tip"))
     # x1 = P/K is constant: the trapezoidal rule integrates it exactly
     assert basis(np.array([0.0]))[0] @ e_hat == pytest.approx(P_TIP, abs=1e-12)
+
+
+def test_timoshenko_first_mode_shape_against_the_characteristic_determinant() -> None:
+    r"""The first mode's w(z)/w(1) and φ(1)/w(1) against an mpmath root of Δ(λ).
+
+    Reference (``tests/characteristic.py``, nothing of phdesign's discretizations): the
+    eigenvalue λ is a root of Δ(λ) = det(U (Φ(1); I)) refined with mpmath from the
+    discrete one, the eigenfunction is e(z) = expm(M z) e(0) with M = P1⁻¹(λ H⁻¹ − P0) and
+    e(0) the null vector of U (Φ(1); I); then x = H⁻¹ e and, by the Cauchy formula for
+    repeated integrals, w(z) = ∫_0^z (x1(s) + (z − s) x3(s)) ds, φ(z) = ∫_0^z x3 (scipy's
+    quad).  The Galerkin eigenvector at degree 24 resolves the first mode (ω = 1.8624 at
+    these parameters) to round-off: its eigenvalue agrees to 8e-15, the normalized shape
+    and rotation to 1.5e-15 and 5e-15; 1e-12 leaves room for the quadrature (asked for
+    1e-13) and the null vector's conditioning.
+    """
+    import mpmath
+    from characteristic import characteristic_determinant
+    from scipy.integrate import quad
+    from scipy.linalg import expm, null_space
+
+    model = phd.load("timoshenko")
+    nm = to_numeric(model, VALUES)
+    d = discretize(nm, "galerkin", 24)
+    lams, vecs = np.linalg.eig(np.linalg.solve(d.E, d.J - d.R))
+    first = np.argmin(np.where(lams.imag > 1e-6, lams.imag, np.inf))
+    delta = characteristic_determinant(nm, dps=30)
+    with mpmath.workdps(30):
+        lam = complex(mpmath.findroot(delta, mpmath.mpc(lams[first])))
+    assert abs(lam - lams[first]) < 1e-9 * abs(lam)
+    Hinv = np.linalg.inv(nm.H_at(np.array([0.0]))[0])
+    M = np.linalg.solve(nm.P[1], lam * Hinv - nm.P[0])
+    S = np.vstack([expm(M), np.eye(4)])
+    e0 = null_space(nm.U @ S, rcond=1e-9)[:, 0]
+
+    def x(s: float) -> np.ndarray:
+        return Hinv @ (expm(M * s) @ e0)
+
+    def integral(f, z0: float) -> complex:
+        re = quad(lambda s: f(s).real, 0, z0, epsabs=1e-13)[0]
+        im = quad(lambda s: f(s).imag, 0, z0, epsabs=1e-13)[0]
+        return complex(re, im)
+
+    def w_exact(z0: float) -> complex:
+        return integral(lambda s: x(s)[0] + (z0 - s) * x(s)[2], z0)
+
+    points = np.array([0.25, 0.5, 0.75, 1.0])
+    exact = np.array([w_exact(z0) for z0 in points]) / w_exact(1.0)
+    discrete = d.displacement_basis(points) @ vecs[:, first]
+    assert np.allclose(discrete / discrete[-1], exact, rtol=0, atol=1e-12)
+    phi_exact = integral(lambda s: x(s)[2], 1.0) / w_exact(1.0)
+    phi = parse_functional("rotation(1)", nm, model).row(d) @ vecs[:, first] / discrete[-1]
+    assert abs(phi - phi_exact) < 1e-12
