@@ -200,8 +200,8 @@ def check_fields(
 def _check_field(f: object, name: str, size: int, parameters: set[sympy.Symbol]) -> None:
     if not isinstance(f, Field) or not f.terms or f.start not in ("a", "b"):
         raise ArgumentError(
-            f"{name} must be a Displacement(component=i, integrations=k) of two integers, "
-            f"or a Field(terms=...); found {type(f).__name__} {brief(f, 60)}"
+            f"{name} must be a Displacement(component=i, integrations=k) of two integers; "
+            f"found {type(f).__name__} {brief(f, 60)} (or a Field(terms=...) of several terms)"
         )
     for term in f.terms:
         if not isinstance(term, Term) or not all(
