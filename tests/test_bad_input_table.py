@@ -189,7 +189,10 @@ COMMAND_ROWS = [
         "--cm: expected a JSON list of rows",
         ObserverError,
     ),
-    row("classify euler-bernoulli --cm []", "--cm: expected a non-empty list", ObserverError),
+    # --cm [] (no sensors) is classify's, without a gain (issue 28: it classifies the plant)
+    row("classify euler-bernoulli --cm [] --gain 1", "--gain: no sensors", ObserverError),
+    row("spectrum euler-bernoulli --cm []", "--cm: no sensors ([]) is for", ObserverError),
+    row("classify euler-bernoulli --cm [[]]", "--cm: expected a non-empty list", ObserverError),
     # gains
     row(
         f"{BEAM_GAIN} 1,2,3",

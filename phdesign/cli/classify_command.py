@@ -64,7 +64,7 @@ def _classify(args: argparse.Namespace) -> int:
         if args.sensors is not None or args.cm is not None:
             raise ObserverError("--all-sensors tries every sensor set; drop --sensors/--cm")
         return _search(args, model)
-    observer = observer_from_args(args, model, default_gain=1)
+    observer = observer_from_args(args, model, default_gain=1, unobserved=True)
     if observer is None:
         raise ObserverError("classify needs --sensors, --cm or --all-sensors")
     result = observer.classify(method=args.method)

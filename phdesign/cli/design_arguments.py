@@ -102,6 +102,7 @@ def observer_from_args(
     command: str = "",
     method: str | None = None,
     resolution: int | None = None,
+    unobserved: bool = False,
 ) -> Any:
     """Return the :class:`phdesign.Observer` of ``--sensors``/``--cm`` and ``--gain``.
 
@@ -109,6 +110,7 @@ def observer_from_args(
     is absent (classify: the identity); without one, a ``command`` that needs a gain
     (spectrum, simulate) refuses sensors given without ``--gain``, and ``--gain`` without
     sensors is always refused.  ``method`` and ``resolution`` are the discretization.
+    ``unobserved`` admits ``--cm '[]'`` (no sensors, no gain: classify only).
     """
     from phdesign.design.observer import Observer
 
@@ -126,6 +128,16 @@ def observer_from_args(
         method=method,
         resolution=resolution,
     )
+    if observer.q == 0:  # C_m with no rows: classify certifies the plant's own dampers
+        if gain_text is not None:
+            observer.with_gain(parse_gain_text(gain_text))  # refused: no sensors, no gain
+        if not unobserved:
+            raise ObserverError(
+                "--cm: no sensors ([]) is for classify, which certifies the plant by its own "
+                "boundary dissipation; without --sensors/--cm, spectrum and simulate act on "
+                "the plant"
+            )
+        return observer
     if gain_text is not None:
         return observer.with_gain(parse_gain_text(gain_text))
     if default_gain is not None:

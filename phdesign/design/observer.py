@@ -44,7 +44,7 @@ from phdesign.core.text import REPR_LIMIT, html_table, matrix_text, sensors_text
 from phdesign.design.noise import ObserverNoise
 from phdesign.design.plant import Plant, numeric_matrix
 from phdesign.symbolic.model import BCPHS
-from phdesign.symbolic.observer import gain_matrix, measurement_matrix, sensor_matrix
+from phdesign.symbolic.observer import gain_matrix, observer_sensors
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     import numpy as np
@@ -135,21 +135,11 @@ class Observer(ObserverNoise):
             raise ArgumentError("give parameters, method and resolution to the Plant, not twice")
         else:
             plant = model
-        n_outputs = plant.model.n_ports  # the external outputs ([feedback] closes the others)
-        if (sensors is None) == (C_m is None):
-            raise ObserverError(
-                "an observer needs either sensors=[...] (outputs by index, e.g. [3, 4]) or "
-                "C_m=[[...]] (the sensor matrix); found "
-                + ("neither" if sensors is None else "both")
-            )
-        exact = (
-            sensor_matrix(sensors, n_outputs)
-            if sensors is not None
-            else measurement_matrix(C_m, n_outputs)
-        )
+        # the external outputs ([feedback] closes the others)
+        exact, L = observer_sensors(sensors, C_m, gain, plant.model.n_ports)
         object.__setattr__(self, "plant", plant)
         object.__setattr__(self, "C_m", exact)
-        object.__setattr__(self, "L", None if gain is None else gain_matrix(gain, exact.rows))
+        object.__setattr__(self, "L", L)
         object.__setattr__(self, "tuning", tuning)
 
     # ------------------------------------------------------------------ views
@@ -170,7 +160,8 @@ class Observer(ObserverNoise):
 
     def with_gain(self, gain: Any) -> Observer:
         """Return an observer with the same sensors and another gain."""
-        return self._copy(gain=gain_matrix(gain, self.q), tuning=None)
+        L = observer_sensors(None, self.C_m, gain, self.C_m.cols)[1] if self.q == 0 else None
+        return self._copy(gain=gain_matrix(gain, self.q) if L is None else L, tuning=None)
 
     def _copy(self, gain: Any, tuning: TuneResult | None) -> Observer:
         return Observer(self.plant, C_m=self.C_m, gain=gain, tuning=tuning)
@@ -183,11 +174,20 @@ class Observer(ObserverNoise):
             )
         return self.L
 
+    def _need_sensors(self, what: str) -> None:
+        if self.q == 0:
+            raise ObserverError(
+                f"{what} needs at least one sensor; found C_m with no rows (an observer "
+                "without sensors only classifies: classify() certifies the plant by its own "
+                "boundary dissipation; Plant.spectrum() and Plant.simulate() act on the plant)"
+            )
+
     def numeric_gain(self, what: str = "this computation") -> tuple[np.ndarray, np.ndarray]:
         """``(C_m, L)`` as read-only float arrays; a symbolic or missing gain is refused.
 
         They are converted once per observer (every numeric method asks for them).
         """
+        self._need_sensors(what)
         if self._gain(what).free_symbols:
             numeric_matrix(self._gain(what), "L", what)  # refuses it, saying what to do
         return self._floats
@@ -302,6 +302,7 @@ class Observer(ObserverNoise):
         """
         from phdesign.numeric.tuning.search import tune
 
+        self._need_sensors("tune")
         C = numeric_matrix(self.C_m, "C_m", "tune")
         report = tune(
             self.plant.numeric,
@@ -429,6 +430,8 @@ class Observer(ObserverNoise):
     def labels(self) -> dict[str, str]:
         """Return the design as text (sensors, gain), as it labels simulations and plots."""
         gain = "none (tune one)" if self.L is None else matrix_text(self.L)
+        if self.q == 0:
+            return {"sensors": "none", "gain": "none (no sensors)"}
         return {"sensors": sensors_text(self.C_m), "gain": gain}
 
     def to_dict(self) -> dict[str, Any]:

@@ -259,9 +259,11 @@ class Classification:
         model = self.model
         lines = [
             f"model {model.name}: N = {model.order}, n = {model.size}",
-            f"sensors: {sensors_text(self.C_m)}",
-            f"gain L = {matrix_text(self.L)}",
         ]
+        if self.C_m.rows == 0:  # the plant's own boundary dissipation is the left-hand side
+            lines.append("sensors: none (the left-hand side is the plant's own dissipation)")
+        else:
+            lines += [f"sensors: {sensors_text(self.C_m)}", f"gain L = {matrix_text(self.L)}"]
         if model.feedback is not None:  # the plant's own dampers: part of the error boundary
             closed = ", ".join(f"u{i}" for i in model.feedback.inputs)
             lines.append(
@@ -403,7 +405,8 @@ def _from_certificate(
         free = tuple(traces[i] for i in cert.free)
         labels = ", ".join(t.label(interval, tilde=True) for t in free)
         verb = "is" if len(free) == 1 else "are"
-        reason = f"{labels} {verb} left free by these sensors"
+        by = "these sensors" if es.C_m.rows else "the boundary dissipation"  # no sensors
+        reason = f"{labels} {verb} left free by {by}"
         if symbolic:
             reason += "; fails for all positive gains"
             conditions = conditions or "fails for all positive gains"

@@ -42,6 +42,8 @@ __all__ = [
     "gain_matrix",
     "gain_symbols",
     "measurement_matrix",
+    "no_sensors",
+    "observer_sensors",
     "parse_sensor_indices",
     "sensor_matrix",
     "sensors_and_gain",
@@ -367,18 +369,96 @@ def _number(x: object, what: str) -> sympy.Expr:
         raise ObserverError(str(error)) from None
 
 
+def no_sensors(C_m: Any, n_outputs: int) -> bool:
+    """Whether ``C_m`` says *no sensors*: ``[]``, or a matrix with no rows.
+
+    A matrix with no rows must have ``n_outputs`` columns (or none: ``np.zeros((0, 0))``
+    and ``[]`` say the same); any other width is refused, as for a matrix with rows.
+
+    Raises
+    ------
+    ObserverError
+        For a matrix with no rows and a width other than 0 or ``n_outputs``.
+
+    Examples
+    --------
+    >>> no_sensors([], 4), no_sensors([[0, 0, 1, 0]], 4)
+    (True, False)
+    """
+    shape = getattr(C_m, "shape", None)
+    if shape is None:
+        return isinstance(C_m, list | tuple) and len(C_m) == 0
+    if len(shape) == 1 or shape[0] != 0:
+        return len(shape) == 1 and shape[0] == 0
+    if len(shape) != 2 or shape[1] not in (0, n_outputs):
+        raise ObserverError(
+            f"Incompatible dimensions of C_m matrix; expected (0, {n_outputs}) for no sensors "
+            f"but found {tuple(shape)}"
+        )
+    return True
+
+
+def _no_gain(L: Any) -> bool:
+    """Whether ``L`` is absent or empty (the gain of no sensors)."""
+    shape = getattr(L, "shape", None)
+    if shape is not None:
+        return 0 in tuple(shape)
+    return L is None or (isinstance(L, list | tuple) and len(L) == 0)
+
+
 def sensors_and_gain(
     C_m: Any, L: Any, n_outputs: int
 ) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix]:
     r"""Read :math:`C_m` and :math:`L` (:func:`measurement_matrix`, :func:`gain_matrix`).
 
-    One case more than those readers take: ``C_m`` of shape ``(0, n_outputs)`` with ``L``
-    of shape ``(0, 0)`` means *no sensors*, which classifies the plant by its own boundary
-    dissipation (its ``[feedback]``): the propositions' left-hand side then holds only
-    :math:`	ilde y_c^	op \operatorname{sym}(K) 	ilde y_c` (observer-based control
-    classifies the controlled plant so).  An empty list is not that case: it is refused.
+    One case more than those readers take: *no sensors* (:func:`no_sensors`: ``C_m`` is
+    ``[]`` or has no rows, and ``L`` is ``None``, ``[]`` or empty).  The error system is
+    then the plant closed by its own ``[feedback]`` (:math:`\tilde u_r = 0`), and the
+    propositions' left-hand side holds only :math:`\tilde y_c^\top \operatorname{sym}(K)
+    \tilde y_c`: the plant is classified by its own boundary dissipation (observer-based
+    control classifies the controlled plant so).  Without a ``[feedback]`` that side is
+    zero and no proposition holds.
+
+    Raises
+    ------
+    ObserverError
+        What :func:`measurement_matrix` and :func:`gain_matrix` raise, and a gain given
+        with no sensors.
     """
-    if getattr(C_m, "shape", None) == (0, n_outputs) and getattr(L, "shape", None) == (0, 0):
+    if no_sensors(C_m, n_outputs):
+        if not _no_gain(L):
+            raise ObserverError(
+                f"gain: no sensors (C_m has no rows) take no gain; expected none or an empty "
+                f"matrix but found {L!r}"
+            )
         return sympy.ImmutableMatrix.zeros(0, n_outputs), sympy.ImmutableMatrix.zeros(0, 0)
     exact = measurement_matrix(C_m, n_outputs)
     return exact, gain_matrix(L, exact.rows)
+
+
+def observer_sensors(
+    sensors: Any, C_m: Any, gain: Any, n_outputs: int
+) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix | None]:
+    """Read an observer's ``sensors`` or ``C_m``, and its ``gain`` (``None``: no gain yet).
+
+    Exactly one of ``sensors`` (:func:`sensor_matrix`) and ``C_m``
+    (:func:`measurement_matrix`, or *no sensors*: :func:`sensors_and_gain`) is given.
+
+    Raises
+    ------
+    ObserverError
+        Neither or both given, or what the readers raise.
+    """
+    if (sensors is None) == (C_m is None):
+        raise ObserverError(
+            "an observer needs either sensors=[...] (outputs by index, e.g. [3, 4]) or "
+            "C_m=[[...]] (the sensor matrix); found " + ("neither" if sensors is None else "both")
+        )
+    if sensors is None and no_sensors(C_m, n_outputs):  # classified by its own dampers
+        return sensors_and_gain(C_m, gain, n_outputs)
+    exact = (
+        sensor_matrix(sensors, n_outputs)
+        if sensors is not None
+        else measurement_matrix(C_m, n_outputs)
+    )
+    return exact, None if gain is None else gain_matrix(gain, exact.rows)

@@ -112,9 +112,10 @@ BAD_DESIGNS = [
         sympy.eye(1),
         r"C_m matrix; expected \(q, 4\).* but found \(1, 3\)",
     ),
-    # an empty list is refused; a (0, 4) C_m with a (0, 0) L is the plant's own
-    # classification (no sensors: observer-based control, issue 16)
-    ([], sympy.eye(0), r"C_m: expected a non-empty list of non-empty rows"),
+    # no sensors ([] or a (0, 4) C_m) is the plant's own classification (issue 16; since
+    # issue 28 also [], tests/design/test_observer_no_sensors.py) and takes no gain
+    ([], sympy.eye(1), r"gain: no sensors \(C_m has no rows\) take no gain"),
+    (np.zeros((0, 3)), sympy.eye(0), r"expected \(0, 4\) for no sensors but found \(0, 3\)"),
     (sympy.zeros(5, 4), sympy.eye(5), r"1 <= q <= 4"),
     (sensor_matrix([3, 4], 4), sympy.eye(3), r"L matrix; expected \(2, 2\).* but found \(3, 3\)"),
     (sensor_matrix([3, 4], 4), sympy.diag(1, -1), r"positive definite.*minor 2 = -4"),
