@@ -11,6 +11,7 @@ import csv
 import io
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from numeric_models import PAPER_SENSORS, numeric
 from phdesign.cli import main
 from phdesign.models import load_builtin
 from phdesign.numeric.noise.figures import noise
+from phdesign.numeric.noise.settle import settle
 from phdesign.numeric.noise.tradeoff import tradeoff
 from phdesign.numeric.noise.tuning import tune_noise
 
@@ -186,3 +188,24 @@ def test_a_noise_tuning_cut_short_by_its_iteration_limit_says_so():
         maxiter=1,
     )
     assert any("stopped at its iteration limit (2 steps)" in w for w in res.warnings)
+
+
+def test_a_figure_that_did_not_converge_prints_its_agreeing_digits_and_star_means_one_thing():
+    # 0.60941 and 0.60950 agree to -log10(9e-5 / 0.6095) = 3.83 digits: 4 are printed
+    var = settle("int(x2: 1)", [0.60941, 0.60950], [20, 30], 1e-6)
+    assert var.approximate() == "≈ 0.6095, 3.8 digits, not converged"
+    assert str(var).startswith("int(x2: 1) ≈ 0.6095, 3.8 digits, not converged")
+    result = tradeoff(
+        numeric("wave"), np.array([[0.0, 1.0]]), grid=[[0.2, 0.5]], performance=["x2: 1"]
+    )
+    point = result.points[0]
+    unsettled = replace(point, noise=replace(point.noise, performance=(var,)))
+    text = str(replace(result, points=(unsettled, result.points[1])))
+    rows = [line for line in text.splitlines() if line.startswith("  [") or "diag" in line]
+    assert "0.7807*" in rows[0]  # rms = sqrt(0.6095): as many digits as the variance
+    assert rows[0].endswith("yes")  # Pareto is a word, so that * has one meaning
+    assert "*" not in rows[1]
+    assert "(*: did not converge, shown to the digits that agree" in text
+    assert "Var[int(x2: 1)~] ≈ 0.6095, 3.8 digits, not converged   rms ≈ 0.7807" in str(
+        unsettled.noise
+    )

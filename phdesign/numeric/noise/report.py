@@ -268,6 +268,9 @@ class NoiseReport:
                     f"  Var[{est.name}~] = {est.value:.10g}   rms {math.sqrt(est.value):.6g}   "
                     f"{est.status()}"
                 )
+            elif est.approximate() is not None:  # its value to the digits that agree
+                rms = est.rounded(math.sqrt(est.values[-1]))
+                lines.append(f"  Var[{est.name}~] {est.approximate()}   rms ≈ {rms}")
             else:
                 lines.append(f"  Var[{est.name}~]: {est.status()}")
         g = self.l2_gain
@@ -278,12 +281,18 @@ class NoiseReport:
                 f"{g.estimate.status()}, over the resolved band |ω| <= {g.band:.4g}"
             )
         else:
-            lines.append(f"  L2-gain noise -> error (energy norm): {g.estimate.status()}")
+            shown = g.estimate.approximate()
+            lines.append(
+                "  L2-gain noise -> error (energy norm)"
+                + (f": {g.estimate.status()}" if shown is None else f" {shown}")
+            )
         energy = self.error_energy
         values = ", ".join(f"{v:.4g}" for v in energy.values)
         verdict = "infinite for the PDE" if energy.diverges else energy.status()
         if energy.value is not None:
             verdict = f"{energy.value:.10g}   {energy.status()}"
+        elif energy.approximate() is not None:
+            verdict = str(energy.approximate())
         elif energy.diverges:
             verdict = f"{energy.status()}: infinite for the PDE"
         lines.append(f"  expected error energy E[H~]: {verdict} ({values} at resolutions {res})")
@@ -306,6 +315,8 @@ class NoiseReport:
         for est in self.performance:
             value = "—" if est.value is None else f"{est.value:.8g}"
             rms = "—" if est.value is None else f"{math.sqrt(est.value):.6g}"
+            if est.rounded() is not None:  # not converged: to the digits that agree
+                value, rms = f"≈ {est.rounded()}", f"≈ {est.rounded(math.sqrt(est.values[-1]))}"
             rows.append((f"Var[{est.name}~]", value, rms, est.status()))
         g = self.l2_gain
         where = "" if g.value is None else f" at ω = {g.frequency:.4g}"

@@ -75,12 +75,39 @@ class Estimate:
             return "not converged"
         return f"not converged ({max(self.digits, 0.0):.1f} digits)"
 
+    def rounded(self, value: float | None = None) -> str | None:
+        """Return a figure that did not converge, to the digits that agree: ``0.6095``.
+
+        ``value`` is a function of the finest value with the same relative accuracy (the
+        RMS, its square root, has at least as many digits); None when the figure
+        converged, diverges, or has no finite value or no agreeing digits to show.
+        """
+        if self.converged or self.diverges or not self.values or self.digits is None:
+            return None
+        top = self.values[-1] if value is None else value
+        if not math.isfinite(top):
+            return None
+        return f"{top:.{min(10, max(1, math.ceil(self.digits)))}g}"
+
+    def approximate(self) -> str | None:
+        """``≈ 0.6095, 3.6 digits, not converged`` (see :meth:`rounded`), else None."""
+        shown = self.rounded()
+        if shown is None or self.digits is None:
+            return None
+        return f"≈ {shown}, {max(self.digits, 0.0):.1f} digits, not converged"
+
     def __str__(self) -> str:
         """``w(1) = 0.1347085719   converged (8.5 digits) (0.1347, ... at resolutions ...)``."""
         values = ", ".join(f"{v:.6g}" for v in self.values)
         at = ", ".join(str(r) for r in self.resolutions)
-        head = self.name if self.value is None else f"{self.name} = {self.value:.10g}"
-        return f"{head}   {self.status()}" + (f" ({values} at resolutions {at})" if at else "")
+        shown = self.approximate()
+        if shown is not None:
+            head = f"{self.name} {shown}"
+        elif self.value is None:
+            head = f"{self.name}   {self.status()}"
+        else:
+            head = f"{self.name} = {self.value:.10g}   {self.status()}"
+        return head + (f" ({values} at resolutions {at})" if at else "")
 
     def __repr__(self) -> str:
         value = None if self.value is None else float(f"{self.value:.10g}")

@@ -210,13 +210,13 @@ class Tradeoff:
                 if p.decay_rate is None
                 else f"{p.decay_rate:.6g}" + ("" if p.abscissa_converged else "*")
             )
-            rms = "—" if p.rms is None else f"{p.rms:.6g}"
-            gain = "—" if p.noise.l2_gain.value is None else f"{p.noise.l2_gain.value:.5g}"
-            mark = "  *" if p.pareto else ""
-            lines.append(f"  {gain_text(p.gain):<28} {rate:>10} {rms:>12} {gain:>10}{mark}")
+            rms, gain = _figure_text(p, ".6g"), _figure_text(p, ".5g", l2=True)
+            pareto = "  yes" if p.pareto else ""
+            lines.append(f"  {gain_text(p.gain):<28} {rate:>10} {rms:>12} {gain:>10}{pareto}")
         lines.append(
-            "(* after -α: the abscissa did not converge to 1e-10, e.g. at a coalescence; "
-            "— : the figure did not converge or diverges)"
+            "(*: did not converge, shown to the digits that agree between the two finest "
+            "resolutions (-α: to 1e-10, e.g. at a coalescence); —: diverges or not computed; "
+            "Pareto: no other gain decays faster with a smaller rms)"
         )
         lines += [f"warning: {w}" for w in self.warnings]
         return "\n".join(lines)
@@ -249,6 +249,19 @@ class Tradeoff:
         from phdesign.plots.noise import plot_tradeoff
 
         return plot_tradeoff(self, path, force=force, annotate=annotate)
+
+
+def _figure_text(point: TradeoffPoint, spec: str, *, l2: bool = False) -> str:
+    """Return a point's rms (or L2-gain) for the table; ``0.6095*`` if not converged."""
+    noise = point.noise
+    value = noise.l2_gain.value if l2 else point.rms
+    if value is not None:
+        return f"{value:{spec}}"
+    est = noise.l2_gain.estimate if l2 else (noise.performance[0] if noise.performance else None)
+    if est is None or not est.values:
+        return "—"
+    shown = est.rounded() if l2 else est.rounded(math.sqrt(max(est.values[-1], 0.0)))
+    return "—" if shown is None else f"{shown}*"
 
 
 def pareto_mask(
