@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import sys
 from typing import Any
 
 from phdesign.cli.common import (
@@ -21,14 +22,16 @@ from phdesign.cli.common import (
     emit,
     emit_json,
     load_model,
+    printable,
     result_text,
     split_items,
     warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
+from phdesign.cli.messages import translated
 from phdesign.core.checks import EXPORT_FORMATS, REDUCTIONS, SAMPLERS
 from phdesign.core.defaults import current
-from phdesign.core.errors import NumericError, ObserverError, OutputFileError
+from phdesign.core.errors import NumericError, ObserverError, OutputFileError, VerificationError
 
 __all__ = ["add_sampling_arguments", "register", "sampling_options"]
 
@@ -111,6 +114,13 @@ def _add_verification_arguments(ex: argparse.ArgumentParser) -> None:
         help="run the exported observer against the high-resolution plant",
     )
     ex.add_argument(
+        "--strict",
+        action="store_true",
+        help="verify (implies --verify) and exit with status 3, writing nothing, when a "
+        "check fails: the targets, the sampled against the continuous observer, the "
+        "verification plant's own resolution",
+    )
+    ex.add_argument(
         "--x0",
         metavar="EXPRS",
         help="plant initial state of the order selection and verification runs (default "
@@ -151,19 +161,12 @@ def _export(args: argparse.Namespace) -> int:
     observer = observer_from_args(args, model, command="export")
     if observer is None:
         raise ObserverError("export needs --sensors or --cm to say which outputs are measured")
-    result = observer.export(
-        dt=args.dt,
-        sampler=args.sampler,
-        order=args.order,
-        reduction=args.reduce,
-        tol=args.tol,
-        output_tol=args.output_tol,
-        verify=args.verify,
-        x0=args.x0 or None,
-        t_end=args.t_end,
-        plant_resolution=args.plant_resolution,
-        points=None if args.at is None else split_items(args.at),
-    )
+    try:
+        result = _exported(args, observer)
+    except VerificationError as error:  # exit 3: the export ran and failed its checks
+        line = f"{translated(str(error))}; nothing written"
+        print(f"phdesign: error: {printable(line)}", file=sys.stderr)
+        return 3
     written = result.write(args.output, args.format, force=args.force)
     if args.json:
         emit_json({**result.to_dict(), "files": written})
@@ -172,6 +175,24 @@ def _export(args: argparse.Namespace) -> int:
     else:
         emit(result_text(result) + "".join(f"\nwrote {path}" for path in written))
     return 0
+
+
+def _exported(args: argparse.Namespace, observer: Any) -> Any:
+    """Return ``observer.export(...)`` with the options of the command line."""
+    return observer.export(
+        dt=args.dt,
+        sampler=args.sampler,
+        order=args.order,
+        reduction=args.reduce,
+        tol=args.tol,
+        output_tol=args.output_tol,
+        verify=args.verify,
+        strict=args.strict,
+        x0=args.x0 or None,
+        t_end=args.t_end,
+        plant_resolution=args.plant_resolution,
+        points=None if args.at is None else split_items(args.at),
+    )
 
 
 def add_sampling_arguments(parser: argparse.ArgumentParser) -> None:

@@ -68,6 +68,10 @@ class NumericError(PhdesignError, ValueError):
     """A numeric request cannot be honoured (bad resolution, time span, method)."""
 
 
+class VerificationError(NumericError):
+    """A strict export whose verification failed (``strict=True``: nothing is returned)."""
+
+
 class OutputFileError(PhdesignError, ValueError):
     """An output path is not writable or would overwrite a file without ``force``."""
 

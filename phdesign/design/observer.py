@@ -345,6 +345,7 @@ class Observer(ObserverNoise):
         tol: float | None = None,
         output_tol: float | None = None,
         verify: bool = False,
+        strict: bool = False,
         x0: str | Callable[[Any], Any] | None = None,
         t_end: float | None = None,
         plant_resolution: int | None = None,
@@ -380,6 +381,10 @@ class Observer(ObserverNoise):
             performance outputs relative to their peak.
         verify : bool
             Run the exported observer against a high-resolution plant.
+        strict : bool
+            Verify (``verify`` implied) and raise
+            :class:`~phdesign.core.errors.VerificationError` naming each failed check
+            (targets, sampled against continuous, the plant's resolution).
         x0 : str or callable, optional
             Plant initial state of those runs (``"x1: 0, x2: z - 0.9"``, or a function of z).
         t_end : float
@@ -418,6 +423,7 @@ class Observer(ObserverNoise):
             tol=tol,
             output_tol=output_tol,
             verify=verify,
+            strict=strict,
             x0=self.plant.initial_state(x0, "x0"),
             x0_text=x0 if isinstance(x0, str) else None,
             t_end=t_end,

@@ -102,3 +102,31 @@ def test_simulate_sampled_flags(capsys):
     assert rows[0][:4] == ["t", "H", "H_hat", "H_err"]
     assert len(rows) == 12
     assert float(rows[-1][0]) == 1.0
+
+
+def test_strict_export_exits_3_writes_nothing_and_names_the_failed_check(capsys, tmp_path):
+    # point samples of the beam's tip velocities every 1 ms alias: the floor is ~1000x the
+    # continuous observer's (docs/export.md, DESIGN.md), the check allows 10x
+    path = tmp_path / "o.json"
+    path.write_text("mine")  # an earlier export (force): a failed strict export keeps it
+    argv = ["export", *BEAM, "--dt", "1e-3", "--sampler", "point", "--order", "34", *PAPER_X0]
+    status, out, err = run(capsys, *argv, "--format", "json", "-o", str(path), "--force")
+    assert status == 0  # without --strict: written, with a warning
+    path.write_text("mine")
+    for extra in ([], ["--json"]):
+        status, out, err = run(
+            capsys, *argv, "--format", "json", "-o", str(path), "--force", "--strict", *extra
+        )
+        assert (status, out) == (3, "")
+        assert err.count("\n") == 1
+        assert err.startswith("phdesign: error: --strict: the export failed its checks: ")
+        assert "sampled against continuous observer: error floor" in err
+        assert "(at most 10x); nothing written" in err
+        assert "targets" not in err  # the order selection met its targets
+        assert path.read_text() == "mine"
+    # the averaged sampler passes every check: written, exit 0
+    good = tmp_path / "good.json"
+    argv = ["export", *BEAM, "--dt", "1e-3", "--order", "34", *PAPER_X0, "--strict"]
+    status, out, err = run(capsys, *argv, "--format", "json", "-o", str(good))
+    assert (status, err) == (0, "")
+    assert json.loads(good.read_text())["verification"]["ratio"] < 10

@@ -57,6 +57,7 @@ from phdesign.numeric.sampled.samplers import (
 from phdesign.numeric.sampled.selection import OrderSelection
 from phdesign.numeric.sampled.verification import (
     Verification,
+    check_strict,
     plant_gap,
     verify_observer,
     with_plant_gap,
@@ -304,6 +305,7 @@ def export_observer(
     tol: float | None = None,
     output_tol: float | None = None,
     verify: bool = False,
+    strict: bool = False,
     x0: Callable[[np.ndarray], np.ndarray] | None = None,
     x0_text: str | None = None,
     t_end: float | None = None,
@@ -331,6 +333,10 @@ def export_observer(
         Spectral and performance targets of the order selection (1e-6 and 1e-3).
     verify : bool
         Run the exported observer against the verification plant.
+    strict : bool
+        Run the verification (``verify`` implied) and raise
+        :class:`~phdesign.core.errors.VerificationError` naming every failed check
+        (:func:`~phdesign.numeric.sampled.verification.failed_checks`).
     x0 : callable, optional
         Plant initial state ``x0(z) -> (m, n)`` of the performance and verification runs;
         default every component ``(z - a)/(b - a) - 0.9``.
@@ -361,19 +367,18 @@ def export_observer(
     (12, ('u1', 'u2', 'y2'), ('yhat1', 'yhat2'))
     """
     sampler, tol, output_tol, t_end = current().export.fill(sampler, tol, output_tol, t_end)
+    verify = _checked_flags(verify, strict)  # strict verifies
     dt = _checked_request(nm, dt, sampler, reduction, t_end, verify, tol, output_tol, x0)
     plant = discretize(
         nm, "galerkin", verification_plant_degree(nm, order, plant_resolution, reduction)
     )
-    points = displacement_points(nm, points)
     initial = default_initial_state(nm.size, nm.interval) if x0 is None else x0
     text = x0_text or ("x_i = (z - a)/(b - a) - 0.9 for every component" if x0 is None else "x0")
     e0 = plant.project(initial)
-    C = np.atleast_2d(np.asarray(C_m, dtype=float))
-    Lm = np.atleast_2d(np.asarray(L, dtype=float))
+    C, Lm = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (C_m, L))
     selection, continuous = select_order(
-        nm, C, Lm, plant=plant, x0=e0, t_end=float(t_end), points=tuple(points), order=order,
-        reduction=reduction, tol=tol, output_tol=output_tol,
+        nm, C, Lm, plant=plant, x0=e0, t_end=float(t_end), order=order, reduction=reduction,
+        points=displacement_points(nm, points), tol=tol, output_tol=output_tol,
     )  # fmt: skip
     discrete = continuous.sampled(dt, sampler)
     verification = None
@@ -384,7 +389,7 @@ def export_observer(
             x0_text=text, realization=discrete,
         )  # fmt: skip
     selection, verification = _plant_checks(
-        nm, plant, continuous, initial, float(t_end), text, selection, verification
+        nm, plant, continuous, initial, float(t_end), text, selection, verification, strict
     )
     return SampledObserver(
         model=model_name or nm.name,
@@ -403,13 +408,21 @@ def export_observer(
     )
 
 
+def _checked_flags(verify: Any, strict: Any) -> bool:
+    """Refuse ``verify`` or ``strict`` that are not booleans; return whether to verify."""
+    for name, value in (("verify", verify), ("strict", strict)):
+        if not isinstance(value, bool):
+            raise ArgumentError(f"{name} must be True or False; found {value!r}")
+    return bool(verify or strict)
+
+
 def _checked_request(
     nm: NumericModel,
     dt: Any,
     sampler: str,
     reduction: str,
     t_end: Any,
-    verify: Any,
+    verify: bool,
     tol: Any,
     output_tol: Any,
     x0: Any,
@@ -420,8 +433,6 @@ def _checked_request(
         raise NumericError(f"unknown reduction {reduction!r}; expected one of {REDUCTIONS}")
     if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):
         raise NumericError(f"t_end must be a finite positive number; found {t_end!r}")
-    if not isinstance(verify, bool):
-        raise ArgumentError(f"verify must be True or False; found {verify!r}")
     check_periods(period, float(t_end), stepped=verify)
     positive_number(tol, "tol")
     positive_number(output_tol, "output_tol")
@@ -438,10 +449,12 @@ def _plant_checks(
     text: str,
     selection: OrderSelection,
     verification: Verification | None,
+    strict: bool = False,
 ) -> tuple[OrderSelection, Verification | None]:
     """Check the verification and a missed target against a finer plant (its own resolution?).
 
     One finer plant serves both checks, on the verification's records when there are any.
+    ``strict`` raises when a check failed (:func:`check_strict`).
     """
     missed = selection.floor > selection.output_tol  # is it the plant's own resolution?
     if verification is None and not missed:
@@ -454,4 +467,6 @@ def _plant_checks(
         verification = with_plant_gap(verification, found, plant.resolution)
     if missed:
         selection = with_target_check(selection, found, plant.resolution, text)
+    if strict:
+        check_strict(selection, verification)
     return selection, verification

@@ -50,6 +50,7 @@ from phdesign.numeric.spectrum.converged import default_resolutions
 __all__ = [
     "GAP_RATIO",
     "free_outputs",
+    "gap_exceeds",
     "gap_warning",
     "plant_resolution_gap",
     "target_warning",
@@ -162,11 +163,16 @@ def target_warning(
     )
 
 
+def gap_exceeds(gap: float, continuous_floor: float, peak: float) -> bool:
+    """Whether the plant's own gap exceeds GAP_RATIO x the continuous floor (not round-off)."""
+    return bool(gap > max(GAP_RATIO * continuous_floor, 1e-12 * peak))
+
+
 def gap_warning(
     gap: float, degrees: tuple[int, int], continuous_floor: float, peak: float, x0_text: str
 ) -> str | None:
     """Return the verification's warning when ``gap`` exceeds GAP_RATIO x the floor."""
-    if not gap > max(GAP_RATIO * continuous_floor, 1e-12 * peak):
+    if not gap_exceeds(gap, continuous_floor, peak):
         return None
     return (
         f"the verification plant does not resolve its own outputs from {x0_text}: at "

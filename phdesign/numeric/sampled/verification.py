@@ -17,17 +17,26 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.defaults import current
+from phdesign.core.errors import VerificationError
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_periods, check_sampling
 from phdesign.numeric.sampled.order import check_order
 from phdesign.numeric.sampled.period_maps import Realization
-from phdesign.numeric.sampled.runs import run_against_continuous
+from phdesign.numeric.sampled.runs import ALIASING_RATIO, aliasing_warning, run_against_continuous
 from phdesign.numeric.sampled.samplers import ContinuousObserver
 from phdesign.numeric.sampled.selection import OrderSelection
 from phdesign.numeric.threads import limited_threads
 
-__all__ = ["Verification", "plant_gap", "verify_observer", "with_plant_gap", "with_target_check"]
+__all__ = [
+    "Verification",
+    "check_strict",
+    "failed_checks",
+    "plant_gap",
+    "verify_observer",
+    "with_plant_gap",
+    "with_target_check",
+]
 
 
 def _fmt(value: float | None) -> str:
@@ -105,6 +114,33 @@ class Verification:
             "plant_gap": self.plant_gap,
             "warnings": list(self.warnings),
         }
+
+    def failures(self) -> tuple[str, ...]:
+        """Return the checks this run failed, one phrase each (empty when it passed).
+
+        Two checks: the sampled observer's error floor against the continuous observer's
+        (at most ALIASING_RATIO x, :func:`~phdesign.numeric.sampled.runs.aliasing_warning`)
+        and the verification plant's own resolution (its outputs move under refinement by
+        at most GAP_RATIO x the continuous floor,
+        :func:`~phdesign.numeric.sampled.plant_resolution.gap_exceeds`).
+        """
+        from phdesign.numeric.sampled.plant_resolution import GAP_RATIO, gap_exceeds
+
+        out = []
+        if aliasing_warning(self.floor, self.continuous_floor, self.peak, self.sampler, self.dt):
+            out.append(
+                f"sampled against continuous observer: error floor {self.floor:.3g} is "
+                f"{self.ratio:.3g}x the continuous observer's {self.continuous_floor:.3g} "
+                f"(at most {ALIASING_RATIO:g}x)"
+            )
+        gap = self.plant_gap
+        if gap is not None and gap_exceeds(gap, self.continuous_floor, self.peak):
+            out.append(
+                f"plant resolution: the verification plant's outputs move by {gap:.3g} when "
+                f"it is refined, {gap / max(self.continuous_floor, 1e-300):.3g}x the "
+                f"continuous floor {self.continuous_floor:.3g} (at most {GAP_RATIO:g}x)"
+            )
+        return tuple(out)
 
     def __repr__(self) -> str:
         return (
@@ -238,3 +274,31 @@ def with_target_check(
     if warning is None:
         return selection
     return dataclasses.replace(selection, warnings=(*selection.warnings, warning))
+
+
+def failed_checks(selection: OrderSelection, verification: Verification | None) -> tuple[str, ...]:
+    """Return every failed check of an export: its targets, then its verification's.
+
+    The targets are the order selection's (rightmost eigenvalues to ``tol``, performance
+    floor to ``output_tol`` of the peak, as its first line reports them); a verification
+    that was not run has no failures of its own.
+    """
+    out = []
+    eig = selection.eigen_error
+    if eig is None or not eig <= selection.tol or not selection.floor <= selection.output_tol:
+        reached = "none converged" if eig is None else f"{eig:.2g}"
+        out.append(
+            f"targets: rightmost eigenvalues to {selection.tol:g} (reached {reached}), "
+            f"performance floor {selection.output_tol:g} of the peak (reached "
+            f"{selection.floor:.3g})"
+        )
+    return tuple(out) + (() if verification is None else verification.failures())
+
+
+def check_strict(selection: OrderSelection, verification: Verification | None) -> None:
+    """Raise :class:`~phdesign.core.errors.VerificationError` naming the failed checks."""
+    failed = failed_checks(selection, verification)
+    if failed:
+        raise VerificationError(
+            "`strict=True`: the export failed its checks: " + "; ".join(failed)
+        )

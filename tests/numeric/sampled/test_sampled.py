@@ -345,3 +345,22 @@ def test_a_sampling_period_is_at_most_the_run_and_the_periods_are_bounded():
         simulate_sampled(nm, *design, options=SimulationOptions(dt=10.0, resolution=6))
     with pytest.raises(NumericError, match=r"^`t_end` / `dt` = 5e\+300 sampling periods"):
         simulate_sampled(nm, *design, options=SimulationOptions(dt=1e-300, resolution=6))
+
+
+def test_strict_export_raises_a_verification_error_naming_each_failed_check():
+    # airy from the default x0 (every x_i = z - 0.9, which violates its boundary
+    # conditions): the plant does not resolve its own outputs, the targets are missed
+    from phdesign.core.errors import NumericError, VerificationError
+    from phdesign.design.observer import Observer
+    from phdesign.models import load_builtin
+
+    observer = Observer(load_builtin("airy"), sensors=[1, 2, 3], gain=1)
+    with pytest.raises(VerificationError, match=r"`strict=True`: the export failed") as info:
+        observer.export(dt=1e-3, strict=True)
+    assert isinstance(info.value, NumericError)
+    assert isinstance(info.value, ValueError)
+    text = str(info.value)
+    assert "targets: rightmost eigenvalues to 1e-06" in text
+    assert "plant resolution: the verification plant's outputs move by" in text
+    with pytest.raises(TypeError, match="strict must be True or False; found 'yes'"):
+        observer.export(dt=1e-3, strict="yes")
