@@ -316,22 +316,27 @@ class Observer(ObserverNoise):
         )
         return self._copy(gain=report.gain, tuning=report)
 
-    def statespace(self, system: str = "error", resolution: int | None = None) -> Any:
+    def statespace(
+        self, system: str = "error", resolution: int | None = None, *, modes: str = "all"
+    ) -> Any:
         """Export ``"plant"``, ``"observer"`` or ``"error"`` as a ``control.StateSpace``.
 
         The discretization is the plant's (:class:`Plant`), at ``resolution`` if given.
-        See :mod:`phdesign.numeric.statespace` for the inputs, outputs and states.
+        ``modes="resolved"`` keeps only the modes resolved under refinement (modal states,
+        the record attached as ``.truncation``); ``"all"`` every discrete mode.  See
+        :mod:`phdesign.numeric.statespace` for the inputs, outputs and states.
         """
         from phdesign.numeric import statespace as export
 
         choice(system, "system", STATESPACE_SYSTEMS, ObserverError)
+        choice(modes, "modes", export.MODES, ObserverError)
         if system == "plant":
-            return export.plant_statespace(self.plant.discrete(resolution))
+            return export.plant_statespace(self.plant.discrete(resolution), modes=modes)
         C, L = self.numeric_gain("statespace")
         d = self.plant.discrete(resolution)
         if system == "observer":
-            return export.observer_statespace(d, C, L)
-        return export.error_statespace(d, C, L)
+            return export.observer_statespace(d, C, L, modes=modes)
+        return export.error_statespace(d, C, L, modes=modes)
 
     # ------------------------------------------------------------------ export
     @reports_progress

@@ -47,6 +47,7 @@ from phdesign.core.errors import NumericError
 from phdesign.numeric.discretization.phs import DiscretePHS, feedback_matrix
 
 __all__ = [
+    "MODES",
     "QUANTITIES",
     "control_signal_name",
     "error_statespace",

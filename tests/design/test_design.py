@@ -245,6 +245,11 @@ def test_public_functions_name_their_arguments(wave, beam):
             ObserverError,
             r"system must be one of 'plant', 'observer', 'error'",
         ),
+        (
+            lambda: phd.Observer(wave, sensors=[2], gain=1).statespace(modes="some"),
+            ObserverError,
+            r"modes must be one of 'all', 'resolved'; found 'some'",
+        ),
         # issue 30: foreign errors (numpy's reshape, os, AttributeError) and a silent
         # reading of bytes as their code points (gain=b"1" was diag(49, 49))
         (

@@ -13,6 +13,7 @@ for the continuous observer the export reports.
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 
@@ -21,8 +22,11 @@ import pytest
 from scipy.linalg import expm
 
 import phdesign as phd
+from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError, ParameterError
 from phdesign.design.loop import Loop
+from phdesign.design.observer import Observer
+from phdesign.models import load_builtin
 from phdesign.numeric.sampled.export import export_observer
 
 K = 0.5
@@ -225,3 +229,24 @@ def test_the_symbolic_commands_never_load_the_numeric_layer():
             [sys.executable, "-c", probe, *argv], capture_output=True, text=True, check=True
         )
         assert out.stdout.strip() == "[]", (argv, out.stdout, out.stderr)
+
+
+def test_observer_statespace_takes_modes_resolved_as_the_lower_level_exports_do():
+    # wave, sensor 2, k = 1/2: the exact error eigenvalues are ½ ln|(1-k)/(1+k)| + i(m+½)π
+    # (DESIGN.md); the resolved modal truncation keeps only poles that agree between p and
+    # 1.5p to the drift rule's relative tolerance, so each lies that close to an exact one
+    pytest.importorskip("control")
+    obs = Observer(load_builtin("wave"), sensors=[2], gain=0.5)
+    alpha = 0.5 * math.log(1 / 3)
+    full, cut = obs.statespace("error", 24), obs.statespace("error", 24, modes="resolved")
+    assert cut.nstates == len(cut.truncation.kept) < full.nstates
+    rtol = current().discretization("galerkin", 1).resolved_rtol
+    for pole in cut.poles():
+        m = round(abs(pole.imag) / math.pi - 0.5)
+        exact = complex(alpha, math.copysign((m + 0.5) * math.pi, pole.imag))
+        assert abs(pole - exact) <= rtol * abs(pole), (pole, exact)
+    assert np.max(full.poles().real) > alpha + 0.1  # the unresolved modes "all" keeps
+    for system in ("plant", "observer"):
+        reduced = obs.statespace(system, 24, modes="resolved")
+        assert reduced.nstates < obs.statespace(system, 24).nstates
+        assert reduced.state_labels[0] == "mode1"
