@@ -138,6 +138,7 @@ def _context(observer: SampledObserver, filename: str = "observer.py") -> dict[s
     inputs = [escaped(name) for name in observer.inputs]  # as comments show them
     outputs = [escaped(name) for name in observer.outputs]
     signals = observer.signal_names()
+    described = [[escaped(text) for text in texts] for texts in observer.descriptions()]
     meaning = {
         "A": "state update, x[k+1] = A x[k] + B v[k]",
         "B": "input map of the state update",
@@ -178,6 +179,9 @@ def _context(observer: SampledObserver, filename: str = "observer.py") -> dict[s
         "timing": timing,
         "inputs": inputs,
         "outputs": outputs,
+        "input_descriptions": described[0],
+        "output_descriptions": described[1],
+        "renumbering": escaped(observer.renumbering or ""),
         "states": states,
         # Python literals (repr writes any text as a valid one) of the python-control names
         "input_list": repr(list(signals[0])),
@@ -219,6 +223,8 @@ def _npz_bytes(observer: SampledObserver) -> bytes:
         D=observer.D,
         inputs=np.array(observer.inputs),
         outputs=np.array(observer.outputs),
+        input_descriptions=np.array(observer.descriptions()[0]),
+        output_descriptions=np.array(observer.descriptions()[1]),
         x0=observer.x0,
         energy_matrix=observer.energy_matrix,
     )

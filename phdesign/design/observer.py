@@ -43,6 +43,7 @@ from phdesign.core.progress import Progress, reports_progress
 from phdesign.core.text import REPR_LIMIT, html_table, matrix_text, sensors_text, shorten
 from phdesign.design.noise import ObserverNoise
 from phdesign.design.plant import Plant, numeric_matrix
+from phdesign.symbolic.feedback import external_numbering
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import gain_matrix, observer_sensors
 
@@ -135,8 +136,10 @@ class Observer(ObserverNoise):
             raise ArgumentError("give parameters, method and resolution to the Plant, not twice")
         else:
             plant = model
-        # the external outputs ([feedback] closes the others)
-        exact, L = observer_sensors(sensors, C_m, gain, plant.model.n_ports)
+        # the external outputs ([feedback] closes the others, and renumbers them)
+        fb = plant.model.feedback
+        note = "" if fb is None else external_numbering(len(plant.model.inputs), fb)
+        exact, L = observer_sensors(sensors, C_m, gain, plant.model.n_ports, note)
         object.__setattr__(self, "plant", plant)
         object.__setattr__(self, "C_m", exact)
         object.__setattr__(self, "L", L)

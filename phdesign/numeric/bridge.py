@@ -30,6 +30,7 @@ import numpy as np
 from phdesign.core.checks import found_text
 from phdesign.core.errors import ArgumentError, ModelError, ParameterError, check_shape
 from phdesign.symbolic.ports import trace_index
+from phdesign.symbolic.printing import format_expression
 
 __all__ = [
     "DisplacementSpec",
@@ -104,6 +105,9 @@ class NumericModel:
         Input and output maps over the trace vector.
     input_labels, output_labels, state_names : tuple of str
         Names used in exports and CSV headers.
+    input_traces, output_traces : tuple of str
+        The external ports as trace expressions at the endpoints (``e1'(1)``), how the
+        exports describe their signals (:mod:`phdesign.numeric.signals`); default the labels.
     displacement : DisplacementSpec or None
         How to reconstruct a physical displacement, if the model has one.
     fields : tuple of (str, DisplacementSpec)
@@ -135,6 +139,8 @@ class NumericModel:
     state_names: tuple[str, ...] = ()
     displacement: DisplacementSpec | None = None
     H_constant: bool = False
+    input_traces: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    output_traces: tuple[str, ...] = field(default=(), compare=False, repr=False)
     extra: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
     feedback: PortFeedback | None = None
     P0: Callable[[np.ndarray], np.ndarray] | None = field(default=None, compare=False)
@@ -180,6 +186,12 @@ class NumericModel:
             object.__setattr__(self, "output_labels", tuple(f"y{i + 1}" for i in range(m)))
         if not self.state_names:
             object.__setattr__(self, "state_names", tuple(f"x{i + 1}" for i in range(n)))
+        for traces, labels in (
+            ("input_traces", "input_labels"),
+            ("output_traces", "output_labels"),
+        ):
+            if not getattr(self, traces):
+                object.__setattr__(self, traces, getattr(self, labels))
 
     def _check_dissipative(self) -> None:
         r"""Refuse a model that is not dissipative.
@@ -337,6 +349,8 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         Y=sub.array(sub.matrix("Y", ports.Y)),
         input_labels=tuple(str(e) for e in inputs),
         output_labels=tuple(str(e) for e in outputs),
+        input_traces=tuple(format_expression(e, model.interval) for e in inputs),
+        output_traces=tuple(format_expression(e, model.interval) for e in outputs),
         state_names=tuple(model.state_names),
         displacement=None if d is None else _numeric_field(sub, d),
         fields=tuple((name, _numeric_field(sub, f)) for name, f in getattr(model, "fields", ())),

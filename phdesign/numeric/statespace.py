@@ -7,9 +7,11 @@ All three are written in standard form with the discrete efforts ê as states
 
 * plant: :math:`A = E^{-1}(J - R)`, :math:`B_s = E^{-1} B`, :math:`C = B^\top`, :math:`D`;
   inputs ``u1..``, outputs ``y1..`` (the model's outputs, in its order).
-* observer: inputs (u, y_m), since :math:`\hat u = M(u + C_m^\top L y_m - K B^\top \hat e)`:
+* observer: inputs (u, y_m), named as the export names them (``u1..``, then ``y3`` for
+  a sensor that picks y3, ``y_m<j>`` for a combination), since
+  :math:`\hat u = M(u + C_m^\top L y_m - K B^\top \hat e)`:
   :math:`A_o = E^{-1}(J - R - B G B^\top)`, :math:`B_o = E^{-1} B M [I, C_m^\top L]`;
-  outputs the estimated model outputs ``y_hat1..`` (:math:`(I - D G)B^\top \hat e + D M
+  outputs the estimated model outputs ``yhat1..`` (:math:`(I - D G)B^\top \hat e + D M
   [I, C_m^\top L]`) and physical estimates at named points (below).
 * error system: :math:`A_e = A_o`, no input, outputs ỹ (``y_err1..``) and optionally the
   estimation error of a physical quantity at named points.
@@ -32,6 +34,9 @@ every discrete mode, including the unresolved high frequencies whose real parts 
 artefacts (error system of a graded string at degree 30: max Re -0.012 against the
 resolved abscissa -0.36).
 
+Every system carries ``signal_descriptions`` (``{"inputs": ..., "outputs": ...}``): what
+each signal is as a trace of the model, ``y3 = e1'(1)`` (:mod:`phdesign.numeric.signals`).
+
 ``control`` is imported lazily, inside the functions, so importing phdesign never pays
 for it.
 """
@@ -45,6 +50,8 @@ import numpy as np
 
 from phdesign.core.errors import NumericError
 from phdesign.numeric.discretization.phs import DiscretePHS, feedback_matrix
+from phdesign.numeric.sampled.samplers import sensor_names
+from phdesign.numeric.signals import estimate_descriptions, input_descriptions, port_description
 
 __all__ = [
     "MODES",
@@ -167,6 +174,12 @@ def _build(
     return sys
 
 
+def _described(inputs: Sequence[str], outputs: Sequence[str], system: Any) -> Any:
+    """Attach what each signal is (``y3 = e1'(1)``) as ``system.signal_descriptions``."""
+    system.signal_descriptions = {"inputs": tuple(inputs), "outputs": tuple(outputs)}
+    return system
+
+
 def _extra_outputs(
     d: DiscretePHS, quantity: str | None, z: Any, suffix: str
 ) -> tuple[np.ndarray, list[str]]:
@@ -190,17 +203,23 @@ def plant_statespace(
     """
     m = d.n_ports
     rows, labels = _extra_outputs(d, quantity, z, "")
-    return _build(
-        d,
-        None,
-        d.B,
-        np.vstack([d.B.T, rows]),
-        np.vstack([d.D, np.zeros((rows.shape[0], m))]),
-        modes,
-        state_labels(d),
-        inputs=[f"u{i + 1}" for i in range(m)],
-        outputs=[f"y{i + 1}" for i in range(m)] + labels,
-        name=name,
+    ports = [port_description(d.model, "u", i) for i in range(m)]
+    outputs = [port_description(d.model, "y", i) for i in range(m)] + labels
+    return _described(
+        ports,
+        outputs,
+        _build(
+            d,
+            None,
+            d.B,
+            np.vstack([d.B.T, rows]),
+            np.vstack([d.D, np.zeros((rows.shape[0], m))]),
+            modes,
+            state_labels(d),
+            inputs=[f"u{i + 1}" for i in range(m)],
+            outputs=[f"y{i + 1}" for i in range(m)] + labels,
+            name=name,
+        ),
     )
 
 
@@ -216,7 +235,7 @@ def observer_statespace(
 ) -> Any:
     """Return the observer as ``control.StateSpace``: inputs (u, y_m), outputs (ŷ, estimates).
 
-    The outputs are the estimated model outputs ``y_hat1..`` followed by the estimate of
+    The outputs are the estimated model outputs ``yhat1..`` followed by the estimate of
     ``quantity`` at the points ``z`` (default: the state x at both ends and the
     midpoint; ``quantity="coefficients"`` gives the discrete states ê_obs).
     """
@@ -227,17 +246,22 @@ def observer_statespace(
     m, q = d.n_ports, C.shape[0]
     In = np.hstack([np.eye(m), C.T @ Lm])  # v = u + C_m^T L y_m = In [u; y_m]
     rows, labels = point_outputs(d, quantity, z, "_hat")
-    return _build(
-        d,
-        K,
-        loop.B @ In,
-        np.vstack([loop.C, rows]),
-        np.vstack([loop.D @ In, np.zeros((rows.shape[0], m + q))]),
-        modes,
-        state_labels(d, "hat_"),
-        inputs=[f"u{i + 1}" for i in range(m)] + [f"y_m{i + 1}" for i in range(q)],
-        outputs=[f"y_hat{i + 1}" for i in range(m)] + labels,
-        name=name,
+    outputs = [*estimate_descriptions(d.model), *labels]
+    return _described(
+        input_descriptions(d.model, C),
+        outputs,
+        _build(
+            d,
+            K,
+            loop.B @ In,
+            np.vstack([loop.C, rows]),
+            np.vstack([loop.D @ In, np.zeros((rows.shape[0], m + q))]),
+            modes,
+            state_labels(d, "hat_"),
+            inputs=[f"u{i + 1}" for i in range(m)] + list(sensor_names(C)),
+            outputs=[f"yhat{i + 1}" for i in range(m)] + labels,
+            name=name,
+        ),
     )
 
 
@@ -259,15 +283,20 @@ def error_statespace(
     loop = d.close(K)
     m, n = d.n_ports, d.dim
     rows, labels = _extra_outputs(d, quantity, z, "_err")
-    return _build(
-        d,
-        K,
-        np.zeros((n, 0)),
-        np.vstack([loop.C, rows]),
-        np.zeros((m + rows.shape[0], 0)),
-        modes,
-        state_labels(d, "err_"),
-        inputs=[],
-        outputs=[f"y_err{i + 1}" for i in range(m)] + labels,
-        name=name,
+    errors = [f"y_err{i + 1} = error of {port_description(d.model, 'y', i)}" for i in range(m)]
+    return _described(
+        [],
+        errors + labels,
+        _build(
+            d,
+            K,
+            np.zeros((n, 0)),
+            np.vstack([loop.C, rows]),
+            np.zeros((m + rows.shape[0], 0)),
+            modes,
+            state_labels(d, "err_"),
+            inputs=[],
+            outputs=[f"y_err{i + 1}" for i in range(m)] + labels,
+            name=name,
+        ),
     )

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 import sympy
 
 from phdesign.core.text import REPR_LIMIT, html_table, number_text, shorten
+from phdesign.symbolic.feedback import external_numbering
 from phdesign.symbolic.printing import format_expression
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
@@ -97,6 +98,8 @@ def model_text(model: BCPHS) -> str:
     lines.append(f"H = {_rows(model.H)}")
     lines.append(f"inputs:  {_port_text(model, model.inputs, 'u')}")
     lines.append(f"outputs: {_port_text(model, model.outputs, 'y')}")
+    if model.feedback is not None:  # what --sensors, --u and the exports index
+        lines.append(external_numbering(len(model.inputs), model.feedback))
     lines += [f"check: {c}" for c in model.checks]
     return "\n".join(lines)
 

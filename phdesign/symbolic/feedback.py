@@ -31,7 +31,13 @@ import sympy
 from phdesign.core.errors import ModelError
 from phdesign.symbolic.definition import parse_matrix
 
-__all__ = ["Feedback", "check_feedback_indices", "external_indices", "feedback_from_mapping"]
+__all__ = [
+    "Feedback",
+    "check_feedback_indices",
+    "external_indices",
+    "external_numbering",
+    "feedback_from_mapping",
+]
 
 
 @dataclass(frozen=True)
@@ -61,6 +67,32 @@ def external_indices(n_ports: int, feedback: Feedback | None) -> tuple[int, ...]
     """0-based indices of the open ports that stay external inputs, in order."""
     closed = set(feedback.closed) if feedback is not None else set()
     return tuple(j for j in range(n_ports) if j not in closed)
+
+
+def external_numbering(n_ports: int, feedback: Feedback) -> str:
+    """Say which of the model's ports each external index is after ``feedback``.
+
+    Examples
+    --------
+    >>> import sympy
+    >>> torque = Feedback((3,), sympy.ImmutableMatrix([[1]]))
+    >>> closed, kept = external_numbering(4, torque).split(": ")
+    >>> closed
+    '[feedback] closes u3'
+    >>> kept
+    "the external u1, u2, u3 (and y1, y2, y3) are the model's u1, u2, u4 (y1, y2, y4)"
+    """
+    kept = external_indices(n_ports, feedback)
+    closed = ", ".join(f"u{i}" for i in feedback.inputs)
+
+    def names(letter: str, indices: Sequence[int]) -> str:
+        return ", ".join(f"{letter}{j + 1}" for j in indices)
+
+    external = range(len(kept))
+    return (
+        f"[feedback] closes {closed}: the external {names('u', external)} (and "
+        f"{names('y', external)}) are the model's {names('u', kept)} ({names('y', kept)})"
+    )
 
 
 def check_feedback_indices(feedback: Feedback, n_inputs: int) -> None:

@@ -51,7 +51,9 @@ __all__ = [
 
 
 # --------------------------------------------------------------------------- sensors
-def sensor_matrix(sensors: Iterable[int] | int, n_outputs: int) -> sympy.ImmutableMatrix:
+def sensor_matrix(
+    sensors: Iterable[int] | int, n_outputs: int, note: str = ""
+) -> sympy.ImmutableMatrix:
     """Return :math:`C_m` whose rows are the unit rows picking outputs ``sensors`` (1-based).
 
     Parameters
@@ -60,6 +62,8 @@ def sensor_matrix(sensors: Iterable[int] | int, n_outputs: int) -> sympy.Immutab
         The measured outputs, 1-based (``[3, 4]`` measures :math:`y_3` and :math:`y_4`).
     n_outputs : int
         The number :math:`Nn` of outputs of the model.
+    note : str
+        Added to an out-of-range message (how a ``[feedback]`` renumbered the outputs).
 
     Raises
     ------
@@ -92,6 +96,7 @@ def sensor_matrix(sensors: Iterable[int] | int, n_outputs: int) -> sympy.Immutab
         if not 1 <= value <= n_outputs:
             raise ObserverError(
                 f"sensors: output index {value} is out of range; expected 1..{n_outputs}"
+                + (f" ({note})" if note else "")
             )
         if value in picked:
             raise ObserverError(
@@ -437,11 +442,11 @@ def sensors_and_gain(
 
 
 def observer_sensors(
-    sensors: Any, C_m: Any, gain: Any, n_outputs: int
+    sensors: Any, C_m: Any, gain: Any, n_outputs: int, note: str = ""
 ) -> tuple[sympy.ImmutableMatrix, sympy.ImmutableMatrix | None]:
     """Read an observer's ``sensors`` or ``C_m``, and its ``gain`` (``None``: no gain yet).
 
-    Exactly one of ``sensors`` (:func:`sensor_matrix`) and ``C_m``
+    Exactly one of ``sensors`` (:func:`sensor_matrix`, with ``note``) and ``C_m``
     (:func:`measurement_matrix`, or *no sensors*: :func:`sensors_and_gain`) is given.
 
     Raises
@@ -457,7 +462,7 @@ def observer_sensors(
     if sensors is None and no_sensors(C_m, n_outputs):  # classified by its own dampers
         return sensors_and_gain(C_m, gain, n_outputs)
     exact = (
-        sensor_matrix(sensors, n_outputs)
+        sensor_matrix(sensors, n_outputs, note)
         if sensors is not None
         else measurement_matrix(C_m, n_outputs)
     )

@@ -63,6 +63,7 @@ from phdesign.numeric.sampled.verification import (
     with_plant_gap,
     with_target_check,
 )
+from phdesign.numeric.signals import signal_lines
 from phdesign.numeric.threads import limited_threads
 
 __all__ = [
@@ -130,6 +131,20 @@ class SampledObserver:
         """The initial state: zeros."""
         return np.zeros(self.order)
 
+    def descriptions(self) -> tuple[tuple[str, ...], tuple[str, ...]]:
+        """Return what each input and output is (``y3 = e1'(1)``), else their names."""
+        c = self.continuous
+        if c is None or not c.input_descriptions:
+            return self.inputs, self.outputs
+        return c.input_descriptions, c.output_descriptions
+
+    @property
+    def renumbering(self) -> str | None:
+        """How a ``[feedback]`` closure renumbered the ports (:mod:`phdesign.numeric.signals`)."""
+        from phdesign.numeric.signals import renumbering
+
+        return None if self.continuous is None else renumbering(self.continuous.discrete.model)
+
     @property
     def warnings(self) -> tuple[str, ...]:
         """Warnings of the order selection and of the verification."""
@@ -183,8 +198,11 @@ class SampledObserver:
         """Return the JSON export (strict JSON).
 
         Keys: model, dt, sampler, order, A, B, C, D, inputs, outputs, x0, energy_matrix,
-        verification (null when not run) and order_selection.
+        verification (null when not run) and order_selection; input_descriptions and
+        output_descriptions say what each signal is (:meth:`descriptions`), renumbering
+        how a ``[feedback]`` closure renumbered the ports (null without one).
         """
+        inputs, outputs = self.descriptions()
         return {
             "model": self.model,
             "dt": self.dt,
@@ -200,6 +218,9 @@ class SampledObserver:
             "energy_matrix": _matrix(self.energy_matrix),
             "verification": None if self.verification is None else self.verification.to_dict(),
             "order_selection": self.selection.to_dict(),
+            "input_descriptions": list(inputs),
+            "output_descriptions": list(outputs),
+            "renumbering": self.renumbering,
         }
 
     def write(self, path: str, format: str = "json", force: bool = False) -> list[str]:
@@ -226,8 +247,7 @@ class SampledObserver:
         lines = [
             f"observer for {self.model}: {self.order} states, dt = {self.dt:g} s, sampler "
             f"{self.sampler} ({how})",
-            f"inputs v: {' '.join(self.inputs)}",
-            f"outputs: {' '.join(self.outputs)}",
+            *signal_lines(*self.descriptions(), self.renumbering),
             str(self.selection),
         ]
         if self.verification is not None:

@@ -46,6 +46,7 @@ from phdesign.numeric.sampled.period_maps import (
     hold_discretization,
     sample_plant,
 )
+from phdesign.numeric.signals import estimate_descriptions, input_descriptions
 
 __all__ = [
     "ContinuousObserver",
@@ -109,6 +110,9 @@ class ContinuousObserver:
         The points z of the displacement outputs ``w(z)`` (empty without displacement).
     reduction : str
         ``"none"``, ``"modal"`` or ``"balanced"``.
+    input_descriptions, output_descriptions : tuple of str
+        What each signal is, as a trace of the model (``y3 = e1'(1)``,
+        :mod:`phdesign.numeric.signals`); empty when unknown.
     """
 
     A: np.ndarray
@@ -124,6 +128,8 @@ class ContinuousObserver:
     performance: tuple[int, ...]
     points: tuple[float, ...] = ()
     reduction: str = "none"
+    input_descriptions: tuple[str, ...] = ()
+    output_descriptions: tuple[str, ...] = ()
 
     @property
     def order(self) -> int:
@@ -183,6 +189,8 @@ class ContinuousObserver:
             outputs=tuple(outputs),
             performance=performance,
             points=tuple(float(z) for z in pts),
+            input_descriptions=input_descriptions(d.model, C),
+            output_descriptions=estimate_descriptions(d.model, tuple(float(z) for z in pts)),
         )
 
     def project(self, V: np.ndarray, W: np.ndarray, reduction: str) -> ContinuousObserver:
@@ -207,6 +215,8 @@ class ContinuousObserver:
             performance=self.performance,
             points=self.points,
             reduction=reduction,
+            input_descriptions=self.input_descriptions,
+            output_descriptions=self.output_descriptions,
         )
 
     def sampled(self, dt: float, sampler: str) -> Realization:

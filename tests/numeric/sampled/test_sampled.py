@@ -183,6 +183,8 @@ def test_json_export_has_the_contract_keys(beam_observer, tmp_path):
     assert set(data) == {
         "model", "dt", "sampler", "order", "A", "B", "C", "D", "inputs", "outputs", "x0",
         "energy_matrix", "verification", "order_selection",
+        # issue 28: what each slot is, and the [feedback] renumbering (keys added)
+        "input_descriptions", "output_descriptions", "renumbering",
     }  # fmt: skip
     assert data["model"] == "euler-bernoulli"
     assert data["sampler"] == "average"
@@ -191,6 +193,16 @@ def test_json_export_has_the_contract_keys(beam_observer, tmp_path):
     assert data["verification"] is None
     assert data["inputs"] == ["u1", "u2", "u3", "u4", "y3", "y4"]
     assert data["outputs"] == ["yhat1", "yhat2", "yhat3", "yhat4", "w(1)"]
+    # the beam's ports (DESIGN.md): u3 = e2(1), y3 = e1'(1), y4 = -e1(1); no [feedback]
+    assert data["input_descriptions"][2:] == [
+        "u3 = e2(1)",
+        "u4 = e2'(1)",
+        "y3 = e1'(1)",
+        "y4 = -e1(1)",
+    ]
+    assert data["output_descriptions"][2] == "yhat3 = estimate of y3 = e1'(1)"
+    assert data["output_descriptions"][4] == "w(1) = estimated displacement at z = 1"
+    assert data["renumbering"] is None
     assert data["x0"] == [0.0] * 34
     Q = np.array(data["energy_matrix"])
     assert np.allclose(Q, Q.T)

@@ -142,15 +142,15 @@ def test_exported_statespace_reproduces_the_simulation(method, res):
     obs = observer_statespace(d, PAPER_SENSORS, L)
     E = error_statespace(d, PAPER_SENSORS, L)
     assert P.input_labels == ["u1", "u2", "u3", "u4"]
-    assert obs.input_labels == ["u1", "u2", "u3", "u4", "y_m1", "y_m2"]
-    assert obs.output_labels[:4] == ["y_hat1", "y_hat2", "y_hat3", "y_hat4"]
-    S = control.ss(
-        [], [], [], PAPER_SENSORS, inputs=P.output_labels, outputs=["y_m1", "y_m2"], name="sensors"
-    )
+    # the export's names (issue 28): a sensor input is the plant output it measures, so
+    # interconnect joins the observer's y3, y4 to the plant's by name
+    assert obs.input_labels == ["u1", "u2", "u3", "u4", "y3", "y4"]
+    assert obs.output_labels[:4] == ["yhat1", "yhat2", "yhat3", "yhat4"]
+    assert obs.signal_descriptions["inputs"][4:] == ("y3 = e1'(1)", "y4 = -e1(1)")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # unused observer state outputs
         loop = control.interconnect(
-            [P, S, obs], inplist=P.input_labels, outlist=obs.output_labels[:4] + P.output_labels
+            [P, obs], inplist=P.input_labels, outlist=obs.output_labels[:4] + P.output_labels
         )
     X0 = np.concatenate([d.project(x0), np.zeros(d.dim)])
     fr = control.forced_response(loop, T=r.t, U=np.zeros((4, r.t.size)), X0=X0)
