@@ -72,7 +72,8 @@ def _add_design_arguments(ex: argparse.ArgumentParser) -> None:
         choices=REDUCTIONS,
         default="none",
         help="drop the unresolved modes (modal) or balance and truncate (balanced, needs "
-        "slycot); default none",
+        "slycot); default none, whose first line says how many unresolved poles it keeps "
+        "that are slower than the abscissa",
     )
     ex.add_argument(
         "--tol",

@@ -244,9 +244,15 @@ class SampledObserver:
 
     def __str__(self) -> str:
         how = "mean over each period" if self.sampler == "average" else "point samples"
+        sel, slow = self.selection, ""
+        if sel.spurious and sel.abscissa is not None and sel.spurious_max_real is not None:
+            slow = (
+                f" ({sel.spurious} unresolved poles slower than the abscissa {sel.abscissa:.3g}: "
+                f"max Re {sel.spurious_max_real:.3g}; `reduction='modal'` drops them)"
+            )
         lines = [
-            f"observer for {self.model}: {self.order} states, dt = {self.dt:g} s, sampler "
-            f"{self.sampler} ({how})",
+            f"observer for {self.model}: {self.order} states{slow}, dt = {self.dt:g} s, "
+            f"sampler {self.sampler} ({how})",
             *signal_lines(*self.descriptions(), self.renumbering),
             str(self.selection),
         ]
