@@ -300,9 +300,7 @@ class _SyncCancelRace:
     def filter(self, record: Any) -> bool:
         """Return False for exactly that record."""
         error = record.exc_info[1] if record.exc_info else None
-        return not (
-            isinstance(error, NameError) and "sync.<locals>.cancel" in record.getMessage()
-        )
+        return not (isinstance(error, NameError) and "sync.<locals>.cancel" in record.getMessage())
 
 
 _RACE_FILTER = _SyncCancelRace()
