@@ -163,6 +163,29 @@ def save_figure(fig: Figure, path: str | os.PathLike[str], force: bool = False) 
     atomic_write(path, figure_bytes(fig, check_plot_path(path, force=force)), force=force)
 
 
+#: Font size of a figure's title (matplotlib's ``large``, at its default 10 pt).
+_SUPTITLE_POINTS = 12.0
+#: Average advance of a character, in units of the font size (DejaVu Sans, mixed text).
+_CHAR_WIDTH = 0.62
+
+
+def wrapped(title: str, width_inches: float, points: float) -> str:
+    """Break ``title`` into lines that fit a figure ``width_inches`` wide (no line cut off).
+
+    Examples
+    --------
+    >>> print(wrapped("spectral abscissa α: spectrum on wave, sensors 1,2", 2.5, 12))
+    spectral abscissa α:
+    spectrum on wave,
+    sensors 1,2
+    """
+    import textwrap
+
+    columns = max(int(0.94 * width_inches * 72 / (_CHAR_WIDTH * points)), 12)
+    lines = (textwrap.fill(line, columns, break_on_hyphens=False) for line in title.split("\n"))
+    return "\n".join(lines)
+
+
 @contextmanager
 def drawing(
     path: str | os.PathLike[str] | None = None,
@@ -194,7 +217,8 @@ def drawing(
     fig, axes = (figure_of(ax), ax) if ax is not None else new_figure(nrows, ncols, **figure)
     yield fig, axes
     if title:
-        fig.suptitle(literal(title), **({} if title_size is None else {"fontsize": title_size}))
+        size = title_size if title_size is not None else _SUPTITLE_POINTS
+        fig.suptitle(literal(wrapped(title, fig.get_figwidth(), size)), fontsize=size)
     if path is not None:
         save_figure(fig, path, force=force)
 

@@ -94,6 +94,17 @@ def _label(dataset: Any, name: str) -> str:
     return f"{name} [{units}]" if units else name
 
 
+def _figure_label(dataset: Any, name: str) -> str:
+    """Return what a figure is, in words, with its unit: ``spectral abscissa α [1/s]``.
+
+    The words are the variable's ``long_name`` up to its first parenthesis (the figure's
+    name when it has none).
+    """
+    words = str(dataset[name].attrs.get("long_name") or name).split(" (")[0].strip() or name
+    units = dataset[name].attrs.get("units")
+    return f"{words} [{units}]" if units else words
+
+
 def _unconverged(dataset: Any, figure: str) -> Any:
     """Return the ``converged`` flags when the figure depends on them, else ``None``."""
     if "converged" not in dataset.data_vars or figure == "converged":
@@ -145,7 +156,7 @@ def _draw_map(fig: Figure, ax: Axes, data: Any, flags: Any, dims: list[str], dat
         mesh = ax.pcolormesh(
             xs, ys, np.ma.masked_invalid(values.astype(float)), shading="nearest", cmap=cmap
         )
-        fig.colorbar(mesh, ax=ax, label=_label(dataset, data.name))
+        fig.colorbar(mesh, ax=ax, label=_figure_label(dataset, data.name))
     if flags is not None:
         bad = ~flags.transpose(y, x).values.astype(bool)
         if bad.any():
@@ -183,7 +194,7 @@ def _draw_curves(ax: Axes, data: Any, flags: Any, dims: list[str], dataset: Any)
                 _mark_unconverged(ax, xs[bad], values[bad])
     if _is_log(dataset, x):
         ax.set_xscale("log")
-    ax.set(xlabel=_label(dataset, x), ylabel=_label(dataset, data.name))
+    ax.set(xlabel=_label(dataset, x), ylabel=_figure_label(dataset, data.name))
     ax.grid(True, alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize="small")
@@ -274,7 +285,8 @@ def _panels(data: Any, dims: list[str]) -> list[Any]:
 
 def _title(dataset: Any, name: str) -> str:
     """Return the default title: the figure, the job, the model, the sensors and gain."""
-    title = f"{name}: {dataset.attrs.get('job', 'sweep')} on {dataset.attrs.get('model', '?')}"
+    figure = _figure_label(dataset, name).split(" [")[0]
+    title = f"{figure}: {dataset.attrs.get('job', 'sweep')} on {dataset.attrs.get('model', '?')}"
     if dataset.attrs.get("sensors"):
         title += f", sensors {dataset.attrs['sensors']}, gain {dataset.attrs.get('gain')}"
     return title

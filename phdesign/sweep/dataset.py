@@ -34,9 +34,7 @@ _LONG_NAMES = {"gain": "gain {}", "parameter": "parameter {}", "sensors": "senso
 
 def attributes(description: SweepDescription) -> dict[str, Any]:
     """Return the Dataset attributes of a sweep (strings and numbers, for Zarr and NetCDF)."""
-    gain = (
-        "1 on every sensor" if description.gain is None else ",".join(map(repr, description.gain))
-    )
+    gain = gain_text(description)
     return {
         "title": f"phdesign sweep: {description.job} on {description.model_name}",
         "model": description.model_name,
@@ -50,6 +48,46 @@ def attributes(description: SweepDescription) -> dict[str, Any]:
         "fingerprint": description.fingerprint,
         SWEEP_ATTRIBUTE: description.to_json(),
     }
+
+
+def gain_text(description: SweepDescription) -> str:
+    """Return the gain as the summary and the plot titles say it, grid axes named.
+
+    A diagonal entry of L that a gain axis sets is named by the axis (``l1``); the other
+    entries are the fixed values (``1`` by default).  Examples: ``"1 on every sensor"``,
+    ``"l1, l2 (the grid's axes)"``, ``"l1, 0.5 (l1: the grid's axis)"``, ``"l (the grid's
+    axis) on every sensor"``.
+    """
+    names = [a.name for a in description.axes if a.kind == "gain"]
+    fixed = ["1"] if description.gain is None else [repr(g) for g in description.gain]
+    if "l" in names:
+        return "l (the grid's axis) on every sensor"
+    if description.sensors is None:  # sensor sets: one fixed value for every sensor
+        if not names:
+            return f"{fixed[0]} on every sensor"
+        return f"{', '.join(names)} (the grid's axes), {fixed[0]} on the other sensors"
+    size = len(description.sensors)
+    entries = fixed * size if len(fixed) == 1 else fixed
+    if not names:
+        return f"{entries[0]} on every sensor" if len(fixed) == 1 else ",".join(entries)
+    for name in names:
+        entries[int(name[1:]) - 1] = name
+    axes = "the grid's axes" if len(names) > 1 else "the grid's axis"
+    if len(names) == size:
+        return f"{', '.join(entries)} ({axes})"
+    return f"{', '.join(entries)} ({', '.join(names)}: {axes})"
+
+
+def time_unit(description: SweepDescription) -> str:
+    """Return the time unit the sweep's model states (``[units] t``), else ``"s"`` (SI)."""
+    import tomllib
+
+    try:
+        units = tomllib.loads(description.model_toml).get("units", {})
+    except tomllib.TOMLDecodeError:  # pragma: no cover - the TOML was written by phdesign
+        units = {}
+    unit = units.get("t") if isinstance(units, dict) else None
+    return unit if isinstance(unit, str) and unit else "s"
 
 
 def description_of(dataset: Any) -> SweepDescription:
@@ -113,7 +151,7 @@ def template(
             values = np.full(description.shape, figure.fill, dtype=figure.dtype)
         attrs = {"long_name": figure.description}
         if figure.units:
-            attrs["units"] = figure.units
+            attrs["units"] = figure.units.replace("1/s", f"1/{time_unit(description)}")
         data_vars[figure.name] = xr.Variable(description.dims, values, attrs)
     return xr.Dataset(data_vars, coords=coords, attrs=attributes(description))
 

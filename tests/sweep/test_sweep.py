@@ -376,7 +376,7 @@ def test_cli_sweep_json_summary_and_plot(tmp_path, capsys):
     assert "wrote" in capsys.readouterr().out
     assert (tmp_path / "k.png").read_bytes()[:4] == b"\x89PNG"
     text = str(summarize(phdesign.sweep.open_sweep(out)))
-    assert text.splitlines()[0] == "sweep: spectrum on wave (sensors 2; gain 1 on every sensor)"
+    assert text.splitlines()[0] == "sweep: spectrum on wave (sensors 2; gain l1 (the grid's axis))"
 
 
 def test_classify_and_the_sweep_package_import_no_dask():
