@@ -200,11 +200,66 @@ def _draw_curves(ax: Axes, data: Any, flags: Any, dims: list[str], dataset: Any)
         ax.legend(fontsize="small")
 
 
+def _draw_bars(ax: Axes, data: Any, dim: str, dataset: Any) -> None:
+    """One bar per category (a sensor-set study): its height κ* (or the figure), its verdict.
+
+    Categories have no order between them, so no line joins them.  A bar is coloured by
+    the verdict when the sweep has one and labelled with the verdict and the value; a text
+    figure (the verdict itself) is drawn as κ* when the sweep has it.
+    """
+    from matplotlib.patches import Patch
+
+    names = [str(v) for v in dataset[dim].values]
+    height_name = data.name if data.dtype.kind not in "US" else "kappa"
+    heights = (
+        np.asarray(dataset[height_name].values, dtype=float)
+        if height_name in dataset.data_vars
+        else np.ones(len(names))
+    )
+    verdicts = (
+        [str(v) for v in dataset["verdict"].values]
+        if "verdict" in dataset.data_vars
+        else [""] * len(names)
+    )
+    colors = [_VERDICT_COLORS.get(v, "tab:blue") for v in verdicts]
+    shown = np.where(np.isfinite(heights), heights, 0.0)
+    bars = ax.bar(range(len(names)), shown, color=colors, edgecolor="black", lw=0.6)
+    for bar, value, verdict in zip(bars, heights, verdicts, strict=True):
+        number = "κ* = none" if height_name == "kappa" else "none"
+        if np.isfinite(value):
+            number = f"κ* = {value:.3g}" if height_name == "kappa" else f"{value:.4g}"
+        text = "\n".join(t for t in (verdict, number) if t)
+        ax.annotate(
+            text,
+            (bar.get_x() + bar.get_width() / 2, bar.get_height()),
+            xytext=(0, 3),
+            textcoords="offset points",
+            ha="center",
+            va="bottom",
+            fontsize="small",
+        )
+    ax.set_xticks(range(len(names)), [f"{dim} {n}" for n in names])
+    ylabel = _figure_label(dataset, height_name) if height_name in dataset.data_vars else ""
+    ax.set(xlabel=_label(dataset, dim), ylabel=ylabel)
+    top = float(np.max(shown, initial=0.0))
+    ax.set_ylim(0, 1.3 * top if top > 0 else 1.0)
+    ax.grid(True, axis="y", alpha=0.3)
+    present = [v for v in _VERDICT_COLORS if v in verdicts]
+    if present:
+        ax.legend(
+            handles=[Patch(color=_VERDICT_COLORS[v], label=v) for v in present],
+            loc="upper left",
+            fontsize="small",
+        )
+
+
 def _draw(fig: Figure, ax: Axes, data: Any, flags: Any, dataset: Any) -> None:
     dims = _varying(data)
     numeric = [d for d in dims if dataset[d].dtype.kind not in "US"]
     if len(dims) == 2 and len(numeric) == 2:
         _draw_map(fig, ax, data, flags, dims, dataset)
+    elif len(dims) == 1 and not numeric:
+        _draw_bars(ax, data, dims[0], dataset)
     else:
         _draw_curves(ax, data, flags, dims, dataset)
 
@@ -285,8 +340,8 @@ def _panels(data: Any, dims: list[str]) -> list[Any]:
 
 def _title(dataset: Any, name: str) -> str:
     """Return the default title: the figure, the job, the model, the sensors and gain."""
-    figure = _figure_label(dataset, name).split(" [")[0]
-    title = f"{figure}: {dataset.attrs.get('job', 'sweep')} on {dataset.attrs.get('model', '?')}"
+    job, model = dataset.attrs.get("job", "sweep"), dataset.attrs.get("model", "?")
+    title = f"{name.replace('_', ' ')}: {job} on {model}"
     if dataset.attrs.get("sensors"):
         title += f", sensors {dataset.attrs['sensors']}, gain {dataset.attrs.get('gain')}"
     return title

@@ -35,6 +35,7 @@ def test_gain_map_title_fits_and_names_the_grid_axes(gain_map):
     fig = plot_sweep(gain_map)
     title = fig.get_suptitle()
     assert "gain 1 on every sensor" not in title
+    assert title.startswith("spectral abscissa: spectrum on wave")
     assert "l1, l2 (the grid's axes)" in " ".join(title.split())
     assert _title_inside(fig), title
     colorbar = fig.axes[1]
@@ -61,3 +62,24 @@ def test_the_model_time_unit_is_the_abscissa_unit(tmp_path):
     assert ds["spectral_abscissa"].attrs["units"] == "1/ms"
     fig = plot_sweep(ds)
     assert fig.axes[0].get_ylabel() == "spectral abscissa α [1/ms]"
+
+
+def test_a_sensor_set_study_is_bars_with_verdict_and_kappa():
+    ds = phdesign.sweep("euler-bernoulli", job="classify", sensor_sets="3;4;3,4", **SYNC)
+    for figure in ("verdict", "kappa"):
+        ax = plot_sweep(ds, figure).axes[0]
+        assert not ax.get_lines()  # no line joins categories
+        assert len(ax.patches) == 3
+        assert [t.get_text() for t in ax.get_xticklabels()] == [
+            "sensors 3",
+            "sensors 4",
+            "sensors 3,4",
+        ]
+        labels = [t.get_text() for t in ax.texts]
+        for k, verdict in enumerate(ds.verdict.values):
+            assert labels[k].splitlines()[0] == verdict
+            kappa = float(ds.kappa.values[k])
+            assert labels[k].splitlines()[1] == (
+                "κ* = none" if kappa != kappa else f"κ* = {kappa:.3g}"
+            )
+            assert ax.patches[k].get_height() == pytest.approx(0.0 if kappa != kappa else kappa)
