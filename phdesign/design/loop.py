@@ -34,7 +34,7 @@ Examples
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
@@ -283,7 +283,7 @@ class Loop:
         )
 
     def design_label(self) -> str:
-        """``u3 = -K ŷ3, K = [[1]]; sensors [[0, 0, 0, 1]], L = [[1]]`` (for reports)."""
+        """``u3 = -K ŷ3, K = [[1]]; C_m = [[0, 0, 0, 1]], L = [[1]]`` (for reports, titles)."""
         feed = "ŷ" if self.source == "estimate" else "y"
         act = ",".join(f"u{a}" for a in self.actuate)
         out = ",".join(f"{feed}{a}" for a in self.actuate)
@@ -357,7 +357,7 @@ class Loop:
             input_function(u, nm, model=self.model) if (u is None or isinstance(u, str)) else u
         )
         opts = SimulationOptions.merged(options, **settings)
-        return simulate_loop(
+        result = simulate_loop(
             nm,
             self.numeric,
             x0=state(x0),
@@ -365,6 +365,8 @@ class Loop:
             u=inputs,
             options=opts.discretized(self.method, self.resolution, "Loop"),
         )
+        info = {**result.info, "model": self.model.name, "design": self.design_label()}
+        return replace(result, info=info)  # the titles name the loop (presentation only)
 
     @reports_progress
     def tune(

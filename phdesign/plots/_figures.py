@@ -50,6 +50,18 @@ DESIGN_COLORS = ("goldenrod", "tab:orange", "tab:purple", "tab:green", "tab:brow
 SI_UNITS = {"t": "s", "z": "m", "energy": "J", "displacement": "m"}
 
 
+def eigenvalue_labels(time_unit: str | None = None) -> tuple[str, str]:
+    """Return the axis labels of the complex plane in the model's time unit (SI: s).
+
+    Examples
+    --------
+    >>> eigenvalue_labels("ms")
+    ('Re λ [1/ms]', 'Im λ [rad/ms]')
+    """
+    unit = time_unit or SI_UNITS["t"]
+    return f"Re λ [1/{unit}]", f"Im λ [rad/{unit}]"
+
+
 def literal(text: str) -> str:
     r"""Return ``text`` as a figure shows it literally: never as matplotlib mathtext.
 

@@ -8,7 +8,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from phdesign.plots._figures import DESIGN_COLORS, drawing, legend_in_view, require, unit_label
+from phdesign.plots._figures import (
+    DESIGN_COLORS,
+    drawing,
+    legend_in_view,
+    literal,
+    require,
+    unit_label,
+)
 from phdesign.plots.deflection import plot_deflection, plot_outputs, plot_tip
 from phdesign.plots.energy import plot_hamiltonians
 
@@ -32,7 +39,8 @@ def plot_simulation(
     the end-tip overlay (:func:`plot_tip`) and the heat map of the estimation error
     :math:`w - \hat w` (of :math:`w` without an observer); otherwise the outputs
     :math:`y` and :math:`\hat y` (:func:`plot_outputs`) and the output error
-    :math:`|y - \hat y|` on a log scale.
+    :math:`|y - \hat y|` on a log scale.  A loop's run (its ``u``) adds a bottom row: the
+    control input :math:`u_a(t) = -K \hat y_a(t)` of each actuated input.
 
     Parameters
     ----------
@@ -55,11 +63,18 @@ def plot_simulation(
         The file exists (without ``force``), its format is unknown, or it cannot be written.
     """
     has_w = getattr(result, "w", None) is not None
+    has_u = getattr(result, "u", None) is not None
     if title is None:
         title = getattr(result, "title", None)
-    frame = drawing(path, force=force, title=title, nrows=2, ncols=2, figsize=(11, 7.5))
+    rows, height = (3, 10.5) if has_u else (2, 7.5)
+    frame = drawing(path, force=force, title=title, nrows=rows, ncols=2, figsize=(11, height))
     with frame as (fig, axes):
         plot_hamiltonians(result, axes[0])
+        if has_u:
+            grid = axes[2, 0].get_gridspec()
+            axes[2, 0].remove()
+            axes[2, 1].remove()
+            _plot_control_input(result, fig.add_subplot(grid[2, :]))
         if has_w:
             plot_tip(result, axes[1, 0])
             which = "error" if getattr(result, "w_hat", None) is not None else "w"
@@ -69,6 +84,30 @@ def plot_simulation(
             plot_outputs(result, axes[1, 0], outputs=measured)
             _plot_output_error(result, axes[1, 1], measured)
     return fig
+
+
+def _plot_control_input(result: Any, ax: Axes) -> None:
+    """Draw the inputs the loop applies, u_a(t) = −K ŷ_a(t), each actuated one labelled."""
+    t = require(result, "t", "no time grid")
+    u = require(result, "u", "no inputs")
+    labels = tuple(getattr(result, "input_labels", ()))
+    actuated = tuple(getattr(result, "actuated", ())) or tuple(range(1, u.shape[1] + 1))
+    feed = "y" if getattr(result, "info", {}).get("feedback_source") == "measured" else "ŷ"
+    for k, a in enumerate(actuated):
+        trace = f" = {labels[a - 1]}" if a - 1 < len(labels) else ""
+        ax.plot(
+            t,
+            u[:, a - 1],
+            color=DESIGN_COLORS[k % len(DESIGN_COLORS)],
+            label=literal(f"u{a}{trace}  (u{a} = −K {feed}{a})"),
+        )
+    ax.set(
+        xlabel=unit_label(result, "time t", "t"),
+        ylabel="control input u",
+        title="control input u(t)",
+    )
+    ax.grid(True, alpha=0.3)
+    legend_in_view(ax, fontsize="small")
 
 
 def _measured_outputs(result: Any) -> list[int] | None:

@@ -14,6 +14,7 @@ from phdesign.plots._figures import (
     RE_LABEL,
     axes_or_new,
     drawing,
+    eigenvalue_labels,
     legend_in_view,
     literal,
 )
@@ -275,9 +276,13 @@ def plot_loop_spectrum(result: Any, ax: Axes | None = None) -> Figure:
     """Draw a loop's rightmost resolved eigenvalues, marked by the block they belong to.
 
     The controlled plant's eigenvalues are circles, the error system's crosses, the loop's
-    abscissa a vertical line (:meth:`LoopSpectrum.plot` hands itself here).
+    abscissa a vertical line (:meth:`LoopSpectrum.plot` hands itself here).  The title
+    names the model and the design; the axes are in the model's time unit (SI: s).
     """
-    with drawing(ax=ax, figsize=(5, 4)) as (fig, axes):
+    title = f"{result.model}: {result.design}"
+    unit = getattr(getattr(result, "plant", None), "time_unit", None)
+    re_label, im_label = eigenvalue_labels(unit)
+    with drawing(ax=ax, title=title if ax is None else None, figsize=(6, 4.5)) as (fig, axes):
         for kind, marker in (("plant", "o"), ("error", "x")):
             z = np.array(
                 [w for w, o in zip(result.rightmost, result.origin, strict=True) if o == kind]
@@ -285,8 +290,9 @@ def plot_loop_spectrum(result: Any, ax: Axes | None = None) -> Figure:
             if z.size:
                 axes.plot(z.real, z.imag, marker, ls="none", label=f"{kind} block")
         if result.spectral_abscissa is not None:
-            axes.axvline(result.spectral_abscissa, color="k", lw=0.8, label="loop abscissa")
-        axes.set_xlabel("Re λ")
-        axes.set_ylabel("Im λ")
-        axes.legend()
+            label = f"loop abscissa α = {result.spectral_abscissa:.4g}"
+            axes.axvline(result.spectral_abscissa, color="k", lw=0.8, label=label)
+        axes.set(xlabel=re_label, ylabel=im_label, title="loop spectrum (rightmost, resolved)")
+        axes.grid(True, alpha=0.3)
+        axes.legend(fontsize="small")
     return fig

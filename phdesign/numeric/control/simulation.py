@@ -103,6 +103,14 @@ class LoopSimulation(SimulationResult):
         rows.append(("actuated", ", ".join(f"u{a}" for a in self.actuated)))
         return rows
 
+    @property
+    def title(self) -> str:
+        """Model, control law (u = −K ŷ, K), sensors and L, and the discretization."""
+        design = self.info.get("design")
+        if not design:
+            return super().title
+        return f"{self.info.get('model', 'loop')}: {design}; {self.method} {self.resolution}"
+
     def __repr__(self) -> str:
         body = ", ".join(f"{k}: {v}" for k, v in self._summary())
         return f"LoopSimulation({body}; {len(self.warnings)} warning(s))"[:300]

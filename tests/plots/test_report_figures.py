@@ -1,0 +1,44 @@
+"""Figures fit for a report (issue 28): titles that say what was run, units, no warnings.
+
+Every check reads the Figure objects (titles, axis labels, number of axes, scales, limits)
+or the warnings raised while drawing; nothing is timed and no pixel is compared.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+import phdesign as phd
+
+
+@pytest.fixture(scope="module")
+def beam_loop():
+    """The beam of notebook 07 at a small resolution: u3 = −K ŷ3, sensor y4."""
+    return phd.Loop(phd.load("euler-bernoulli"), 3, 1, [4], 1, resolution=16)
+
+
+def test_loop_simulation_figure_names_the_design_and_draws_u(beam_loop):
+    run = beam_loop.simulate(x0="x1: 0, x2: z", t_end=1.0, samples=21)
+    fig = run.plot()
+    title = " ".join(fig.get_suptitle().split())
+    for part in (
+        "euler-bernoulli",
+        "u3 = -K ŷ3",
+        "K = [[1]]",
+        "C_m = [[0, 0, 0, 1]]",
+        "L = [[1]]",
+    ):
+        assert part in title, title
+    panel = next(ax for ax in fig.axes if ax.get_title() == "control input u(t)")
+    (line,) = panel.get_lines()
+    assert line.get_ydata().tolist() == run.u[:, 2].tolist()  # u3, the actuated input
+    assert panel.get_xlabel() == "time t [s]"
+
+
+def test_loop_spectrum_figure_has_title_and_units(beam_loop):
+    spectrum = beam_loop.spectrum(count=4, resolution=12, max_resolution=24)
+    fig = spectrum.plot()
+    title = " ".join(fig.get_suptitle().split())
+    assert title.startswith("euler-bernoulli: u3 = -K ŷ3"), title
+    ax = fig.axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("Re λ [1/s]", "Im λ [rad/s]")
