@@ -279,6 +279,20 @@ def tip_label(result: Any) -> str:
     return "z = b" if z is None or len(z) == 0 else f"z = {float(np.asarray(z)[-1]):g}"
 
 
+def log_scale_if_positive(ax: Axes, *curves: Any) -> bool:
+    """Put the y axis on a log scale when some value drawn is positive; else keep it linear.
+
+    A run from rest has energies and errors that are exactly zero: a log scale of nothing
+    positive is what makes matplotlib warn ("Data has no positive values"), so the panel
+    stays linear instead and says so in its axis label.  Returns whether it is a log scale.
+    """
+    positive = any(bool(np.any(np.asarray(c, dtype=float) > 0)) for c in curves)
+    ax.set_yscale("log" if positive else "linear")
+    if not positive:
+        ax.set_ylabel(f"{ax.get_ylabel().replace(', log scale', '')} (all zero: linear scale)")
+    return positive
+
+
 def plain_numbers(ax: Axes) -> None:
     """Tick labels without an offset (a conserved energy reads 0.25, not 1e-13 + 2.5e-1)."""
     formatter = ax.yaxis.get_major_formatter()

@@ -17,6 +17,7 @@ from phdesign.plots._figures import (
     figure_of,
     labelled_results,
     legend_in_view,
+    log_scale_if_positive,
     new_figure,
     plain_numbers,
     require,
@@ -64,11 +65,13 @@ def plot_hamiltonians(result: Any, axes: Sequence[Axes] | None = None) -> Figure
         drawn += [H_hat, H_err]
         ax_lin.plot(t, H_hat, color=OBSERVER_COLOR, ls="--", label="Ĥ (observer)")
         ax_lin.plot(t, H_err, color=ERROR_COLOR, ls="-", label="H̃ (estimation error)")
-        ax_log.semilogy(t, H_err, color=ERROR_COLOR, ls="-", label="H̃ (estimation error)")
-    ax_log.semilogy(t, H, color=PLANT_COLOR, ls=":", label="H (plant)")
+        ax_log.plot(t, H_err, color=ERROR_COLOR, ls="-", label="H̃ (estimation error)")
+    ax_log.plot(t, H, color=PLANT_COLOR, ls=":", label="H (plant)")
     time, energy = unit_label(result, "time t", "t"), unit_label(result, "energy", "energy")
     ax_lin.set(xlabel=time, ylabel=energy, title="Hamiltonians")
     ax_log.set(xlabel=time, ylabel=f"{energy}, log scale", title="decay (log scale)")
+    if not log_scale_if_positive(ax_log, *drawn[::2]):  # H and H̃, the curves drawn there
+        ax_log.set_title("decay (all zero: linear scale)")
     # energies are >= 0: from zero and without offset, a conserved energy is a flat line
     ax_lin.set_ylim(0.0, 1.05 * max(float(np.max(curve)) for curve in drawn) or 1.0)
     plain_numbers(ax_lin)
@@ -102,6 +105,7 @@ def plot_error_energy(
     Figure
     """
     fig, ax = axes_or_new(ax, figsize=(6, 4))
+    drawn = []
     for k, (label, res) in enumerate(labelled_results(results)):
         t = require(res, "t", "no time grid")
         H_err = require(res, "H_err", "simulate with sensors and a gain to get H̃")
@@ -109,7 +113,8 @@ def plot_error_energy(
             if not H_err[0] > 0:
                 raise NumericError(f"design {label!r}: H̃(0) = {H_err[0]:g}; cannot normalize")
             H_err = H_err / H_err[0]
-        ax.semilogy(t, H_err, color=DESIGN_COLORS[k % len(DESIGN_COLORS)], label=label)
+        ax.plot(t, H_err, color=DESIGN_COLORS[k % len(DESIGN_COLORS)], label=label)
+        drawn.append(H_err)
     if normalize:
         for level in levels:
             ax.axhline(level, color="gray", ls=":", lw=1, label=f"level {level:g}")
@@ -117,6 +122,7 @@ def plot_error_energy(
     energy = unit_label(first, "H̃(t)", "energy")
     ylabel = "H̃(t) / H̃(0)  (log scale)" if normalize else f"{energy} (log scale)"
     ax.set(xlabel=unit_label(first, "time t", "t"), ylabel=ylabel, title="estimation-error energy")
+    log_scale_if_positive(ax, *drawn)
     ax.grid(True, which="both", alpha=0.3)
     legend_in_view(ax)
     return fig

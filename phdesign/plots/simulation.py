@@ -13,6 +13,7 @@ from phdesign.plots._figures import (
     drawing,
     legend_in_view,
     literal,
+    log_scale_if_positive,
     require,
     unit_label,
 )
@@ -129,11 +130,12 @@ def _plot_output_error(result: Any, ax: Axes, outputs: list[int] | None) -> None
     error = np.abs(y - np.asarray(y_hat, dtype=float))
     for k, j in enumerate(picked):
         values = np.where(error[:, j - 1] > 0, error[:, j - 1], np.nan)
-        ax.semilogy(t, values, color=DESIGN_COLORS[k % len(DESIGN_COLORS)], label=f"|y{j} − ŷ{j}|")
+        ax.plot(t, values, color=DESIGN_COLORS[k % len(DESIGN_COLORS)], label=f"|y{j} − ŷ{j}|")
     ax.set(
         xlabel=unit_label(result, "time t", "t"),
         ylabel="output error, log scale",
         title="output error",
     )
+    log_scale_if_positive(ax, error[:, [j - 1 for j in picked]])
     ax.grid(True, which="both", alpha=0.3)
     legend_in_view(ax, fontsize="small")

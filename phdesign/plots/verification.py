@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from phdesign.plots._figures import drawing
+from phdesign.plots._figures import drawing, log_scale_if_positive, unit_label
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
@@ -31,9 +31,11 @@ def plot_verification(verification: Any, ax: Axes | None = None) -> Axes:
     """
     with drawing(ax=ax, figsize=(7, 3.5)) as (_, axes):
         v = verification
-        axes.semilogy(v.t, np.abs(v.continuous_error).max(axis=1), label="continuous")
-        axes.semilogy(v.t, np.abs(v.error).max(axis=1), label=f"{v.sampler}, dt = {v.dt:g}")
-        axes.set_xlabel("t")
+        continuous, sampled = np.abs(v.continuous_error).max(axis=1), np.abs(v.error).max(axis=1)
+        axes.plot(v.t, continuous, label="continuous")
+        axes.plot(v.t, sampled, label=f"{v.sampler}, dt = {v.dt:g}")
+        axes.set_xlabel(unit_label(v, "time t", "t"))
         axes.set_ylabel("|" + ", ".join(v.outputs) + " error|")
+        log_scale_if_positive(axes, continuous, sampled)
         axes.legend()
     return cast("Axes", axes)

@@ -6,6 +6,8 @@ or the warnings raised while drawing; nothing is timed and no pixel is compared.
 
 from __future__ import annotations
 
+import warnings
+
 import pytest
 
 import phdesign as phd
@@ -42,3 +44,21 @@ def test_loop_spectrum_figure_has_title_and_units(beam_loop):
     assert title.startswith("euler-bernoulli: u3 = -K ŷ3"), title
     ax = fig.axes[0]
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("Re λ [1/s]", "Im λ [rad/s]")
+
+
+@pytest.mark.parametrize("sensors", [None, [2]])
+def test_a_run_from_rest_draws_without_a_matplotlib_warning(sensors):
+    model = phd.load("wave")
+    if sensors is None:
+        run = phd.Plant(model, resolution=12).simulate(t_end=0.5, samples=11)
+    else:
+        run = phd.Observer(model, sensors=sensors, gain=1, resolution=12).simulate(
+            t_end=0.5, samples=11
+        )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # "Data has no positive values ..." fails here
+        fig = run.plot()
+        fig.canvas.draw()
+    decay = next(ax for ax in fig.axes if ax.get_title().startswith("decay"))
+    assert decay.get_yscale() == "linear"  # nothing positive: no log scale
+    assert "all zero" in decay.get_ylabel()
