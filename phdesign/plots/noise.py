@@ -89,9 +89,13 @@ def _draw_tradeoff(ax: Axes, result: Any, annotate: str) -> None:
             fontsize=8,
         )
     ax.set_xscale("log")
+    unit = getattr(result, "performance_unit", "")
+    rate = getattr(result, "time_unit", "") or "s"
     ax.set(
-        xlabel=f"RMS of the estimation error of {result.performance}",
-        ylabel="decay rate −α [1/s]",
+        xlabel=literal(
+            f"RMS of the estimation error of {result.performance}" + (f" [{unit}]" if unit else "")
+        ),
+        ylabel=f"decay rate −α [1/{rate}]",
         title=literal(
             f"{result.model}, sensors {measured_text(result.sensors)}: speed against noise"
         ),
@@ -138,16 +142,18 @@ def plot_noise_report(
 def _draw_frequency_response(left: Axes, report: Any) -> None:
     if report.pencils:
         omega = report.default_frequencies()
+        band = report.l2_gain.band
+        if band and omega[0] < band < omega[-1]:  # the axis ends where the resolved band does
+            omega = np.append(omega[omega < band], band)
         for res, values in report.frequency_response(omega).items():
             left.loglog(omega, values, lw=1, label=f"resolution {res}")
-        band = report.l2_gain.band
-        if band:
-            left.axvspan(band, omega[-1], color="0.9", label="unresolved frequencies")
+        left.set_xlim(float(omega[0]), float(omega[-1]))
         g = report.l2_gain
         if g.value is not None and g.frequency:
             left.plot(g.frequency, g.value, "k*", ms=12, label=f"γ = {g.value:.4g}")
         disc = g.discrete
-        if disc is not None and disc.values and g.discrete_frequency:
+        shown = g.discrete_frequency is not None and g.discrete_frequency <= omega[-1]
+        if disc is not None and disc.values and g.discrete_frequency and shown:
             # a sharp resonance of an unresolved mode falls between the plotted samples
             left.plot(
                 g.discrete_frequency,

@@ -62,3 +62,28 @@ def test_a_run_from_rest_draws_without_a_matplotlib_warning(sensors):
     decay = next(ax for ax in fig.axes if ax.get_title().startswith("decay"))
     assert decay.get_yscale() == "linear"  # nothing positive: no log scale
     assert "all zero" in decay.get_ylabel()
+
+
+@pytest.fixture(scope="module")
+def wave_observer():
+    """The string with sensor y2 (wave's [displacement] is in m, its time in s)."""
+    return phd.Observer(phd.load("wave"), sensors=[2], gain=0.5)
+
+
+def test_noise_plot_ends_where_the_resolved_band_ends(wave_observer):
+    report = wave_observer.noise(max_resolution=40)
+    band = report.l2_gain.band
+    assert band  # the wave's band is finite: its noise figure resolves up to there
+    left = report.plot().axes[0]
+    assert left.get_xscale() == "log"
+    assert left.get_xlim()[1] == pytest.approx(band)
+    for line in left.get_lines():
+        assert max(line.get_xdata()) <= band * (1 + 1e-12)
+
+
+def test_tradeoff_rms_axis_has_the_model_unit():
+    beam = phd.Observer(phd.load("euler-bernoulli"), sensors=[3, 4], gain=[0.1, 1])
+    result = beam.tradeoff(direction=[0.1, 1.0], scales=[1.0, 2.0])  # RMS of w(1), in m
+    ax = result.plot().axes[0]
+    assert ax.get_xlabel().endswith("[m]"), ax.get_xlabel()
+    assert ax.get_ylabel() == "decay rate −α [1/s]"

@@ -121,6 +121,10 @@ class Tradeoff:
         The performance output whose RMS is traded against the decay rate.
     intensity : tuple of float
     output_labels : tuple of str
+    performance_unit : str
+        The unit the model states for the performance output (``""``: none).
+    time_unit : str
+        The unit of time the model states (``""``: none).
     """
 
     model: str
@@ -132,6 +136,8 @@ class Tradeoff:
     intensity: tuple[float, ...]
     output_labels: tuple[str, ...] = ()
     warnings: tuple[str, ...] = field(default=())
+    performance_unit: str = ""
+    time_unit: str = ""
 
     @property
     def pareto_points(self) -> tuple[TradeoffPoint, ...]:
@@ -406,7 +412,17 @@ def tradeoff(
         intensity=points[0].noise.intensity,
         output_labels=nm.output_labels,
         warnings=tuple(warnings),
+        performance_unit=_unit_of(functionals[0], nm),
+        time_unit=dict(nm.units).get("t", ""),
     )
+
+
+def _unit_of(functional: Functional, nm: NumericModel) -> str:
+    """Return the unit the model states for a displacement or a named field, else ``""``."""
+    if functional.kind != "displacement":
+        return ""
+    key = "displacement" if functional.field_name == "w" else functional.field_name
+    return dict(nm.units).get(key, "")
 
 
 def _figures(
