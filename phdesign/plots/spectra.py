@@ -64,7 +64,8 @@ def plot_spectrum(
     Resolved eigenvalues (those that agree between two resolutions, see
     :func:`phdesign.numeric.spectrum.drift.match_resolved`) are filled blue dots; unresolved
     ones are grey crosses: they are artefacts of the discretization and the spectral
-    abscissa ignores them.  The legend, below the axes, lists only what the view shows.
+    abscissa ignores them.  The legend lists only what the view shows: below the axes,
+    or inside them when they are one panel of several.
 
     Parameters
     ----------
@@ -124,7 +125,10 @@ def plot_spectrum(
     if ylim is not None:
         ax.set_ylim(*ylim)
     ax.grid(True, alpha=0.3)
-    legend_in_view(ax, outside=True)
+    # below the axes when the spectrum has its figure to itself; inside when it is one
+    # panel of several (each legend below its panel would squeeze the panels to nothing)
+    alone = len([a for a in fig.axes if a.get_visible()]) == 1
+    legend_in_view(ax, outside=alone, **({} if alone else {"loc": "lower left", "fontsize": 7}))
     return fig
 
 

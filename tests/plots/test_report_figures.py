@@ -87,3 +87,21 @@ def test_tradeoff_rms_axis_has_the_model_unit():
     ax = result.plot().axes[0]
     assert ax.get_xlabel().endswith("[m]"), ax.get_xlabel()
     assert ax.get_ylabel() == "decay rate −α [1/s]"
+
+
+def test_three_spectrum_panels_keep_their_room():
+    """Notebook 02's figure: three spectra side by side, each with its legend."""
+    import numpy as np
+
+    from phdesign.plots import new_figure
+
+    lam = np.array([-1 + 5j, -1 - 5j, -2 + 40j, -20 + 900j])
+    resolved = np.array([True, True, True, False])
+    fig, axes = new_figure(1, 3, figsize=(10, 3))  # the notebook in a narrower window
+    for k, ax in enumerate(axes):
+        phd.plots.plot_spectrum(lam, resolved, ax=ax, abscissa=-1.0, title=f"design {k}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # "constrained_layout not applied ..." fails here
+        fig.canvas.draw()
+    for ax in axes:
+        assert ax.get_position().height > 0.5  # of the figure: not squeezed by legends
