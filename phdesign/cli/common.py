@@ -303,7 +303,7 @@ def check_finite_series(result: Any) -> None:
     """
     import numpy as np
 
-    for name in ("H", "H_hat", "H_err", "y", "y_hat", "w", "w_hat"):
+    for name in ("H", "H_hat", "H_err", "y", "y_hat", "w", "w_hat", "at_values", "at_values_hat"):
         series = getattr(result, name, None)
         if series is None:
             continue

@@ -27,6 +27,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.figure import Figure
 
 __all__ = [
+    "plot_at",
     "plot_deflection",
     "plot_deflection_panels",
     "plot_outputs",
@@ -126,6 +127,38 @@ def plot_tip(result: Any, ax: Axes | None = None) -> Figure:
     )
     ax.grid(True, alpha=0.3)
     legend_in_view(ax)
+    return fig
+
+
+def plot_at(result: Any, ax: Axes | None = None) -> Figure:
+    """Draw the point outputs ``at`` (``rotation(1)``, ``w(0.5)``), estimates dashed.
+
+    Each is labelled with its field's unit where the model states one; the axis carries
+    the unit when every output shares it.
+
+    Returns
+    -------
+    Figure
+    """
+    t = require(result, "t", "no time grid")
+    values = require(result, "at_values", "simulate with at=[...] to get point outputs")
+    estimates = getattr(result, "at_values_hat", None)
+    fig, ax = axes_or_new(ax, figsize=(6, 3.5))
+    parts = [name.partition("(") for name in result.at]
+    keys = ["displacement" if field == "w" else field for field, _, _ in parts]
+    units = getattr(result, "units", None) or {}
+    shared = len({units.get(key) for key in keys}) == 1
+    for k, (name, (field, _, point)) in enumerate(zip(result.at, parts, strict=True)):
+        color = f"C{k % 10}"  # matplotlib's cycle: one distinct colour per output
+        label = name if shared else unit_label(result, name, keys[k])
+        ax.plot(t, values[:, k], color=color, ls="-", label=f"{label} (plant)")
+        if estimates is not None:
+            hat = f"{field}_hat({point}"
+            ax.plot(t, estimates[:, k], color=color, ls="--", label=f"{hat} (observer)")
+    ylabel = unit_label(result, "point outputs", keys[0]) if shared else "point outputs"
+    ax.set(xlabel=unit_label(result, "time t", "t"), ylabel=ylabel, title="point outputs")
+    ax.grid(True, alpha=0.3)
+    legend_in_view(ax, fontsize="small")
     return fig
 
 

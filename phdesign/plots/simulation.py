@@ -17,7 +17,7 @@ from phdesign.plots._figures import (
     require,
     unit_label,
 )
-from phdesign.plots.deflection import plot_deflection, plot_outputs, plot_tip
+from phdesign.plots.deflection import plot_at, plot_deflection, plot_outputs, plot_tip
 from phdesign.plots.energy import plot_hamiltonians
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
@@ -38,7 +38,8 @@ def plot_simulation(
 
     Top row: :func:`plot_hamiltonians`.  Bottom row, when the model has a displacement:
     the end-tip overlay (:func:`plot_tip`) and the heat map of the estimation error
-    :math:`w - \hat w` (of :math:`w` without an observer); otherwise the outputs
+    :math:`w - \hat w` (of :math:`w` without an observer), the end tip replaced by the
+    point outputs (:func:`plot_at`) when the run has ``at``; otherwise the outputs
     :math:`y` and :math:`\hat y` (:func:`plot_outputs`) and the output error
     :math:`|y - \hat y|` on a log scale.  A loop's run (its ``u``) adds a bottom row: the
     control input :math:`u_a(t) = -K \hat y_a(t)` of each actuated input.
@@ -64,6 +65,7 @@ def plot_simulation(
         The file exists (without ``force``), its format is unknown, or it cannot be written.
     """
     has_w = getattr(result, "w", None) is not None
+    has_at = getattr(result, "at_values", None) is not None
     has_u = getattr(result, "u", None) is not None
     if title is None:
         title = getattr(result, "title", None)
@@ -76,13 +78,17 @@ def plot_simulation(
             axes[2, 0].remove()
             axes[2, 1].remove()
             _plot_control_input(result, fig.add_subplot(grid[2, :]))
-        if has_w:
+        measured = _measured_outputs(result)
+        if has_at:
+            plot_at(result, axes[1, 0])
+        elif has_w:
             plot_tip(result, axes[1, 0])
+        else:
+            plot_outputs(result, axes[1, 0], outputs=measured)
+        if has_w:
             which = "error" if getattr(result, "w_hat", None) is not None else "w"
             plot_deflection(result, which, axes[1, 1])
         else:
-            measured = _measured_outputs(result)
-            plot_outputs(result, axes[1, 0], outputs=measured)
             _plot_output_error(result, axes[1, 1], measured)
     return fig
 

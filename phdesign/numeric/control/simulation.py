@@ -177,6 +177,7 @@ def simulate_loop(
     """
     opts = SimulationOptions.merged(options)
     opts.require("simulate_loop", "continuous")
+    opts.refuse_at("simulate_loop")
     if opts.tol is not None:
         raise ArgumentError(
             f"tol: the loop's midpoint steps once per output interval, without a tolerance; "

@@ -36,6 +36,7 @@ from numpy.polynomial import legendre as leg
 from phdesign.core.cache import OwnerCache
 from phdesign.core.errors import NumericError, ParameterError
 from phdesign.core.limits import MAX_CACHE_BYTES, MAX_CACHED_ROWS
+from phdesign.core.text import did_you_mean
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.inputs import initial_state_function, trace_row
@@ -44,6 +45,7 @@ __all__ = [
     "Functional",
     "default_performance",
     "displacement_at",
+    "field_names",
     "integral_functional",
     "parse_functional",
     "parse_functionals",
@@ -131,6 +133,11 @@ def _read_only(rows: np.ndarray) -> np.ndarray:
     return row
 
 
+def field_names(nm: NumericModel) -> tuple[str, ...]:
+    """Return the fields a point output may name: ``w`` (with a displacement), then the model's."""
+    return (("w",) if nm.displacement is not None else ()) + tuple(name for name, _ in nm.fields)
+
+
 def displacement_at(nm: NumericModel, point: float | str, name: str = "w") -> Functional:
     """Return the displacement ``w(point)``, or the named field ``name(point)``.
 
@@ -156,10 +163,10 @@ def displacement_at(nm: NumericModel, point: float | str, name: str = "w") -> Fu
             "expected a point of it"
         )
     if name != "w" and nm.field_spec(name) is None:
-        names = ", ".join(f for f, _ in nm.fields) or "none"
+        known = field_names(nm)
         raise NumericError(
-            f"{name}({text}): the model {nm.name!r} defines no field {name!r}; its named "
-            f"fields are {names}"
+            f"{name}({text}): the model {nm.name!r} defines no field {name!r}"
+            f"{did_you_mean(name, known)}; its fields are {', '.join(known) or 'none'}"
         )
     if nm.displacement is None and name == "w":
         raise NumericError(

@@ -99,6 +99,7 @@ def simulate_sampled(
     """
     opts = SimulationOptions.merged(options)
     opts.require("simulate_sampled", "sampled", "continuous")
+    opts.refuse_at("simulate_sampled")
     if opts.scheme != "expm":
         raise NumericError(SAMPLED_SCHEME.format(scheme=opts.scheme))
     if opts.dt is not None:

@@ -108,6 +108,11 @@ class SimulationOptions:
         White noise on the plant inputs (one per input or one for all).
     seed : int, optional
         Seed of the noise (needs a noise intensity).
+    at : sequence of str or float, optional
+        Point outputs reported beside ``w(z)``: a number is the displacement there,
+        ``"rotation(1)"`` a named field of the model (read against the model by the
+        simulator, :mod:`phdesign.numeric.discretization.points`); the continuous simulation
+        reports them (the sampled, noisy and loop simulations refuse them).
 
     Raises
     ------
@@ -132,6 +137,7 @@ class SimulationOptions:
     noise_intensity: tuple[float, ...] | None
     input_intensity: tuple[float, ...] | None
     seed: int | None
+    at: tuple[str | float, ...] | None
 
     def __init__(
         self,
@@ -149,6 +155,7 @@ class SimulationOptions:
         noise_intensity: float | Sequence[float] | None = None,
         input_intensity: float | Sequence[float] | None = None,
         seed: int | None = None,
+        at: str | float | Sequence[str | float] | None = None,
     ) -> None:
         table = current()  # None: the table's default, in force when the options are made
         t_end, samples, scheme, _ = table.simulation.fill(t_end, samples, scheme)
@@ -176,6 +183,7 @@ class SimulationOptions:
         self._set("check_resolution", check_resolution)
         self._check_sampling(dt, sampler, observer_resolution)
         self._check_noise(noise_intensity, input_intensity, seed)
+        self._set("at", None if at is None else _point_items(at))
 
     def _set(self, name: str, value: Any) -> None:
         object.__setattr__(self, name, value)  # frozen: the checked value replaces the given
@@ -246,6 +254,15 @@ class SimulationOptions:
         """``z_w``, or 21 uniform points of ``interval``."""
         a, b = interval
         return np.linspace(a, b, 21) if self.z_w is None else np.asarray(self.z_w, dtype=float)
+
+    def refuse_at(self, simulator: str) -> None:
+        """Refuse ``at`` in a simulator that reports only ``w(z)``."""
+        if self.at is not None:
+            raise ArgumentError(
+                f"at: {simulator} does not read point outputs; drop `at`, or run the "
+                "continuous observer (without `dt`, `sampler`, `observer_resolution` and "
+                "the noise)"
+            )
 
     def require(self, simulator: str, *kinds: str) -> None:
         """Refuse options of a kind of run that ``simulator`` does not do.
@@ -333,3 +350,20 @@ def _points(z_w: Any) -> tuple[float, ...]:
     if points.ndim != 1 or not points.size or not np.all(np.isfinite(points)):
         raise NumericError(f"z_w must be a non-empty list of finite points; found {z_w!r}")
     return tuple(points.tolist())
+
+
+def _point_items(at: Any) -> tuple[str | float, ...]:
+    """Return ``at`` as a non-empty tuple of texts and numbers (read by the simulator)."""
+    items = [at] if isinstance(at, (str, int, float)) else at
+    try:
+        out = tuple(items)
+    except TypeError:
+        out = ()
+    if not out or not all(
+        isinstance(x, (str, int, float)) and not isinstance(x, bool) for x in out
+    ):
+        raise ArgumentError(
+            "at must be a point, a field at a point such as 'rotation(1)', or a non-empty "
+            f"list of them; found {at!r}"
+        )
+    return out

@@ -51,6 +51,12 @@ def _json_safe(value: Any) -> Any:
     return value
 
 
+def _hat(name: str) -> str:
+    """Return ``rotation_hat(1)`` for the point output ``rotation(1)``."""
+    field, _, point = name.partition("(")
+    return f"{field}_hat({point}"
+
+
 @dataclass(frozen=True, repr=False)
 class SimulationResult(SimulationDisplay):
     """Time series of a plant (and observer) simulation.
@@ -77,6 +83,11 @@ class SimulationResult(SimulationDisplay):
         resolution (None: resolved over the whole run, or not checked).
     resolved_until : float or None
         Last sample time at which it still agrees (None likewise).
+    at : tuple of str
+        The point outputs asked for (``at``): ``"w(0.5)"``, ``"rotation(1)"``
+        (:mod:`phdesign.numeric.discretization.points`).
+    at_values, at_values_hat : ndarray (nt, len(at)) or None
+        Their values on the plant and their estimates by the observer.
     """
 
     t: np.ndarray
@@ -98,6 +109,21 @@ class SimulationResult(SimulationDisplay):
     units: dict[str, str] | None = field(default=None, repr=False)
     resolved_floor: float | None = None
     resolved_until: float | None = None
+    at: tuple[str, ...] = ()
+    at_values: np.ndarray | None = None
+    at_values_hat: np.ndarray | None = None
+
+    def at_columns(self) -> list[tuple[str, np.ndarray]]:
+        """Return ``(name, series)`` of each point output, then of each estimate.
+
+        The estimate of ``rotation(1)`` is ``rotation_hat(1)``, as ``w_hat`` is ``w``'s.
+        """
+        if self.at_values is None:
+            return []
+        cols = [(name, self.at_values[:, k]) for k, name in enumerate(self.at)]
+        if self.at_values_hat is not None:
+            cols += [(_hat(name), self.at_values_hat[:, k]) for k, name in enumerate(self.at)]
+        return cols
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary of the time series (no discrete states; strict JSON)."""
@@ -118,6 +144,9 @@ class SimulationResult(SimulationDisplay):
             out["z_w"] = _finite_list(self.z_w)
             out["w"] = _finite_list(self.w)
             out["w_hat"] = _finite_list(self.w_hat)
+        if self.at:
+            out["at"] = list(self.at)
+            out["at_values"] = {name: _finite_list(v) for name, v in self.at_columns()}
         out.update(
             {
                 k: _json_safe(v)
@@ -134,7 +163,10 @@ class SimulationResult(SimulationDisplay):
         return json.dumps(self.to_dict(), allow_nan=False)
 
     def to_csv(self) -> str:
-        """CSV: t, H, H_hat, H_err, y_i, y_hat_i and the tip displacement w(b), ŵ(b)."""
+        """CSV: t, H, H_hat, H_err, y_i, y_hat_i, the tip displacement w(b), ŵ(b), then ``at``.
+
+        The point outputs ``at`` follow as ``rotation(1)``, then ``rotation_hat(1)``.
+        """
         cols: list[tuple[str, np.ndarray]] = [("t", self.t), ("H", self.H)]
         if self.H_hat is not None and self.H_err is not None:
             cols += [("H_hat", self.H_hat), ("H_err", self.H_err)]
@@ -147,6 +179,7 @@ class SimulationResult(SimulationDisplay):
             cols.append(("w_tip", self.w[:, -1]))
             if self.w_hat is not None:
                 cols.append(("w_hat_tip", self.w_hat[:, -1]))
+        cols += self.at_columns()
         buf = io.StringIO()
         writer = csv.writer(buf, lineterminator="\n")
         writer.writerow([c[0] for c in cols])

@@ -49,7 +49,9 @@ from phdesign.core.errors import NumericError
 from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_simulate_arguments
+from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.phs import ClosedLoop
+from phdesign.numeric.discretization.points import point_outputs, point_rows
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.threads import limited_threads
@@ -185,6 +187,7 @@ def simulate(
     opts = SimulationOptions.merged(options)
     opts.require("simulate", "continuous")
     check_simulate_arguments(nm, C_m, L, x0=x0, xhat0=xhat0, u=u, options=opts, discrete=discrete)
+    at = point_outputs(nm, opts.at, "at")  # an unknown field is refused before any work
     d = discrete if discrete is not None else discretize(nm, opts.method, opts.resolution)
     step = _Stepper.of(opts)
     U = None if u is None else input_samples(u, step.t, nm.n_ports)
@@ -196,7 +199,7 @@ def simulate(
         K = feedback_matrix(C_m, L, nm.n_ports)
         e0 = _difference(start, xhat0 or _zero(nm))
         error = _error_run(nm, d, K, e0, step, opts.check_resolution)
-    return _result(nm, _Run(d, opts, step.t, U, plant, error))
+    return _result(nm, _Run(d, opts, step.t, U, plant, error, at))
 
 
 def _zero(nm: NumericModel) -> InitialState:
@@ -270,6 +273,7 @@ class _Run:
     U: np.ndarray | None
     plant: Trajectory
     error: _ErrorRun | None
+    at: tuple[Functional, ...] = ()
 
     @property
     def trajectories(self) -> dict[str, Trajectory]:
@@ -298,6 +302,7 @@ def _result(nm: NumericModel, run: _Run) -> SimulationResult:
         Wd = d.displacement_basis(zw)
         w = eh @ Wd.T
         w_hat = None if eo is None else eo @ Wd.T
+    rows = point_rows(d, run.at)
     return SimulationResult(
         t=run.t,
         H=d.hamiltonian(eh),
@@ -318,6 +323,9 @@ def _result(nm: NumericModel, run: _Run) -> SimulationResult:
         resolved_floor=None if error is None else error.floor,
         resolved_until=None if error is None else error.until,
         units=dict(nm.units),
+        at=tuple(f.name for f in run.at),
+        at_values=eh @ rows.T if run.at else None,
+        at_values_hat=eo @ rows.T if run.at and eo is not None else None,
     )
 
 

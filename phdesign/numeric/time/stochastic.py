@@ -163,6 +163,7 @@ def simulate_noisy(
     """
     opts = SimulationOptions.merged(options)
     opts.require("simulate_noisy", "noisy", "continuous")
+    opts.refuse_at("simulate_noisy")
     if opts.scheme != "expm":
         raise NumericError(NOISY_SCHEME.format(scheme=opts.scheme))
     if opts.noise_intensity is not None and C_m is None:
