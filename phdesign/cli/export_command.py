@@ -144,7 +144,8 @@ def _add_verification_arguments(ex: argparse.ArgumentParser) -> None:
     ex.add_argument(
         "--at",
         metavar="Z,..",
-        help="displacement points of the outputs w(z) (default b, for a model with one)",
+        help="point outputs: the displacement at these points, e.g. 0.5,1, or named fields "
+        "at a point, e.g. rotation(1) (default b, for a model with a displacement)",
     )
 
 

@@ -357,7 +357,7 @@ class Observer(ObserverNoise):
         x0: str | Callable[[Any], Any] | None = None,
         t_end: float | None = None,
         plant_resolution: int | None = None,
-        points: float | Sequence[float] | None = None,
+        points: float | str | Sequence[float | str] | None = None,
         progress: Progress | None = None,
     ) -> SampledObserver:
         r"""Return the observer a controller runs: finite order, sampled every ``dt``.
@@ -398,8 +398,8 @@ class Observer(ObserverNoise):
         t_end : float
         plant_resolution : int, optional
             Galerkin degree of the verification plant.
-        points : sequence of float, optional
-            Displacement points of the outputs ``w(z)`` (default b, with a displacement).
+        points : sequence of float or str, optional
+            Point outputs: ``w(z)`` at numbers, named fields as ``"rotation(1)"`` (default b).
         progress : callable, optional
             Called with one line of text at each stage (:mod:`phdesign.core.progress`).
 

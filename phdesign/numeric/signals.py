@@ -22,6 +22,7 @@ Examples
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -77,10 +78,17 @@ def input_descriptions(nm: NumericModel, C_m: np.ndarray) -> tuple[str, ...]:
     return inputs + sensor_descriptions(nm, C_m)
 
 
-def estimate_descriptions(nm: NumericModel, points: Sequence[float] = ()) -> tuple[str, ...]:
-    """Return the observer's outputs: ``yhat3 = estimate of y3 = e1'(1)``, then ``w(z)``."""
+def estimate_descriptions(nm: NumericModel, points: Sequence[Any] = ()) -> tuple[str, ...]:
+    """Return the observer's outputs: ``yhat3 = estimate of y3 = e1'(1)``, then each point's.
+
+    ``points`` are point outputs (a ``Functional`` of kind ``"displacement"``: ``w(1) =
+    estimated displacement at z = 1``, ``rotation(1) = estimated rotation at z = 1``).
+    """
     out = [f"yhat{i + 1} = estimate of {port_description(nm, 'y', i)}" for i in range(nm.n_ports)]
-    return tuple(out) + tuple(f"w({z:g}) = estimated displacement at z = {z:g}" for z in points)
+    for f in points:
+        what = "displacement" if f.field_name == "w" else f.field_name
+        out.append(f"{f.name} = estimated {what} at z = {f.point:g}")
+    return tuple(out)
 
 
 def renumbering(nm: NumericModel) -> str | None:

@@ -46,7 +46,7 @@ def test_simulate_at_writes_the_rotation_and_its_estimate(capsys) -> None:
     assert data["units"]["rotation"] == "rad"
 
 
-@pytest.mark.parametrize("command", ["simulate", "tune"])
+@pytest.mark.parametrize("command", ["simulate", "tune", "export"])
 def test_an_unknown_field_is_one_line_naming_the_known_fields(capsys, tmp_path, command) -> None:
     extra = {
         "simulate": (),

@@ -24,7 +24,8 @@ Timing, as a controller runs it (period Δt):
   the estimate at :math:`t_k` and advances.
 
 Outputs: ``yhat1..`` (every model output), then ``w(z)`` for each displacement point
-(the displacement at b by default, e.g. the beam's tip w(1)). Energy:
+(the displacement at b by default, e.g. the beam's tip w(1)) and ``rotation(z)`` for each
+named field asked for (:mod:`phdesign.numeric.discretization.points`). Energy:
 :math:`\hat H = \tfrac12 \hat x^\top Q \hat x`, Q = ``energy_matrix`` (the Galerkin mass
 matrix in the efforts, or :math:`V^\top E V` after a reduction x = V x_r).
 """
@@ -45,15 +46,13 @@ from phdesign.core.progress import report
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_initial_state, check_periods, check_sampling
+from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.phs import DiscretePHS
+from phdesign.numeric.discretization.points import point_outputs
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.sampled.order import REDUCTIONS, select_order
 from phdesign.numeric.sampled.plant_resolution import verification_plant_degree
-from phdesign.numeric.sampled.samplers import (
-    ContinuousObserver,
-    default_initial_state,
-    displacement_label,
-)
+from phdesign.numeric.sampled.samplers import ContinuousObserver, default_initial_state
 from phdesign.numeric.sampled.selection import OrderSelection
 from phdesign.numeric.sampled.verification import (
     Verification,
@@ -284,38 +283,20 @@ class SampledObserver:
         return self.verification.plot(ax)
 
 
-def displacement_points(nm: NumericModel, points: Any, name: str = "points") -> tuple[float, ...]:
-    """Return the points of the outputs ``w(z)``: numbers of [a, b] (default: b, if any).
+def displacement_points(
+    nm: NumericModel, points: Any, name: str = "points"
+) -> tuple[Functional, ...]:
+    """Return the point outputs of the export: ``w(z)`` at numbers, named fields by name.
 
-    Two points may not give one output name (:func:`displacement_label`, 6 significant
-    digits): ``1, 1`` would be two outputs ``w(1)``. ``name`` is how the points are called
-    in the messages (``"--at"`` on the command line).
+    Default: w(b) when the model has a displacement, none otherwise.  A number is the
+    displacement there, ``"rotation(1)"`` a named field
+    (:func:`~phdesign.numeric.discretization.points.point_outputs`, which refuses an
+    unknown field, a point outside [a, b] and two items of one output name). ``name`` is
+    how the points are called in the messages (``"--at"`` on the command line).
     """
     if points is None:
-        return (nm.interval[1],) if nm.displacement is not None else ()
-    a, b = nm.interval
-    if nm.displacement is None and np.size(points):
-        raise NumericError(
-            f"{name}: model {nm.name!r} has no displacement: drop the displacement points"
-        )
-    try:
-        values = tuple(float(z) for z in np.asarray(points, dtype=float).ravel())
-    except (TypeError, ValueError):
-        raise NumericError(
-            f"{name}: expected numbers in [{a:g}, {b:g}]; found {points!r}"
-        ) from None
-    outside = [z for z in values if not (math.isfinite(z) and a <= z <= b)]
-    if outside:
-        raise NumericError(f"{name}: expected numbers in [{a:g}, {b:g}]; found {outside[0]:g}")
-    labels = [displacement_label(z) for z in values]
-    for i, label in enumerate(labels):
-        if label in labels[:i]:
-            first = values[labels.index(label)]
-            raise NumericError(
-                f"{name}: {first!r} and {values[i]!r} both give the output {label}; expected "
-                "distinct points (6 significant digits)"
-            )
-    return values
+        return point_outputs(nm, nm.interval[1], name) if nm.displacement is not None else ()
+    return point_outputs(nm, points, name)
 
 
 @limited_threads
@@ -336,7 +317,7 @@ def export_observer(
     x0_text: str | None = None,
     t_end: float | None = None,
     plant_resolution: int | None = None,
-    points: float | Sequence[float] | None = None,
+    points: float | str | Sequence[float | str] | None = None,
     model_name: str | None = None,
 ) -> SampledObserver:
     """Design the observer a controller runs: order, sampled discretization, verification.
@@ -373,9 +354,9 @@ def export_observer(
     plant_resolution : int, optional
         Galerkin degree of the verification plant (default the table's
         ``export.plant_degree``, raised to twice the order: :mod:`phdesign.core.defaults`).
-    points : float or sequence of float, optional
-        Displacement points of the outputs ``w(z)``; default (b,) for a model with a
-        displacement, none otherwise.
+    points : float, str or a sequence of them, optional
+        Point outputs: numbers are displacement points ``w(z)``, ``"rotation(1)"`` a named
+        field; default (b,) for a model with a displacement, none otherwise.
     model_name : str, optional
         Name recorded in the export (default the model's).
 

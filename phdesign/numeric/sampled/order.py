@@ -54,6 +54,7 @@ from phdesign.core.errors import NumericError
 from phdesign.core.progress import report as report_stage
 from phdesign.core.progress import stage
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize, feedback_matrix
 from phdesign.numeric.sampled.reduction import balanced_truncation, modal_truncation
@@ -136,7 +137,7 @@ def select_order(
     plant: DiscretePHS,
     x0: np.ndarray,
     t_end: float,
-    points: tuple[float, ...] = (),
+    points: tuple[Functional, ...] = (),
     order: int | None = None,
     reduction: str = "none",
     tol: float | None = None,
@@ -156,8 +157,9 @@ def select_order(
         The plant's initial efforts for the performance runs.
     t_end : float
         Length of the performance runs.
-    points : tuple of float
-        Displacement points (the performance outputs), empty for the model's outputs.
+    points : tuple of Functional
+        Point outputs (the performance outputs: ``w(1)``, ``rotation(1)``,
+        :mod:`phdesign.numeric.discretization.points`), empty for the model's outputs.
     order : int, optional
         Number of states; None chooses it from the targets.
     reduction : {"none", "modal", "balanced"}
@@ -253,7 +255,7 @@ class _Trial:
     L: np.ndarray
     plant: DiscretePHS
     x0: np.ndarray
-    points: tuple[float, ...]
+    points: tuple[Functional, ...]
     reduction: str
     tol: float
     output_tol: float

@@ -29,6 +29,7 @@ import scipy.linalg as sl
 
 from phdesign.core.errors import NumericError, check_shape
 from phdesign.numeric.discretization.phs import DiscretePHS
+from phdesign.numeric.discretization.points import point_rows
 from phdesign.numeric.sampled.period_maps import Realization, sample_plant
 from phdesign.numeric.sampled.samplers import ContinuousObserver
 
@@ -78,8 +79,8 @@ class LoopRun:
 
 def plant_targets(plant: DiscretePHS, observer: ContinuousObserver) -> np.ndarray:
     """Rows mapping plant efforts to the plant's values of the performance outputs."""
-    if observer.points and plant.displacement_basis is not None:
-        return plant.displacement_basis(np.array(observer.points))
+    if observer.points:
+        return point_rows(plant, observer.points)
     return plant.B.T  # the model outputs (the plant's D u term is added by the caller)
 
 

@@ -38,7 +38,9 @@ import numpy as np
 
 from phdesign.core.errors import NumericError, check_shape
 from phdesign.numeric.checks import check_sampling
+from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.phs import DiscretePHS
+from phdesign.numeric.discretization.points import point_rows
 from phdesign.numeric.sampled.period_maps import (
     ObserverModel,
     Realization,
@@ -65,6 +67,14 @@ def displacement_label(z: float) -> str:
     ('w(0.5)', 'w(1)')
     """
     return f"w({z:g})"
+
+
+def _point_output(point: float | Functional) -> Functional:
+    """Return a point output: a number is the displacement ``w`` there."""
+    if isinstance(point, Functional):
+        return point
+    z = float(point)
+    return Functional(displacement_label(z), "displacement", point=z)
 
 
 def sensor_names(C_m: np.ndarray) -> tuple[str, ...]:
@@ -106,8 +116,9 @@ class ContinuousObserver:
         Signal names.
     performance : tuple of int
         Indices of the performance outputs in ``outputs``.
-    points : tuple of float
-        The points z of the displacement outputs ``w(z)`` (empty without displacement).
+    points : tuple of Functional
+        The point outputs, ``w(z)`` or a named field such as ``rotation(1)``
+        (:mod:`phdesign.numeric.discretization.points`); empty for the model's outputs.
     reduction : str
         ``"none"``, ``"modal"`` or ``"balanced"``.
     input_descriptions, output_descriptions : tuple of str
@@ -126,7 +137,7 @@ class ContinuousObserver:
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
     performance: tuple[int, ...]
-    points: tuple[float, ...] = ()
+    points: tuple[Functional, ...] = ()
     reduction: str = "none"
     input_descriptions: tuple[str, ...] = ()
     output_descriptions: tuple[str, ...] = ()
@@ -143,7 +154,11 @@ class ContinuousObserver:
 
     @classmethod
     def from_discretization(
-        cls, d: DiscretePHS, C_m: np.ndarray, L: np.ndarray, points: Sequence[float] = ()
+        cls,
+        d: DiscretePHS,
+        C_m: np.ndarray,
+        L: np.ndarray,
+        points: Sequence[float | Functional] = (),
     ) -> ContinuousObserver:
         r"""Build the observer of :math:`\hat u = u + C_m^\top L (y_m - \hat y_m)` on ``d``.
 
@@ -158,7 +173,8 @@ class ContinuousObserver:
 
         (:meth:`ObserverModel.continuous
         <phdesign.numeric.sampled.period_maps.ObserverModel.continuous>`) and the
-        displacement :math:`w(z) = W(z)\hat e` at each of ``points``.
+        point outputs :math:`f(z) = W_f(z)\hat e` (the displacement at a number, a named
+        field given as a :class:`Functional`).
         """
         C = np.atleast_2d(np.asarray(C_m, dtype=float))
         m = d.n_ports
@@ -166,16 +182,16 @@ class ContinuousObserver:
         closed = model.continuous()
         outputs = [f"yhat{i + 1}" for i in range(m)]
         rows, feed = [closed.C], [closed.D]
-        pts = np.asarray(points, dtype=float).reshape(-1)
-        if pts.size:
-            if d.displacement_basis is None:
+        pts = tuple(_point_output(p) for p in points)
+        if pts:
+            if any(f.field_name == "w" for f in pts) and d.displacement_basis is None:
                 raise NumericError(
                     f"model {d.model.name!r} has no displacement: drop the displacement points"
                 )
-            rows.append(d.displacement_basis(pts))
-            feed.append(np.zeros((pts.size, closed.B.shape[1])))
-            outputs += [displacement_label(float(z)) for z in pts]
-        performance = tuple(range(m, m + pts.size)) if pts.size else tuple(range(m))
+            rows.append(point_rows(d, pts))
+            feed.append(np.zeros((len(pts), closed.B.shape[1])))
+            outputs += [f.name for f in pts]
+        performance = tuple(range(m, m + len(pts))) if pts else tuple(range(m))
         return cls(
             A=closed.A,
             B=closed.B,
@@ -188,9 +204,9 @@ class ContinuousObserver:
             inputs=tuple(f"u{i + 1}" for i in range(m)) + sensor_names(C),
             outputs=tuple(outputs),
             performance=performance,
-            points=tuple(float(z) for z in pts),
+            points=pts,
             input_descriptions=input_descriptions(d.model, C),
-            output_descriptions=estimate_descriptions(d.model, tuple(float(z) for z in pts)),
+            output_descriptions=estimate_descriptions(d.model, pts),
         )
 
     def project(self, V: np.ndarray, W: np.ndarray, reduction: str) -> ContinuousObserver:

@@ -176,7 +176,7 @@ def _result(
         output_labels=nm.output_labels,
         method=plant.method,
         resolution=plant.resolution,
-        z_w=np.array(observer.points) if has_w else None,
+        z_w=np.array([f.point for f in observer.points]) if has_w else None,
         w=run.target if has_w else None,
         w_hat=run.yhat[:, m:] if has_w else None,
         states=run.x,
