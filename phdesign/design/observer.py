@@ -320,26 +320,26 @@ class Observer(ObserverNoise):
         return self._copy(gain=report.gain, tuning=report)
 
     def statespace(
-        self, system: str = "error", resolution: int | None = None, *, modes: str = "all"
+        self,
+        system: str = "error",
+        resolution: int | None = None,
+        *,
+        modes: str = "all",
+        at: Any = None,
     ) -> Any:
         """Export ``"plant"``, ``"observer"`` or ``"error"`` as a ``control.StateSpace``.
 
-        The discretization is the plant's (:class:`Plant`), at ``resolution`` if given.
-        ``modes="resolved"`` keeps only the modes resolved under refinement (modal states,
-        the record attached as ``.truncation``); ``"all"`` every discrete mode.  See
-        :mod:`phdesign.numeric.statespace` for the inputs, outputs and states.
+        On the plant's discretization (at ``resolution`` if given); ``modes="resolved"`` keeps
+        the modes resolved under refinement (``.truncation`` says which), ``at`` appends point
+        outputs (``["rotation(1)"]``: ``rotation_hat(z=1)``): :mod:`phdesign.numeric.statespace`.
         """
         from phdesign.numeric import statespace as export
 
         choice(system, "system", STATESPACE_SYSTEMS, ObserverError)
         choice(modes, "modes", export.MODES, ObserverError)
-        if system == "plant":
-            return export.plant_statespace(self.plant.discrete(resolution), modes=modes)
-        C, L = self.numeric_gain("statespace")
+        C, L = (None, None) if system == "plant" else self.numeric_gain("statespace")
         d = self.plant.discrete(resolution)
-        if system == "observer":
-            return export.observer_statespace(d, C, L, modes=modes)
-        return export.error_statespace(d, C, L, modes=modes)
+        return export.design_statespace(d, system, C, L, modes=modes, at=at)
 
     # ------------------------------------------------------------------ export
     @reports_progress

@@ -20,7 +20,11 @@ All three are written in standard form with the discrete efforts ê as states
 labelled ``x1_hat(z=0p5)``: the decimal point of z is written ``p`` because
 python-control refuses '.' in signal names), ``"effort"`` (``e1_hat(z=1)``),
 ``"displacement"`` (``w_hat(z=1)``, models with a displacement), or
-``"coefficients"`` (the discrete states themselves, ``hat_e1[3]``).
+``"coefficients"`` (the discrete states themselves, ``hat_e1[3]``).  ``at`` appends
+point outputs of any field the model declares, named as the displacement is:
+``at=["rotation(1)"]`` gives ``rotation(z=1)`` (plant), ``rotation_hat(z=1)`` (observer),
+``rotation_err(z=1)`` (error) (:mod:`phdesign.numeric.discretization.points`; a number is
+the displacement there).
 
 **Untrustworthy modes.**  ``modes="resolved"`` returns the modal truncation to the
 eigenvalues resolved under refinement (:mod:`phdesign.numeric.sampled.modal`: eigenvalues at p
@@ -50,6 +54,8 @@ import numpy as np
 
 from phdesign.core.errors import NumericError
 from phdesign.numeric.discretization.phs import DiscretePHS, feedback_matrix
+from phdesign.numeric.discretization.points import point_outputs as read_point_outputs
+from phdesign.numeric.discretization.points import point_rows
 from phdesign.numeric.sampled.samplers import sensor_names
 from phdesign.numeric.signals import estimate_descriptions, input_descriptions, port_description
 
@@ -57,6 +63,7 @@ __all__ = [
     "MODES",
     "QUANTITIES",
     "control_signal_name",
+    "design_statespace",
     "error_statespace",
     "observer_statespace",
     "plant_statespace",
@@ -181,11 +188,15 @@ def _described(inputs: Sequence[str], outputs: Sequence[str], system: Any) -> An
 
 
 def _extra_outputs(
-    d: DiscretePHS, quantity: str | None, z: Any, suffix: str
+    d: DiscretePHS, quantity: str | None, z: Any, suffix: str, at: Any = None
 ) -> tuple[np.ndarray, list[str]]:
-    if quantity is None:
-        return np.zeros((0, d.dim)), []
-    return point_outputs(d, quantity, z, suffix)
+    """Rows and labels of ``quantity`` at ``z`` (none without it), then of ``at``."""
+    rows, labels = (
+        (np.zeros((0, d.dim)), []) if quantity is None else point_outputs(d, quantity, z, suffix)
+    )
+    fields = read_point_outputs(d.model, at, "at")
+    named = [f"{f.field_name}{suffix}(z={_point_name(float(f.point or 0))})" for f in fields]
+    return np.vstack([rows, point_rows(d, fields)]), labels + named
 
 
 def plant_statespace(
@@ -195,14 +206,15 @@ def plant_statespace(
     modes: str = "all",
     quantity: str | None = None,
     z: Sequence[float] | np.ndarray | None = None,
+    at: Any = None,
 ) -> Any:
     """Return the discretized plant as ``control.StateSpace`` (inputs u, outputs y).
 
-    ``quantity``/``z`` append physical outputs (module docstring); ``modes="resolved"``
-    keeps the resolved modes only.
+    ``quantity``/``z`` append physical outputs, ``at`` point outputs of the model's fields
+    (module docstring); ``modes="resolved"`` keeps the resolved modes only.
     """
     m = d.n_ports
-    rows, labels = _extra_outputs(d, quantity, z, "")
+    rows, labels = _extra_outputs(d, quantity, z, "", at)
     ports = [port_description(d.model, "u", i) for i in range(m)]
     outputs = [port_description(d.model, "y", i) for i in range(m)] + labels
     return _described(
@@ -232,12 +244,14 @@ def observer_statespace(
     modes: str = "all",
     quantity: str = "state",
     z: Sequence[float] | np.ndarray | None = None,
+    at: Any = None,
 ) -> Any:
     """Return the observer as ``control.StateSpace``: inputs (u, y_m), outputs (ŷ, estimates).
 
     The outputs are the estimated model outputs ``yhat1..`` followed by the estimate of
     ``quantity`` at the points ``z`` (default: the state x at both ends and the
-    midpoint; ``quantity="coefficients"`` gives the discrete states ê_obs).
+    midpoint; ``quantity="coefficients"`` gives the discrete states ê_obs), then the
+    estimates of the point outputs ``at`` (``rotation_hat(z=1)``).
     """
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
     Lm = np.atleast_2d(np.asarray(L, dtype=float))
@@ -245,7 +259,7 @@ def observer_statespace(
     loop = d.close(K)
     m, q = d.n_ports, C.shape[0]
     In = np.hstack([np.eye(m), C.T @ Lm])  # v = u + C_m^T L y_m = In [u; y_m]
-    rows, labels = point_outputs(d, quantity, z, "_hat")
+    rows, labels = _extra_outputs(d, quantity, z, "_hat", at)
     outputs = [*estimate_descriptions(d.model), *labels]
     return _described(
         input_descriptions(d.model, C),
@@ -274,15 +288,17 @@ def error_statespace(
     modes: str = "all",
     quantity: str | None = None,
     z: Sequence[float] | np.ndarray | None = None,
+    at: Any = None,
 ) -> Any:
     """Return the observer error system as ``control.StateSpace`` (no input, output ỹ).
 
-    ``quantity``/``z`` append the estimation error of a physical quantity at points.
+    ``quantity``/``z`` append the estimation error of a physical quantity at points, ``at``
+    that of point outputs of the model's fields (``rotation_err(z=1)``).
     """
     K = feedback_matrix(np.atleast_2d(np.asarray(C_m, dtype=float)), L, d.n_ports)
     loop = d.close(K)
     m, n = d.n_ports, d.dim
-    rows, labels = _extra_outputs(d, quantity, z, "_err")
+    rows, labels = _extra_outputs(d, quantity, z, "_err", at)
     errors = [f"y_err{i + 1} = error of {port_description(d.model, 'y', i)}" for i in range(m)]
     return _described(
         [],
@@ -300,3 +316,25 @@ def error_statespace(
             name=name,
         ),
     )
+
+
+def design_statespace(
+    d: DiscretePHS,
+    system: str,
+    C_m: np.ndarray | None,
+    L: np.ndarray | None,
+    *,
+    modes: str = "all",
+    at: Any = None,
+) -> Any:
+    """Return ``"plant"``, ``"observer"`` or ``"error"`` of a design (``Observer.statespace``).
+
+    The plant needs no ``C_m`` and ``L``; ``at`` appends point outputs (module docstring).
+    """
+    if system == "plant":
+        return plant_statespace(d, modes=modes, at=at)
+    if C_m is None or L is None:
+        raise NumericError(f"the {system} system needs the sensors C_m and the gain L")
+    if system == "observer":
+        return observer_statespace(d, C_m, L, modes=modes, at=at)
+    return error_statespace(d, C_m, L, modes=modes, at=at)
