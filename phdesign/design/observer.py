@@ -29,18 +29,18 @@ The observer implemented is the paper's:
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import sympy
 
-from phdesign.core.checks import choice
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, ObserverError
 from phdesign.core.progress import Progress, reports_progress
 from phdesign.core.text import REPR_LIMIT, html_table, matrix_text, sensors_text, shorten
+from phdesign.design.export import STATESPACE_SYSTEMS, ObserverExport
 from phdesign.design.noise import ObserverNoise
 from phdesign.design.plant import Plant, numeric_matrix
 from phdesign.symbolic.feedback import external_numbering
@@ -50,7 +50,8 @@ from phdesign.symbolic.observer import gain_matrix, observer_sensors
 if TYPE_CHECKING:  # pragma: no cover - typing only
     import numpy as np
 
-    from phdesign.numeric.sampled.export import SampledObserver
+    from phdesign.numeric.spectrum.drift import PairSpectrum
+    from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
     from phdesign.numeric.spectrum.report import SpectrumReport
     from phdesign.numeric.time.options import SimulationOptions
     from phdesign.numeric.time.result import SimulationResult
@@ -59,12 +60,9 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 __all__ = ["STATESPACE_SYSTEMS", "Observer", "Plant", "numeric_matrix"]
 
-#: The systems :meth:`Observer.statespace` exports.
-STATESPACE_SYSTEMS = ("plant", "observer", "error")
-
 
 @dataclass(frozen=True, init=False, repr=False)
-class Observer(ObserverNoise):
+class Observer(ObserverNoise, ObserverExport):
     r"""A boundary observer for a model: sensors :math:`C_m` and gain :math:`L`.
 
     Parameters
@@ -279,6 +277,88 @@ class Observer(ObserverNoise):
         opts = self.plant.simulation_options(options, **settings)
         return self.plant.run(C, L, x0, xhat0=xhat0, u=u, options=opts, labels=self.labels())
 
+    def abscissas(
+        self, gains: Iterable[Any], *, resolution: int | tuple[int, int] | None = None
+    ) -> np.ndarray:
+        r"""Return the error system's spectral abscissa at many gains, for these sensors.
+
+        Each value is the abscissa :meth:`spectrum` reports at the first pair of its
+        refinement, without refining: the drift test and the rules of
+        :mod:`phdesign.numeric.spectrum.abscissa` at one fixed pair of resolutions, the pair
+        discretized once per observer (a gain map, a search of one's own, a scan).
+
+        Parameters
+        ----------
+        gains : iterable of gains
+            Each a number (every sensor), a sequence (the diagonal) or a ``q x q`` matrix.
+        resolution : int or (int, int), optional
+            The pair ``(p, p_fine)``, or ``p`` for ``(p, ⌈1.5 p⌉)``; default: the start of
+            the spectrum's refinement (:mod:`phdesign.core.defaults`).
+
+        Returns
+        -------
+        ndarray of float
+            One abscissa per gain (``-inf``: empty spectrum, ``nan``: unresolved).
+
+        Examples
+        --------
+        >>> import math
+        >>> from phdesign.models import load_builtin
+        >>> string = Observer(load_builtin("wave"), sensors=[2])
+        >>> string.abscissas([0.5, [3.0]], resolution=(20, 30)).round(10).tolist()
+        [-0.5493061443, -0.3465735903]
+        >>> round(0.5 * math.log(1 / 3), 10)  # the exact damper at k = 0.5
+        -0.5493061443
+        """
+        evaluator = self._evaluator(resolution)
+        return evaluator.abscissas([self._gain_array(g) for g in gains])
+
+    def pair(self, gain: Any, *, resolution: int | tuple[int, int] | None = None) -> PairSpectrum:
+        """Return the error system's eigenvalues at one gain and a fixed resolution pair.
+
+        What :meth:`abscissas` reads at that gain: ``.eigenvalues`` at the finer
+        resolution (in the model's time unit), ``.resolved`` (agrees with the coarser),
+        ``.coarse``; ``gain`` and ``resolution`` as there.
+        """
+        return self._evaluator(resolution).pair(self._gain_array(gain))
+
+    def _evaluator(self, resolution: int | tuple[int, int] | None) -> AbscissaEvaluator:
+        from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
+
+        self._need_sensors("abscissas")
+        if resolution is None:
+            order = self.plant.numeric.order
+            resolution = current().discretization(str(self.plant.method), order).spectrum_start
+        key: tuple[int, int] | int = (
+            (int(resolution[0]), int(resolution[1]))
+            if isinstance(resolution, tuple | list)
+            else int(resolution)
+        )
+        if key not in self._evaluators:
+            C = numeric_matrix(self.C_m, "C_m", "abscissas")
+            self._evaluators[key] = AbscissaEvaluator(
+                self.plant.numeric, C, key, method=self.plant.method
+            )
+        return self._evaluators[key]
+
+    @cached_property
+    def _evaluators(self) -> dict[tuple[int, int] | int, AbscissaEvaluator]:
+        return {}  # one per resolution pair: the discretizations are built once
+
+    def _gain_array(self, gain: Any) -> np.ndarray:
+        """Return a numeric gain as the ``q x q`` array (a number, a diagonal or the matrix)."""
+        import numpy as np
+
+        L = np.asarray(gain, dtype=float)
+        if L.ndim < 2:
+            L = np.diag(np.broadcast_to(L, (self.q,)).copy()) if L.size in (1, self.q) else L
+        if L.shape != (self.q, self.q):
+            raise ArgumentError(
+                f"gain: expected a number, {self.q} numbers or a {self.q} x {self.q} matrix; "
+                f"found shape {L.shape}"
+            )
+        return L
+
     def tune(
         self,
         *,
@@ -318,127 +398,6 @@ class Observer(ObserverNoise):
             progress=progress,
         )
         return self._copy(gain=report.gain, tuning=report)
-
-    def statespace(
-        self,
-        system: str = "error",
-        resolution: int | None = None,
-        *,
-        modes: str = "all",
-        at: Any = None,
-    ) -> Any:
-        """Export ``"plant"``, ``"observer"`` or ``"error"`` as a ``control.StateSpace``.
-
-        On the plant's discretization (at ``resolution`` if given); ``modes="resolved"`` keeps
-        the modes resolved under refinement (``.truncation`` says which), ``at`` appends point
-        outputs (``["rotation(1)"]``: ``rotation_hat(z=1)``): :mod:`phdesign.numeric.statespace`.
-        """
-        from phdesign.numeric import statespace as export
-
-        choice(system, "system", STATESPACE_SYSTEMS, ObserverError)
-        choice(modes, "modes", export.MODES, ObserverError)
-        C, L = (None, None) if system == "plant" else self.numeric_gain("statespace")
-        d = self.plant.discrete(resolution)
-        return export.design_statespace(d, system, C, L, modes=modes, at=at)
-
-    # ------------------------------------------------------------------ export
-    @reports_progress
-    def export(
-        self,
-        *,
-        dt: float,
-        sampler: str | None = None,
-        order: int | None = None,
-        reduction: str = "none",
-        tol: float | None = None,
-        output_tol: float | None = None,
-        verify: bool = False,
-        strict: bool = False,
-        x0: str | Callable[[Any], Any] | None = None,
-        t_end: float | None = None,
-        plant_resolution: int | None = None,
-        points: float | str | Sequence[float | str] | None = None,
-        progress: Progress | None = None,
-    ) -> SampledObserver:
-        r"""Return the observer a controller runs: finite order, sampled every ``dt``.
-
-        .. math::
-
-            \hat x_{k+1} = A \hat x_k + B v_k, \qquad \hat y_k = C \hat x_k + D v_k,
-            \qquad v_k = (u_k;\ y_{m,k}),
-
-        exact for the declared sampler: ``"average"`` (the mean of :math:`y_m` over each
-        period; its error system is dissipative for every period) or ``"point"``
-        (samples :math:`y_m(t_k)`, which alias a boundary velocity's unresolved content):
-        :func:`phdesign.numeric.sampled.export.export_observer`.  The observer is a
-        Legendre-Galerkin one whatever the plant's ``method``; its order is chosen from
-        ``tol`` and ``output_tol`` unless given.
-
-        Parameters
-        ----------
-        dt : float
-            Sampling period (s).
-        sampler : {"average", "point"}, optional
-            Default ``"average"``; this and every default are the export's
-            (:mod:`phdesign.core.defaults`).
-        order : int, optional
-            Observer states (default: the smallest that meets the targets).
-        reduction : {"none", "modal", "balanced"}
-        tol, output_tol : float
-            Relative accuracy of the rightmost error eigenvalues; error floor of the
-            performance outputs relative to their peak.
-        verify : bool
-            Run the exported observer against a high-resolution plant.
-        strict : bool
-            Verify (``verify`` implied) and raise
-            :class:`~phdesign.core.errors.VerificationError` naming each failed check
-            (targets, sampled against continuous, the plant's resolution).
-        x0 : str or callable, optional
-            Plant initial state of those runs (``"x1: 0, x2: z - 0.9"``, or a function of z).
-        t_end : float
-        plant_resolution : int, optional
-            Galerkin degree of the verification plant.
-        points : sequence of float or str, optional
-            Point outputs: ``w(z)`` at numbers, named fields as ``"rotation(1)"`` (default b).
-        progress : callable, optional
-            Called with one line of text at each stage (:mod:`phdesign.core.progress`).
-
-        Returns
-        -------
-        SampledObserver
-            ``.A, .B, .C, .D``, ``.inputs``, ``.outputs``, ``.statespace()``,
-            ``.write(path, "json" | "c" | "npz" | "statespace")``.
-
-        Examples
-        --------
-        >>> from phdesign.models import load_builtin
-        >>> string = Observer(load_builtin("wave"), sensors=[2], gain=0.5)
-        >>> sampled = string.export(dt=1e-2, order=12)
-        >>> sampled.order, sampled.inputs, sampled.sampler
-        (12, ('u1', 'u2', 'y2'), 'average')
-        """
-        from phdesign.numeric.sampled.export import export_observer
-
-        C, L = self.numeric_gain("export")
-        return export_observer(
-            self.plant.numeric,
-            C,
-            L,
-            dt=dt,
-            sampler=sampler,
-            order=order,
-            reduction=reduction,
-            tol=tol,
-            output_tol=output_tol,
-            verify=verify,
-            strict=strict,
-            x0=self.plant.initial_state(x0, "x0"),
-            x0_text=x0 if isinstance(x0, str) else None,
-            t_end=t_end,
-            plant_resolution=plant_resolution,
-            points=points,
-            model_name=self.model.name,
-        )
 
     # ------------------------------------------------------------------ display
     def labels(self) -> dict[str, str]:
