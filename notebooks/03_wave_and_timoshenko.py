@@ -22,35 +22,14 @@
 # %%
 import numpy as np
 
+import phdesign as phd
 from phdesign import plots
-from phdesign.models import load_builtin
-from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.spectrum.converged import spectrum
-from phdesign.numeric.time.options import SimulationOptions
-from phdesign.numeric.time.simulation import simulate
-from phdesign.symbolic.classify import classify
-from phdesign.symbolic.observer import gain_matrix, sensor_matrix
-from phdesign.symbolic.search import search_sensors
 
-# %% [markdown]
-# ## The wave: the error system is a string with a damper
-#
-# `wave` has inputs $e_1(0)$ (velocity), $e_2(1)$ (stress) and outputs $-e_2(0)$,
-# $e_1(1)$. Measuring $y_2 = e_1(1)$ with gain $k$ gives the error boundary condition
-# $\tilde e_2(1) = -k\, \tilde e_1(1)$, i.e. $\tilde u_z(1) = -k\, \tilde u_t(1)$ with
-# $\tilde u(0) = 0$: the string with a damper at its end. Its spectrum is known exactly:
-# $\tfrac12 \ln|(1-k)/(1+k)| + i(m + \tfrac12)\pi$ for $k < 1$, $+\, i m \pi$ for $k > 1$,
-# and empty for $k = 1$ (the damper matches the impedance: every wave is absorbed in finite
-# time).
-
-# %%
-wave = load_builtin("wave")
-verdict = classify(wave, sensor_matrix([2], 2), gain_matrix("symbolic", 1))
+wave = phd.load("wave")
+verdict = phd.Observer(wave, sensors=[2], gain="symbolic").classify()
 print("sensor y2, symbolic gain:", verdict.verdict, "|", verdict.result("3.2", 2).reason)
 assert verdict.verdict == "exponential"
-nm_wave = to_numeric(wave)
-C2 = np.array([[0.0, 1.0]])
+string = phd.Observer(wave, sensors=[2])  # y2 = u_t(1); a gain per question below
 
 
 def exact_abscissa(k):
@@ -61,7 +40,7 @@ def exact_abscissa(k):
 gains = np.array([0.1, 0.2, 0.35, 0.5, 0.7, 0.85, 0.95, 1.05, 1.2, 1.5, 2.0, 3.0, 5.0])
 computed = []
 for k in gains:
-    rep = spectrum(nm_wave, C2, np.array([[k]]))
+    rep = string.with_gain(float(k)).spectrum()
     computed.append(rep.spectral_abscissa if rep.converged else np.nan)
 computed = np.array(computed)
 errors = np.abs(computed - exact_abscissa(gains))
@@ -78,7 +57,7 @@ fig
 # does not invent a number for it:
 
 # %%
-matched = spectrum(nm_wave, C2, np.array([[1.0]]))
+matched = string.with_gain(1.0).spectrum()
 print("k = 1: unbounded below:", matched.unbounded_below, "| abscissa:", matched.spectral_abscissa)
 print(matched.warnings[0])
 assert matched.unbounded_below
@@ -90,7 +69,7 @@ assert matched.unbounded_below
 # semi-discretization), which is why only resolved eigenvalues count.
 
 # %%
-rep = spectrum(nm_wave, C2, np.array([[0.5]]))
+rep = string.with_gain(0.5).spectrum()
 p, p_fine = rep.resolutions
 m = np.arange(-12, 12)
 exact = exact_abscissa(0.5) + 1j * (m + 0.5) * np.pi
@@ -111,8 +90,8 @@ print(f"{rep.n_resolved} of {rep.n_total} eigenvalues resolved at degrees {p} an
 # subset.
 
 # %%
-timo = load_builtin("timoshenko")
-found = search_sensors(timo, gain=1)
+timo = phd.load("timoshenko")
+found = phd.search_sensors(timo, gain=1)
 print("minimal sensor sets:", found.minimal)
 assert found.minimal["exponential"] == ((1, 2), (3, 4))
 
@@ -122,16 +101,14 @@ assert found.minimal["exponential"] == ((1, 2), (3, 4))
 # energies. Inconclusive is not unstable: the propositions are sufficient conditions.
 
 # %%
-nm_timo = to_numeric(timo)
-x0 = initial_state_function("x1: sin(pi*z), x3: z*(1 - z)", nm_timo, model=timo)
+timo_plant = phd.Plant(timo)  # one numeric model for both designs
+x0 = "x1: sin(pi*z), x3: z*(1 - z)"
 designs = {"{y3, y4}": (3, 4), "{y2, y3}": (2, 3)}
 runs, reps = {}, {}
 for label, sensors in designs.items():
-    C = np.eye(4)[[s - 1 for s in sensors]]
-    reps[label] = spectrum(nm_timo, C, np.eye(2))
-    runs[label] = simulate(
-        nm_timo, C, np.eye(2), x0=x0, options=SimulationOptions(t_end=10.0, samples=401)
-    )
+    obs = phd.Observer(timo_plant, sensors=list(sensors), gain=1)
+    reps[label] = obs.spectrum()
+    runs[label] = obs.simulate(x0=x0, t_end=10.0, samples=401)
     verdict = found.subset(sensors).verdict
     # below its resolved floor H̃ is made of unresolved modes: time_below() then says None
     times = [runs[label].time_below(r) for r in (1e-2, 1e-4)]

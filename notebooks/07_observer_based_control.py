@@ -32,12 +32,11 @@
 # %%
 import numpy as np
 
+import phdesign as phd
 from phdesign import plots
-from phdesign.design.loop import Loop
-from phdesign.models import load_builtin
 
-beam = load_builtin("euler-bernoulli")
-loop = Loop(beam, actuate=3, feedback=1, sensors=[4], gain=1, parameters={"d": 0})
+beam = phd.load("euler-bernoulli")
+loop = phd.Loop(beam, actuate=3, feedback=1, sensors=[4], gain=1, parameters={"d": 0})
 print(loop)
 
 # %% [markdown]
@@ -86,7 +85,7 @@ fig
 # plant.
 
 # %%
-ideal = Loop(
+ideal = phd.Loop(
     beam,
     actuate=3,
     feedback=1,
@@ -96,7 +95,7 @@ ideal = Loop(
     feedback_source="measured",
     resolution=24,
 )
-estimated = Loop(
+estimated = phd.Loop(
     beam, actuate=3, feedback=1, sensors=[4], gain=1, parameters={"d": 0}, resolution=24
 )
 x0 = "x1: 0, x2: z - 0.9"
@@ -158,7 +157,7 @@ assert tuned.limited_by == "plant"
 # system too, and so is the loop.
 
 # %%
-certified = Loop(beam, actuate=4, feedback=1, sensors=[2], gain=1).classify()
+certified = phd.Loop(beam, actuate=4, feedback=1, sensors=[2], gain=1).classify()
 print(certified.plant.verdict, certified.error.verdict, "->", certified.verdict)
 print(certified.reason)
 assert certified.verdict == "exponential"
