@@ -26,18 +26,11 @@ import math
 
 import numpy as np
 
+import phdesign as phd
 from phdesign import plots
-from phdesign.models import load_builtin
-from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretization.registry import discretize, feedback_matrix
-from phdesign.numeric.spectrum.converged import eigen, spectrum
-from phdesign.symbolic.classify import classify
-from phdesign.symbolic.observer import gain_matrix, sensor_matrix
-from phdesign.symbolic.ports import derive_ports
-from phdesign.symbolic.search import search_sensors
 
-airy = load_builtin("airy")
-ports = derive_ports(airy)
+airy = phd.load("airy")
+ports = phd.derive_ports(airy)
 print("Q =", ports.Q.tolist())
 print("identities:", ports.identities)
 assert all(v == 0 for v in ports.identities.values())
@@ -51,7 +44,7 @@ assert all(v == 0 for v in ports.identities.values())
 # escapes.
 
 # %%
-full = classify(airy, sensor_matrix([1, 2, 3], 3), gain_matrix("symbolic", 3))
+full = phd.Observer(airy, sensors=[1, 2, 3], gain="symbolic").classify()
 print("sensors y1, y2, y3:", full.verdict)
 for r in full.results:
     print(f"  {r.proposition}.{r.variant}: applicable={r.applicable}, {r.reason}")
@@ -59,12 +52,12 @@ assert full.verdict == "asymptotic"
 assert full.result("3.1", 1).holds
 assert full.result("3.1", 2).holds
 assert not any(r.applicable for r in full.results if r.proposition != "3.1")
-one = classify(airy, sensor_matrix([1], 3), gain_matrix(1, 1))
+one = phd.Observer(airy, sensors=[1], gain=1).classify()
 print("sensor y1 only:", one.verdict, "|", one.result("3.1", 1).reason)
 assert one.verdict == "inconclusive"
 
 # %%
-found = search_sensors(airy, gain=1)
+found = phd.search_sensors(airy, gain=1)
 for s in found.subsets:
     print(f"  sensors {s.sensors}: {s.verdict:12} best {s.best}, κ* = {s.kappa}")
 print("minimal sets:", found.minimal)
@@ -77,8 +70,8 @@ assert found.minimal["exponential"] == ()
 # The plant ($u = 0$) is conservative: its eigenvalues lie on the imaginary axis.
 
 # %%
-nm = to_numeric(airy)
-plant = spectrum(nm)
+airy_plant = phd.Plant(airy)  # one numeric model for every design below
+plant = airy_plant.spectrum()
 print(
     f"plant: spectral abscissa {plant.spectral_abscissa:.2e} (converged {plant.converged}); "
     f"rightmost {plant.rightmost[:3]}"
@@ -97,10 +90,10 @@ assert abs(plant.spectral_abscissa) < 1e-8
 DEGREES = (10, 20, 30)
 
 
-def agreed_eigenvalues(C, L, tol=1e-3):
+def agreed_eigenvalues(obs, tol=1e-3):
     """Eigenvalues at the finest degree that match one at every coarser degree within tol."""
-    K = feedback_matrix(C, L, nm.n_ports)
-    sets = [eigen(discretize(nm, "galerkin", p), K)[0] for p in DEGREES]
+    low, high = obs.pair(1, resolution=DEGREES[:2]), obs.pair(1, resolution=DEGREES[1:])
+    sets = [low.coarse, low.eigenvalues, high.eigenvalues]  # degrees 10, 20 and 30
     sets = [lam[np.isfinite(lam)] for lam in sets]
     finest = sets[-1]
     keep = np.ones(finest.size, dtype=bool)
@@ -112,10 +105,9 @@ def agreed_eigenvalues(C, L, tol=1e-3):
 
 rows = {}
 for sensors in [(1,), (2,), (3,), (1, 3), (2, 3), (1, 2, 3)]:
-    C = np.eye(3)[[s - 1 for s in sensors]]
-    L = np.eye(len(sensors))
-    rep = spectrum(nm, C, L)
-    lam, keep = agreed_eigenvalues(C, L)
+    obs = phd.Observer(airy_plant, sensors=list(sensors), gain=1)  # L = I
+    rep = obs.spectrum()
+    lam, keep = agreed_eigenvalues(obs)
     agreed = lam[keep]
     alpha = float(np.max(agreed.real)) if agreed.size else math.nan
     rows[sensors] = (found.subset(sensors).verdict, rep, alpha, lam, keep)
