@@ -28,24 +28,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.optimize import minimize
 
+import phdesign as phd
 from phdesign import plots
-from phdesign.models import load_builtin
-from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.inputs import initial_state_function
-from phdesign.numeric.spectrum.converged import spectrum
-from phdesign.numeric.spectrum.evaluator import AbscissaEvaluator
-from phdesign.numeric.time.options import SimulationOptions
-from phdesign.numeric.time.simulation import simulate
-from phdesign.numeric.tuning.search import tune
-from phdesign.symbolic.classify import classify
-from phdesign.symbolic.observer import gain_matrix, sensor_matrix
-from phdesign.symbolic.ports import derive_ports
-from phdesign.symbolic.search import search_sensors
 
-beam = load_builtin("euler-bernoulli")
+beam = phd.load("euler-bernoulli")
 print(beam.description)
 print("parameters:", {str(s): v for s, v in beam.parameters})
-ports = derive_ports(beam)
+ports = phd.derive_ports(beam)
 print("identities (max |entry|, exact):", ports.identities)
 assert all(v == 0 for v in ports.identities.values())
 
@@ -61,8 +50,7 @@ assert all(v == 0 for v in ports.identities.values())
 # $y_3 = \partial_z e_1(1)$ is $l_1$); the exact constant carries $l_1$.
 
 # %%
-C_sym = sensor_matrix([3, 4], 4)
-two = classify(beam, C_sym, gain_matrix("symbolic", 2))
+two = phd.Observer(beam, sensors=[3, 4], gain="symbolic").classify()
 print("verdict:", two.verdict)
 for r in two.results:
     if r.applicable:
@@ -70,7 +58,7 @@ for r in two.results:
 assert two.verdict == "exponential"
 assert two.result("3.4", 3).holds
 assert not two.result("3.3", 3).holds
-three = classify(beam, sensor_matrix([2, 3, 4], 4), gain_matrix("symbolic", 3))
+three = phd.Observer(beam, sensors=[2, 3, 4], gain="symbolic").classify()
 print(
     "three sensors (y2, y3, y4):", three.verdict, "via 3.3.3, κ* =", three.result("3.3", 3).kappa
 )
@@ -84,12 +72,13 @@ assert three.result("3.3", 3).holds
 # left at zero), so the tip-velocity sensor alone already certifies exponential convergence.
 
 # %%
-found = search_sensors(beam)
+found = phd.search_sensors(beam)
 print("minimal sensor sets per verdict:", found.minimal)
 alone = found.subset((4,))
 print(f"y4 alone: {alone.verdict} via {alone.best}")
 assert alone.verdict == "exponential"
-alpha_y4 = spectrum(to_numeric(beam), np.array([[0.0, 0.0, 0.0, 1.0]]), np.eye(1))
+plant = phd.Plant(beam)  # the numeric model, made once for every design below
+alpha_y4 = phd.Observer(plant, sensors=[4], gain=1).spectrum()
 print(f"y4 alone, L = 1: error spectral abscissa {alpha_y4.spectral_abscissa:.4f}")
 
 # %% [markdown]
@@ -101,25 +90,19 @@ print(f"y4 alone, L = 1: error spectral abscissa {alpha_y4.spectral_abscissa:.4f
 # the discretization.
 
 # %%
-nm = to_numeric(beam)
-C = np.array(C_sym.tolist(), dtype=float)
-x0 = initial_state_function("x1: 0, x2: z - 0.9", nm, model=beam)
+observers = phd.Observer(plant, sensors=[3, 4])  # y3, y4; a gain per design
+x0 = "x1: 0, x2: z - 0.9"
 designs = {"design 1": (0.03, 0.3), "design 2": (0.1, 1.0), "design 3": (0.2, 2.0)}
 z_w = np.linspace(0.0, 1.0, 41)
 T_END, SAMPLES = 8.0, 801
 runs = {
-    name: simulate(
-        nm, C, np.diag(g), x0=x0, options=SimulationOptions(t_end=T_END, samples=SAMPLES, z_w=z_w)
-    )
+    name: observers.with_gain(list(g)).simulate(x0=x0, t_end=T_END, samples=SAMPLES, z_w=z_w)
     for name, g in designs.items()
 }
+plant_fd = phd.Plant(beam, method="fd")  # the paper's staggered finite differences
 runs_fd = {
-    name: simulate(
-        nm,
-        C,
-        np.diag(g),
-        x0=x0,
-        options=SimulationOptions(t_end=T_END, samples=SAMPLES, method="fd"),
+    name: phd.Observer(plant_fd, sensors=[3, 4], gain=list(g)).simulate(
+        x0=x0, t_end=T_END, samples=SAMPLES
     )
     for name, g in designs.items()
 }
@@ -183,7 +166,7 @@ assert t_superpose < 1.2
 # $|\tilde w(1, 0)|$) and its number of sign changes.
 
 # %%
-reports = {name: spectrum(nm, C, np.diag(g)) for name, g in designs.items()}
+reports = {name: observers.with_gain(list(g)).spectrum() for name, g in designs.items()}
 table = {}
 for name, g in designs.items():
     rep, res = reports[name], runs[name]
@@ -263,9 +246,7 @@ for ax, (name, g) in zip(axes7, designs.items(), strict=True):
 # 3,4 --grid l1=... --grid l2=... -o map.zarr`.
 
 # %%
-import phdesign
-
-gain_map = phdesign.sweep(
+gain_map = phd.sweep(
     beam,
     sensors=[3, 4],
     grid={"l1": f"{10**-2.5!r}:1:24:log", "l2": f"{10**-1.5!r}:{10**1.3!r}:24:log"},
@@ -273,7 +254,7 @@ gain_map = phdesign.sweep(
     scheduler="synchronous",
     progress=False,
 )
-print(phdesign.sweep.summarize(gain_map))
+print(phd.sweep.summarize(gain_map))
 l1_grid, l2_grid = gain_map.l1.values, gain_map.l2.values
 alpha_map = gain_map.spectral_abscissa.transpose("l2", "l1").values
 j, i = np.unravel_index(np.nanargmin(alpha_map), alpha_map.shape)
@@ -284,20 +265,24 @@ print(
 assert int(gain_map.unbounded_below.sum()) == 0
 
 # each point is what spectrum() reports at that gain (the same refinement, at the same
-# degrees), and the evaluator used below for single gains agrees at the first pair
-evaluator = AbscissaEvaluator(nm, C, (20, 30))
-for jj, ii in [(j, i), (0, 0), (23, 23), (7, 13)]:
-    L_point = np.diag([l1_grid[ii], l2_grid[jj]])
-    report = spectrum(nm, C, L_point, resolution=20, max_resolution=30)
+# degrees), and Observer.abscissas, used below for single gains, agrees at the first pair
+PAIR = (20, 30)
+checked = [(j, i), (0, 0), (23, 23), (7, 13)]
+at_20 = phd.Observer(phd.Plant(beam, resolution=20), sensors=[3, 4])
+for jj, ii in checked:
+    report = at_20.with_gain([l1_grid[ii], l2_grid[jj]]).spectrum(max_resolution=30)
     assert alpha_map[jj, ii] == report.spectral_abscissa
+points = observers.abscissas([(l1_grid[ii], l2_grid[jj]) for jj, ii in checked], resolution=PAIR)
+assert np.array_equal(points, [alpha_map[jj, ii] for jj, ii in checked], equal_nan=True)
 
-tuned = tune(nm, C)
+tuned_observer = observers.tune(starts=3)  # the numeric tuner's three starts
+tuned = tuned_observer.tuning
 g_tuned = tuple(float(x) for x in np.diag(tuned.gain))
 print(tuned)
 
-# A cross-check of tune's optimum: Nelder-Mead on the evaluator from the best grid point.
+# A cross-check of tune's optimum: Nelder-Mead on the abscissa from the best grid point.
 best = minimize(
-    lambda s: evaluator(np.diag(np.exp(s))),
+    lambda s: observers.abscissas([np.exp(s)], resolution=PAIR)[0],
     np.log([l1_grid[i], l2_grid[j]]),
     method="Nelder-Mead",
     options={"xatol": 1e-6, "fatol": 1e-9, "maxiter": 400},
@@ -308,9 +293,7 @@ print(
     f"alpha = {best.fun:.4f}; tune: alpha = {tuned.spectral_abscissa:.6f} at a coalescence "
     f"of {tuned.coalescence.size} eigenvalues"
 )
-run_tuned = simulate(
-    nm, C, tuned.gain, x0=x0, options=SimulationOptions(t_end=T_END, samples=SAMPLES, z_w=z_w)
-)
+run_tuned = tuned_observer.simulate(x0=x0, t_end=T_END, samples=SAMPLES, z_w=z_w)
 print(
     f"H̃/H̃(0) < 1e-2 at {run_tuned.time_below(1e-2):.2f} s and < 1e-4 at "
     f"{run_tuned.time_below(1e-4):.2f} s with the tuned gain "
@@ -361,7 +344,7 @@ fig8
 l2_scan = np.linspace(1.0, 1.6, 121)
 l2_critical = None
 for l2 in l2_scan:
-    lam = evaluator.pair(np.diag([0.1, l2])).eigenvalues
+    lam = observers.pair([0.1, l2], resolution=PAIR).eigenvalues
     lam = lam[np.isfinite(lam) & (np.abs(lam) < 10.0)]
     if lam.size and np.max(np.abs(lam.imag)) < 1e-3:
         l2_critical = float(l2)
