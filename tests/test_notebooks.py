@@ -9,6 +9,7 @@ the notebook discusses. Budget: all notebooks together within 5 minutes (issue 6
 
 from __future__ import annotations
 
+import ast
 import json
 import sys
 import time
@@ -35,6 +36,73 @@ NEEDS = {
     "02_euler_bernoulli_paper": (("dask", "xarray", "zarr"), "sweep"),
     "06_implementation": (("jinja2", "slycot"), "codegen,reduce"),
 }
+
+
+#: What a notebook may import of phdesign: the flat namespace the README teaches and the
+#: public subpackages (figures and sweeps); the layers below the design objects are private.
+PUBLIC_MODULES = {"phdesign", "phdesign.plots", "phdesign.sweep"}
+
+
+def private_imports(source: str) -> list[str]:
+    """Return each import of a private phdesign module in ``source`` (and its line)."""
+    import phdesign
+
+    public = set(phdesign.__all__)
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names = [node.module]
+            if node.module == "phdesign":
+                names += [f"phdesign.{a.name}" for a in node.names if a.name not in public]
+        else:
+            continue
+        found += [
+            f"line {node.lineno}: {name}"
+            for name in names
+            if name.split(".")[0] == "phdesign" and name not in PUBLIC_MODULES
+        ]
+    return found
+
+
+def test_the_import_check_sees_every_form_of_a_private_import():
+    source = (
+        "import phdesign as phd\nfrom phdesign import Observer, plots\n"
+        "from phdesign.numeric.bridge import to_numeric\nimport phdesign.symbolic.ports\n"
+        "from phdesign import numeric\nfrom phdesign.design.loop import Loop\n"
+    )
+    assert private_imports(source) == [
+        "line 3: phdesign.numeric.bridge",
+        "line 4: phdesign.symbolic.ports",
+        "line 5: phdesign.numeric",
+        "line 6: phdesign.design.loop",
+    ]
+
+
+#: Notebooks still to be rewritten (their Monte Carlo and sampled-observer cells reach
+#: below the design objects); strict, so that a rewritten one fails here until removed.
+NOT_YET_PUBLIC = {"05_noise_tradeoff", "06_implementation"}
+
+
+@pytest.mark.parametrize(
+    "path",
+    [
+        pytest.param(
+            p,
+            marks=pytest.mark.xfail(p.stem in NOT_YET_PUBLIC, reason="not rewritten", strict=True),
+        )
+        for p in PATHS
+    ],
+    ids=[p.stem for p in PATHS],
+)
+def test_notebooks_use_the_public_api(path: Path):
+    notebook = jupytext.read(path)
+    code = [c.source for c in notebook.cells if c.cell_type == "code"]
+    found = [f"cell {i}, {hit}" for i, src in enumerate(code) for hit in private_imports(src)]
+    assert not found, (
+        f"{path.name} imports private modules (use `import phdesign as phd`): {found}"
+    )
 
 
 @pytest.fixture(scope="module")
