@@ -131,8 +131,8 @@ class ObserverExport:
 
         Examples
         --------
-        >>> from phdesign.models import load_builtin
-        >>> string = Observer(load_builtin("wave"), sensors=[2], gain=0.5)
+        >>> import phdesign as phd
+        >>> string = phd.Observer(phd.load("wave"), sensors=[2], gain=0.5)
         >>> sampled = string.export(dt=1e-2, order=12)
         >>> sampled.order, sampled.inputs, sampled.sampler
         (12, ('u1', 'u2', 'y2'), 'average')
