@@ -165,4 +165,10 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *_EXPORTS, *_SUBMODULES})
+    """Return the package's own names: its exports, its subpackages and its dunders.
+
+    Not the names this file uses to build them (``annotations``, ``importlib``, ``Any``,
+    ``TYPE_CHECKING``), which a user's tab completion would offer as phdesign's.
+    """
+    dunders = {name for name in globals() if name.startswith("__") and name.endswith("__")}
+    return sorted({*__all__, *_EXPORTS, *_SUBMODULES, *dunders})

@@ -177,13 +177,19 @@ def check_initial_state(x0: Any, nm: Any, name: str) -> None:
         )
     a, b = nm.interval
     z = np.linspace(a, b, 17)
+    expected = f"{name}(z) must return an array of shape (len(z), n) = ({z.size}, {nm.size})"
     with np.errstate(all="ignore"):
-        values = np.asarray(x0(z), dtype=float)
+        returned = x0(z)
+        try:
+            values = np.asarray(returned, dtype=float)
+        except (ValueError, TypeError):  # ragged: e.g. [0, z - 0.9], a number beside an array
+            raise NumericError(
+                f"{expected}, one row per point; found {_shapes(returned)} (a list of "
+                "components is np.column_stack([np.zeros_like(z), z - 0.9]), or give the "
+                "text 'x1: 0, x2: z - 0.9')"
+            ) from None
     if values.shape != (z.size, nm.size):
-        raise NumericError(
-            f"{name}(z) must return an array of shape (len(z), n) = ({z.size}, {nm.size}); "
-            f"found {values.shape}"
-        )
+        raise NumericError(f"{expected}; found {values.shape}")
     bad = ~np.isfinite(values)
     if bad.any():
         i, j = np.argwhere(bad)[0]
@@ -191,6 +197,22 @@ def check_initial_state(x0: Any, nm: Any, name: str) -> None:
             f"{name} must be finite on [{a:g}, {b:g}]; found {values[i, j]} in component "
             f"{j + 1} at z = {z[i]:g}"
         )
+
+
+def _shapes(value: Any) -> str:
+    """Describe a ragged return value: ``a list of 2 entries of shapes (), (17,)``."""
+    if isinstance(value, (list, tuple)):
+        shapes = ", ".join(str(np.shape(v)) if _is_array_like(v) else "?" for v in value)
+        return f"a {type(value).__name__} of {len(value)} entries of shapes {shapes}"
+    return f"a {type(value).__name__}"
+
+
+def _is_array_like(value: Any) -> bool:
+    try:
+        np.shape(value)
+    except (ValueError, TypeError):
+        return False
+    return True
 
 
 def _common(

@@ -90,7 +90,7 @@ from typing import Any
 import sympy
 
 from phdesign.core.errors import LoopError, ObserverError
-from phdesign.core.text import html_table
+from phdesign.core.text import html_table, matrix_text, sensors_text
 from phdesign.symbolic.classify import Classification, classify
 from phdesign.symbolic.closing import close_inputs
 from phdesign.symbolic.expressions import vanishes
@@ -418,14 +418,13 @@ class LoopClassification:
 
     def __str__(self) -> str:
         """Return the text ``phdesign loop classify`` prints."""
-        sensors = [[str(x) for x in row] for row in self.error.C_m.tolist()]
         act = ",".join(f"y{a}" for a in self.actuate)
         lines = [
             f"model: {self.model.name}   loop: {self._design()}",
             f"controlled plant (u_a = -K {act}, no sensors): {self.plant.verdict}",
             *_variant_lines(self.plant, plant=True),
-            f"observer error system (C_m = {sensors}, L = {self.error.L.tolist()}): "
-            f"{self.error.verdict}",
+            f"observer error system (sensors {sensors_text(self.error.C_m)}, "
+            f"L = {matrix_text(self.error.L)}): {self.error.verdict}",
             *_variant_lines(self.error, plant=False),
             f"loop: {self.verdict}: {self.reason}",
         ]

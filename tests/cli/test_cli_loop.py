@@ -57,6 +57,9 @@ def test_loop_classify_reports_the_three_verdicts(capsys):
     assert payload["feedback"] == [["1"]]
     text, _ = run(argv, capsys)
     assert text.splitlines()[-1].startswith("loop: exponential: both converge exponentially")
+    # the sensors as the classify command names them, not C_m's entries as strings (issue 28)
+    error_line = next(line for line in text.splitlines() if line.startswith("observer error"))
+    assert error_line == "observer error system (sensors y2, L = diag(1)): exponential"
 
 
 def test_loop_simulate_writes_csv_and_a_figure_and_refuses_to_overwrite(tmp_path, capsys):

@@ -64,6 +64,9 @@ def test_flat_namespace_names_every_entry_point():
     assert phd.Observer.__module__ == "phdesign.design.observer"
     assert phd.search_sensors is phd.symbolic.search.search_sensors
     assert {"load", "Observer", "classify", "port_inverse", "spectrum"} <= set(dir(phd))
+    assert set(phd.__all__) <= set(dir(phd))
+    # the names phdesign/__init__.py builds them with are not phdesign's (issue 28)
+    assert not {"annotations", "importlib", "Any", "TYPE_CHECKING"} & set(dir(phd))
     with pytest.raises(AttributeError, match="no attribute 'nope'"):
         _ = phd.nope
 

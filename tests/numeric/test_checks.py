@@ -73,3 +73,25 @@ def test_an_observer_converts_its_sensors_and_gain_to_floats_once():
     assert not L.flags.writeable
     with pytest.raises(ObserverError, match="spectrum needs numbers for L"):
         obs.with_gain("symbolic").numeric_gain("spectrum")
+
+
+@pytest.mark.parametrize(
+    ("x0", "found"),
+    [
+        # a list of components, one of them a number: numpy cannot stack it (a raw
+        # "inhomogeneous shape" ValueError before; issue 28)
+        (lambda z: [0, z - 0.9], "found a list of 2 entries of shapes (), (17,)"),
+        (lambda z: (z, z[:3]), "found a tuple of 2 entries of shapes (17,), (3,)"),
+        # components stacked the other way round: (n, m) instead of (m, n)
+        (lambda z: np.vstack([0 * z, z - 0.9]), "found (2, 17)"),
+    ],
+)
+def test_an_initial_state_of_the_wrong_shape_is_refused_naming_the_shape(x0, found):
+    obs = phd.Observer(phd.load("euler-bernoulli"), sensors=[3, 4], gain=[0.1, 1])
+    with pytest.raises(ValueError, match="x0") as error:
+        obs.simulate(x0=x0, t_end=0.1)
+    assert "x0(z) must return an array of shape (len(z), n) = (17, 2)" in str(error.value)
+    assert found in str(error.value)
+    # the same state as the check asks for it runs
+    good = obs.simulate(x0=lambda z: np.column_stack([np.zeros_like(z), z - 0.9]), t_end=0.01)
+    assert good.t.size > 0
