@@ -107,6 +107,15 @@ def test_readme_starts_with_install_and_test_commands():
     assert "steering" not in text
 
 
+def test_getting_started_installs_what_the_readme_installs():
+    # issue 28: the getting-started page gave fewer extras than the README's test command
+    readme = re.search(r"```bash\n(.*?)```", README.read_text(encoding="utf-8"), flags=re.S)
+    page = (DOCS / "getting_started.rst").read_text(encoding="utf-8")
+    block = re.search(r"\.\. code-block:: bash\n\n(.*?)\n\n", page, flags=re.S)
+    commands = [line.strip() for line in block.group(1).splitlines()]
+    assert commands == readme.group(1).strip().splitlines()
+
+
 def test_readme_is_a_front_page_whose_links_exist():
     # the structure issue: at most 6000 characters (python-control's is 4.9k, py-pde's 4.0k);
     # the manual lives in docs/, and every page the README links to exists
