@@ -38,3 +38,6 @@ html_theme = "alabaster"
 html_theme_options = {"description": "Boundary observers for 1D BC-PHS", "fixed_sidebar": True}
 html_static_path: list[str] = []
 master_doc = "index"
+# prose keeps "--" and quotes as typed: an option copied from a page must run, and docutils
+# would turn "--gain" into an en dash
+smartquotes = False

@@ -63,3 +63,45 @@ def test_every_notebook_becomes_a_valid_page(path):
     code = [c for kind, c in phdesign_docs.notebook_cells(path.read_text()) if kind == "code"]
     assert code
     assert all(line in page for line in code[0].splitlines() if line.strip())
+
+
+def _flat(text: str) -> str:
+    return " ".join(text.split())
+
+
+def test_cli_reference_is_each_commands_help_nested_commands_included(monkeypatch):
+    # issue 28: the page showed "(default %(default)g)" and "'5%%'" and no loop subcommands.
+    # Each option's text must be what ``--help`` prints; on a terminal as wide as the text
+    # argparse does not wrap (it would break "--min-decay" after its hyphen)
+    import argparse
+
+    monkeypatch.setenv("COLUMNS", "100000")
+
+    from phdesign.cli import build_parser
+
+    page = phdesign_docs.cli_page()
+    assert "%(" not in page
+    assert "%%" not in page
+    found = phdesign_docs.commands(build_parser())
+    names = [name for name, _, _ in found]
+    for nested in ("classify", "spectrum", "simulate", "tune"):
+        assert f"phdesign loop {nested}" in names
+    for name, parser, _ in found:
+        assert f"\n{name}\n{'-' * len(name)}\n" in page
+        printed = _flat(parser.format_help())
+        for action in parser._actions:
+            if isinstance(action, argparse._HelpAction) or not action.help:
+                continue
+            text = parser._get_formatter()._expand_help(action)
+            assert _flat(text) in printed, (name, action.dest)
+            assert phdesign_docs._escape(phdesign_docs.option_help(parser, action)) in page
+
+
+def test_the_site_keeps_double_dashes_as_typed():
+    # docutils' smart quotes turn "--gain" in prose into an en dash, which fails when copied
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("conf", DOCS / "conf.py")
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)
+    assert conf.smartquotes is False

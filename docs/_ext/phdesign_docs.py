@@ -61,17 +61,45 @@ JSON_KEYS = {
 }
 
 
-def _option_row(action: argparse.Action) -> tuple[str, str]:
+def _option_row(parser: argparse.ArgumentParser, action: argparse.Action) -> tuple[str, str]:
     names = ", ".join(action.option_strings) or action.metavar or action.dest
     if action.option_strings and action.nargs != 0:
         metavar = action.metavar or action.dest.upper()
         names = ", ".join(f"{name} {metavar}" for name in action.option_strings)
-    text = action.help or ""
-    if "%(default)s" in text:
-        text = text.replace("%(default)s", str(action.default))
+    return names, option_help(parser, action)
+
+
+def option_help(parser: argparse.ArgumentParser, action: argparse.Action) -> str:
+    """Return an option's help as ``--help`` prints it, then its choices.
+
+    ``%(default)g`` and ``%%`` are expanded by argparse's own formatter.
+    """
+    if not action.help or action.help == argparse.SUPPRESS:
+        text = ""
+    else:
+        text = parser._get_formatter()._expand_help(action)
     if action.choices and not isinstance(action, argparse._SubParsersAction):
         text += f" (one of: {', '.join(map(str, action.choices))})"
-    return names, text
+    return text
+
+
+def commands(
+    parser: argparse.ArgumentParser, prefix: str = "phdesign"
+) -> list[tuple[str, argparse.ArgumentParser, str]]:
+    """Return every command, nested ones too (``phdesign loop classify``), in help order.
+
+    Each as ``(name, parser, one-line help)``.
+    """
+    found = []
+    for action in parser._actions:
+        if not isinstance(action, argparse._SubParsersAction):
+            continue
+        helps = {a.dest: a.help for a in action._choices_actions}
+        for name, sub in action.choices.items():
+            sub.complete()  # the options a command adds when it is first used (sweep's jobs)
+            found.append((f"{prefix} {name}", sub, helps.get(name) or ""))
+            found += commands(sub, f"{prefix} {name}")
+    return found
 
 
 def _escape(text: str) -> str:
@@ -83,7 +111,6 @@ def cli_page() -> str:
     from phdesign.cli import build_parser
 
     parser = build_parser()
-    subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     lines = [
         "Command-line reference",
         "=" * 22,
@@ -98,21 +125,19 @@ def cli_page() -> str:
         *("   " + line for line in parser.format_usage().splitlines()),
         "",
     ]
-    helps = {a.dest: a.help for a in subparsers._choices_actions}
-    for name, sub in subparsers.choices.items():
-        sub.complete()  # the options a command adds when it is first used (sweep's jobs)
-        title = f"phdesign {name}"
+    for title, sub, summary in commands(parser):
         lines += [title, "-" * len(title), ""]
-        lines += [_escape(sub.description or helps.get(name) or ""), ""]
+        lines += [_escape(sub.description or summary), ""]
         lines += [".. code:: text", ""]
         lines += ["   " + line for line in sub.format_usage().removeprefix("usage: ").splitlines()]
         lines += ["", ".. list-table::", "   :widths: 30 70", ""]
         for action in sub._actions:
             if isinstance(action, argparse._HelpAction):
                 continue
-            option, text = _option_row(action)
+            option, text = _option_row(sub, action)
             lines += [f"   * - ``{option}``", f"     - {_escape(text) or ' '}"]
         lines.append("")
+        name = title.removeprefix("phdesign ")
         if name in JSON_KEYS:
             lines += [f"*JSON* (``--json``): {JSON_KEYS[name]}.", ""]
     return "\n".join(lines) + "\n"
