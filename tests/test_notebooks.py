@@ -82,7 +82,7 @@ def test_the_import_check_sees_every_form_of_a_private_import():
 
 #: Notebooks still to be rewritten (their Monte Carlo and sampled-observer cells reach
 #: below the design objects); strict, so that a rewritten one fails here until removed.
-NOT_YET_PUBLIC = {"05_noise_tradeoff", "06_implementation"}
+NOT_YET_PUBLIC = {"06_implementation"}
 
 
 @pytest.mark.parametrize(
