@@ -1,12 +1,28 @@
-"""Strings and coupled strings shared by the spectrum tests, and the honesty of a digits claim."""
+"""Strings and coupled strings shared by the spectrum tests, and the honesty of a digits claim.
+
+Also the built-in string in milliseconds (:func:`wave_in_ms`), for the figures' time units.
+"""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 
 from phdesign.symbolic.model import BCPHS
 
 SENSOR2 = np.array([[0.0, 1.0]])  # strings: y2 = e1(b), the velocity at the damper end
+
+
+def wave_in_ms(folder: Path) -> Path:
+    """Write a copy of the built-in ``wave`` whose ``[units] t`` is ``"ms"``; return its path."""
+    from phdesign.models import builtin_toml
+
+    text = builtin_toml("wave")
+    assert 't = "s"' in text  # the copy differs from the original in its time unit only
+    path = folder / "wave_ms.toml"
+    path.write_text(text.replace('t = "s"', 't = "ms"'), encoding="utf-8")
+    return path
 
 
 def string(T: str, b: str = "1") -> BCPHS:

@@ -62,6 +62,18 @@ def eigenvalue_labels(time_unit: str | None = None) -> tuple[str, str]:
     return f"Re λ [1/{unit}]", f"Im λ [rad/{unit}]"
 
 
+def frequency_label(time_unit: str | None = None) -> str:
+    """Return the label of a frequency axis in the model's time unit (SI: s).
+
+    Examples
+    --------
+    >>> frequency_label("ms"), frequency_label()
+    ('frequency ω [rad/ms]', 'frequency ω [rad/s]')
+    """
+    unit = time_unit or SI_UNITS["t"]
+    return f"frequency ω [rad/{unit}]"
+
+
 def literal(text: str) -> str:
     r"""Return ``text`` as a figure shows it literally: never as matplotlib mathtext.
 

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from phdesign.core.text import gain_text, measured_text
-from phdesign.plots._figures import drawing, literal
+from phdesign.plots._figures import drawing, frequency_label, literal
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
@@ -164,7 +164,7 @@ def _draw_frequency_response(left: Axes, report: Any) -> None:
             )
         left.legend(loc="lower left", fontsize=8)
     left.set(
-        xlabel="frequency ω [rad/s]",
+        xlabel=frequency_label(getattr(report, "time_unit", None)),
         ylabel="gain noise → error (energy norm)",
         title="frequency response",
     )

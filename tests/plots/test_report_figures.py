@@ -9,6 +9,7 @@ from __future__ import annotations
 import warnings
 
 import pytest
+from string_models import wave_in_ms
 
 import phdesign as phd
 
@@ -79,6 +80,15 @@ def test_noise_plot_ends_where_the_resolved_band_ends(wave_observer):
     assert left.get_xlim()[1] == pytest.approx(band)
     for line in left.get_lines():
         assert max(line.get_xdata()) <= band * (1 + 1e-12)
+
+
+def test_noise_plot_frequency_axis_is_in_the_model_time_unit(wave_observer, tmp_path):
+    in_ms = phd.Observer(phd.load(wave_in_ms(tmp_path)), sensors=[2], gain=0.5)
+    report = in_ms.noise(max_resolution=30)
+    assert report.time_unit == "ms"
+    assert report.plot().axes[0].get_xlabel() == "frequency ω [rad/ms]"
+    in_s = wave_observer.noise(max_resolution=30)
+    assert in_s.plot().axes[0].get_xlabel() == "frequency ω [rad/s]"
 
 
 def test_tradeoff_rms_axis_has_the_model_unit():

@@ -11,6 +11,8 @@ import pytest
 pytest.importorskip("xarray", reason="install the sweep extra")
 pytest.importorskip("zarr", reason="install the sweep extra")
 
+from string_models import wave_in_ms
+
 import phdesign
 from phdesign.plots.sweep import plot_sweep
 from phdesign.sweep import summarize
@@ -53,12 +55,7 @@ def test_one_axis_of_two_and_the_fixed_entry():
 
 
 def test_the_model_time_unit_is_the_abscissa_unit(tmp_path):
-    from phdesign.models import builtin_toml
-
-    text = builtin_toml("wave").replace('t = "s"', 't = "ms"')
-    path = tmp_path / "wave_ms.toml"
-    path.write_text(text, encoding="utf-8")
-    ds = phdesign.sweep(str(path), sensors=[2], grid={"l1": "0.3,0.6"}, **SYNC)
+    ds = phdesign.sweep(str(wave_in_ms(tmp_path)), sensors=[2], grid={"l1": "0.3,0.6"}, **SYNC)
     assert ds["spectral_abscissa"].attrs["units"] == "1/ms"
     fig = plot_sweep(ds)
     assert fig.axes[0].get_ylabel() == "spectral abscissa α [1/ms]"

@@ -385,6 +385,7 @@ class _Refinement:
             output_labels=nm.output_labels,
             warnings=tuple(warnings),
             pencils=tuple(s.pencil for s in self.stats) if self.steady else (),
+            time_unit=dict(nm.units).get("t"),
         )
 
 

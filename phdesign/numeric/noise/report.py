@@ -170,6 +170,9 @@ class NoiseReport:
         The error system at each resolution (for :meth:`frequency_response`).
     figures : tuple of Estimate
         The caller's further figures (:mod:`phdesign.numeric.noise.metrics`), in order.
+    time_unit : str or None
+        The model's unit of time (``[units] t``), when it states one: the frequency
+        axis of :meth:`plot` is in rad per that unit.
     """
 
     model: str
@@ -187,6 +190,7 @@ class NoiseReport:
     warnings: tuple[str, ...] = ()
     pencils: tuple[TriangularPencil, ...] = field(default=(), compare=False, repr=False)
     figures: tuple[Estimate, ...] = ()
+    time_unit: str | None = None
 
     def frequency_response(self, omega: np.ndarray | None = None) -> dict[int, np.ndarray]:
         """Energy-norm gain from the noise to the error at each resolution, at ``omega``.
