@@ -18,7 +18,6 @@ Examples
 
 from __future__ import annotations
 
-import difflib
 import html
 from collections.abc import Iterable, Sequence
 from typing import Any
@@ -241,5 +240,7 @@ def did_you_mean(name: object, choices: Iterable[str]) -> str:
     >>> did_you_mean("xyz", ["wave"])
     ''
     """
+    import difflib  # only on a miss: every command's start would pay for it
+
     close = difflib.get_close_matches(str(name), list(choices), n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""

@@ -57,7 +57,6 @@ from sympy.polys.matrices import DomainMatrix
 from phdesign.core.errors import ObserverError
 from phdesign.core.limits import EXACT_KAPPA_BITS, EXACT_KAPPA_DEGREE, EXACT_KAPPA_OPERATIONS
 from phdesign.symbolic.expressions import vanishes
-from phdesign.symbolic.gain_kappa import symbolic_kappa
 from phdesign.symbolic.observer import ErrorSystem
 
 __all__ = ["Certificate", "certify", "float_kappa"]
@@ -168,6 +167,8 @@ def certify(
         return Certificate(True, None, None, True, None, (), "symbolic" if symbolic else "exact")
     pencil = (A_r, B_r, K_m)
     if symbolic:
+        from phdesign.symbolic.gain_kappa import symbolic_kappa  # symbolic gains only
+
         kappa, conditions = symbolic_kappa(A_r, B_r)
         return Certificate(True, kappa, None, False, None, (), "symbolic", conditions, pencil)
     return _numeric_kappa(pencil, method)

@@ -31,7 +31,6 @@ from phdesign.symbolic.definiteness import check_definite
 from phdesign.symbolic.expressions import Z, canonical, vanishes
 from phdesign.symbolic.feedback import check_feedback_indices
 from phdesign.symbolic.fields import check_fields
-from phdesign.symbolic.output_faults import outputs_fault_message
 from phdesign.symbolic.parser import brief, check_expression
 from phdesign.symbolic.traces import linear_coefficients, trace_of
 from phdesign.symbolic.units import check_units
@@ -146,7 +145,10 @@ def _check_all_ports(
     try:
         model.ports  # noqa: B018 - derives the ports (checking the identities) and caches them
     except PortError as exc:
-        located = outputs_fault_message(model, defaults)  # the outputs at fault, named
+        # the outputs at fault, named (imported on a failure only: a valid model never asks)
+        from phdesign.symbolic.output_faults import outputs_fault_message
+
+        located = outputs_fault_message(model, defaults)
         if not located:
             raise
         raise PortError(f"{exc}; {located}") from None
