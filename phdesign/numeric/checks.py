@@ -202,17 +202,16 @@ def check_initial_state(x0: Any, nm: Any, name: str) -> None:
 def _shapes(value: Any) -> str:
     """Describe a ragged return value: ``a list of 2 entries of shapes (), (17,)``."""
     if isinstance(value, (list, tuple)):
-        shapes = ", ".join(str(np.shape(v)) if _is_array_like(v) else "?" for v in value)
+        shapes = ", ".join(_shape_text(v) for v in value)
         return f"a {type(value).__name__} of {len(value)} entries of shapes {shapes}"
     return f"a {type(value).__name__}"
 
 
-def _is_array_like(value: Any) -> bool:
+def _shape_text(value: Any) -> str:
     try:
-        np.shape(value)
-    except (ValueError, TypeError):
-        return False
-    return True
+        return str(np.shape(value))
+    except (ValueError, TypeError):  # itself ragged
+        return "?"
 
 
 def _common(
