@@ -1,0 +1,1 @@
+"""Certified numbers: the exact closed system, the certified spectrum and its proof file."""
