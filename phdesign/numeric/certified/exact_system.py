@@ -167,7 +167,7 @@ class ExactClosedSystem:
         """Whether every entry (matrices, interval, boundary rows) is a rational number."""
         matrices = (self.H, *self.P, self.boundary)
         entries = [x for M in matrices for x in M] + list(self.interval)
-        return all(sympy.sympify(x).is_Rational for x in entries)
+        return all(isinstance(x, sympy.Rational) for x in entries)
 
     def dissipation(self) -> Dissipation:
         r"""Decide the signs of the energy identity exactly (:class:`Dissipation`).
@@ -257,8 +257,8 @@ def closed_system(
         raise ObserverError(f"a certificate needs a numeric gain; found the symbols {names} in L")
     P = tuple(_exact(M, defaults, f"P{k}", model.name) for k, M in enumerate(model.P))
     H = _exact(model.H, defaults, "H", model.name)
-    a, b = (sympy.sympify(x) for x in model.interval)
-    if not (a.is_Rational and b.is_Rational):
+    a, b = model.interval
+    if not (isinstance(a, sympy.Rational) and isinstance(b, sympy.Rational)):
         raise ModelError(
             f"a certificate needs a rational interval; found [{a}, {b}] in model {model.name!r}"
         )
