@@ -9,6 +9,8 @@ DOCS = Path(__file__).resolve().parent
 sys.path.insert(0, str(DOCS.parent))  # document this checkout
 sys.path.insert(0, str(DOCS / "_ext"))
 
+from offline_math import MATHJAX2_CONFIG, MATHJAX_PATH  # noqa: E402
+
 import phdesign  # noqa: E402
 
 project = "phdesign"
@@ -23,6 +25,7 @@ extensions = [
     "numpydoc",
     "myst_parser",
     "phdesign_docs",
+    "offline_math",
 ]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 myst_heading_anchors = 3  # "model_files.md#boundary-feedback-dampers-in-the-plant" links work
@@ -41,3 +44,6 @@ master_doc = "index"
 # prose keeps "--" and quotes as typed: an option copied from a page must run, and docutils
 # would turn "--gain" into an en dash
 smartquotes = False
+# MathJax ships with the site (docs/_ext/offline_math.py): formulas render without a network
+mathjax_path = MATHJAX_PATH
+mathjax2_config = MATHJAX2_CONFIG
