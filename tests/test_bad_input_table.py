@@ -513,6 +513,22 @@ COMMAND_ROWS = [
         "the following arguments are required: --format",
         None,
     ),
+    # point outputs of the sampled, noisy and loop simulations: read before any work
+    row(
+        "simulate euler-bernoulli --sensors 3,4 --dt 1e-2 --at 2",
+        r"--at: expected numbers in \[0, 1\]; found 2$",
+        NumericError,
+    ),
+    row(
+        "simulate timoshenko --sensors 3,4 --noise-intensity 1 --at rotaton(1)",
+        r"--at: rotaton\(1\): .*no field 'rotaton' \(did you mean 'rotation'\?\)",
+        NumericError,
+    ),
+    row(
+        "loop simulate wave --actuate 2 --sensors 2 --at 1",
+        "--at: model 'wave' has no displacement",
+        NumericError,
+    ),
     row(f"{SIM} --dt 0", "--dt must be a finite positive number of seconds", NumericError),
     row(f"{SIM} --sampler point", "--sampler needs --dt, the sampling period", NumericError),
     row("simulate wave --dt 1e-3", "act on the observer: give --sensors or --cm", NumericError),

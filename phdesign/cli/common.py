@@ -18,6 +18,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 __all__ = [
     "add_discretization_arguments",
+    "add_simulation_outputs",
     "add_json_argument",
     "add_method_argument",
     "add_model_argument",
@@ -324,3 +325,24 @@ def simulation_text(args: argparse.Namespace, model: str, result: Any) -> str:
 
         return dumps_json({"model": model, **result.to_dict()}, indent=None)
     return str(result)
+
+
+def add_simulation_outputs(sim: argparse.ArgumentParser) -> None:
+    """Add what a simulation writes (``simulate``, ``loop simulate``).
+
+    CSV or JSON, the point outputs ``--at``, the output file and the figure.
+    """
+    fmt = sim.add_mutually_exclusive_group()
+    fmt.add_argument("--csv", action="store_true", help="CSV output (the default)")
+    fmt.add_argument(
+        "--json", action="store_true", help="JSON output (keys: see the command-line reference)"
+    )
+    sim.add_argument(
+        "--at",
+        metavar="Z,..",
+        help="also report the displacement at these points, e.g. 0.5,1, or named fields "
+        "of the model at a point, e.g. rotation(1) (CSV columns rotation(1), rotation_hat(1))",
+    )
+    sim.add_argument("--output", "-o", metavar="FILE", help="write to FILE instead of stdout")
+    sim.add_argument("--plot", metavar="FILE", help="also draw a summary figure to FILE")
+    sim.add_argument("--force", action="store_true", help="overwrite existing files")

@@ -16,12 +16,14 @@ from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
     add_quiet_argument,
+    add_simulation_outputs,
     check_finite_series,
     check_positive,
     emit_result,
     load_model,
     run_outputs,
     simulation_text,
+    split_items,
     warn,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
@@ -117,12 +119,7 @@ def _add_simulate(sub: argparse._SubParsersAction) -> None:
     sim.add_argument("--t-end", type=float, default=run.t_end, metavar="T", help="final time")
     sim.add_argument("--samples", type=int, default=run.samples, help="output samples on [0, T]")
     sim.add_argument("--scheme", choices=("expm", "midpoint"), default=run.scheme)
-    fmt = sim.add_mutually_exclusive_group()
-    fmt.add_argument("--csv", action="store_true", help="CSV output (the default)")
-    fmt.add_argument("--json", action="store_true", help="JSON output")
-    sim.add_argument("--output", "-o", metavar="FILE", help="write to FILE instead of stdout")
-    sim.add_argument("--plot", metavar="FILE", help="also draw a summary figure to FILE")
-    sim.add_argument("--force", action="store_true", help="overwrite existing files")
+    add_simulation_outputs(sim)  # --csv/--json, --at, -o, --plot, --force as for simulate
     sim.set_defaults(handler=_simulate)
 
 
@@ -199,6 +196,7 @@ def _simulate(args: argparse.Namespace) -> int:
                 t_end=args.t_end,
                 samples=args.samples,
                 scheme=args.scheme,
+                at=None if args.at is None else split_items(args.at),
             )
         check_finite_series(run)
         commit(simulation_text(args, loop.model.name, run), run)

@@ -22,6 +22,7 @@ from phdesign.cli.common import (
     add_json_argument,
     add_model_argument,
     add_quiet_argument,
+    add_simulation_outputs,
     check_finite_series,
     check_positive,
     emit_result,
@@ -150,29 +151,11 @@ def _add_simulate(subparsers: argparse._SubParsersAction) -> None:
         help="midpoint: largest estimated error of the states, relative to their largest "
         "energy norm; the substeps are chosen to meet it; default: %(default)s",
     )
-    _add_simulate_outputs(sim)
+    add_simulation_outputs(sim)
     add_sampling_arguments(sim)  # --dt, --sampler, --observer-resolution (export command)
     add_stochastic_arguments(sim)
     add_quiet_argument(sim)
     sim.set_defaults(handler=_simulate)
-
-
-def _add_simulate_outputs(sim: argparse.ArgumentParser) -> None:
-    """Add what ``simulate`` writes: CSV or JSON, the point outputs ``--at``, files, figure."""
-    fmt = sim.add_mutually_exclusive_group()
-    fmt.add_argument("--csv", action="store_true", help="CSV output (the default)")
-    fmt.add_argument(
-        "--json", action="store_true", help="JSON output (keys: see the command-line reference)"
-    )
-    sim.add_argument(
-        "--at",
-        metavar="Z,..",
-        help="also report the displacement at these points, e.g. 0.5,1, or named fields "
-        "of the model at a point, e.g. rotation(1) (CSV columns rotation(1), rotation_hat(1))",
-    )
-    sim.add_argument("--output", "-o", metavar="FILE", help="write to FILE instead of stdout")
-    sim.add_argument("--plot", metavar="FILE", help="also draw a summary figure to FILE")
-    sim.add_argument("--force", action="store_true", help="overwrite existing files")
 
 
 def _add_tune(subparsers: argparse._SubParsersAction) -> None:

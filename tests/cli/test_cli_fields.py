@@ -1,4 +1,5 @@
-r"""Named fields on the command line: ``simulate --at``, ``tune --at``, ``export --at``.
+r"""Named fields on the command line: ``simulate --at`` (also sampled, noisy, loop), ``tune --at``,
+``export --at``.
 
 The built-in ``timoshenko`` (unit parameters, clamped at 0) has the rotation
 φ(z) = ∫_0^z x3 (``[fields.rotation]``).  Under the static tip load P (u3 = e1(1) = P) its
@@ -62,11 +63,31 @@ def test_an_unknown_field_is_one_line_naming_the_known_fields(capsys, tmp_path, 
     assert not (tmp_path / "o.json").exists()
 
 
-def test_a_sampled_simulation_refuses_at_in_one_line(capsys) -> None:
-    argv = ("simulate", "timoshenko", "--sensors", "3,4", "--dt", "0.01", *RUN)
-    status, _, err = run(capsys, *argv, "--at", "rotation(1)")
-    assert status == 2
-    assert err.startswith("phdesign: error: --at: simulate_sampled does not read point outputs")
+@pytest.mark.parametrize(
+    ("command", "extra"),
+    [
+        (("simulate",), ("--dt", "0.05", "--observer-resolution", "8")),
+        (("simulate",), ("--noise-intensity", "0.01", "--seed", "1")),
+        (("loop", "simulate"), ("--actuate", "4")),
+    ],
+    ids=["sampled", "noisy", "loop"],
+)
+def test_sampled_noisy_and_loop_simulations_report_named_fields(capsys, command, extra) -> None:
+    """The observer starts at the plant's equilibrium too: φ(1) = P/2 for both (EI = 1).
+
+    Sensor noise moves only the estimate, so the noisy run checks the plant's column.
+    """
+    argv = (*command, "timoshenko", "--sensors", "3,4", *STATIC, *RUN, *extra)
+    status, out, err = run(capsys, *argv, "--xhat0", STATIC[1], "--at", "rotation(1)")
+    assert status == 0, err
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert len(rows) == 5
+    columns = (
+        ["rotation(1)"] if "--noise-intensity" in extra else ["rotation(1)", "rotation_hat(1)"]
+    )
+    for row in rows:
+        for column in columns:
+            assert float(row[column]) == pytest.approx(P_TIP / 2, rel=1e-10)
 
 
 @pytest.mark.slow

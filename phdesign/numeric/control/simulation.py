@@ -32,6 +32,8 @@ from phdesign.core.progress import report
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import LoopSystem, NumericLoop, assemble
+from phdesign.numeric.discretization.functionals import Functional
+from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.threads import limited_threads
@@ -148,7 +150,8 @@ def simulate_loop(
         ``u(t) -> (n_ports,)``: signals on the inputs that are *not* actuated (the
         actuated entries must be zero; the controller sets them).
     options : SimulationOptions, optional
-        ``t_end``, ``samples``, ``method``, ``resolution``, ``scheme`` and ``z_w``, as for
+        ``t_end``, ``samples``, ``method``, ``resolution``, ``scheme``, ``z_w`` and ``at``
+        (point outputs of the plant and of the observer), as for
         :func:`phdesign.numeric.time.simulation.simulate`.  The loop's midpoint steps once
         per output interval (no ``tol``); a sampled or noisy loop is not simulated.
 
@@ -177,12 +180,12 @@ def simulate_loop(
     """
     opts = SimulationOptions.merged(options)
     opts.require("simulate_loop", "continuous")
-    opts.refuse_at("simulate_loop")
     if opts.tol is not None:
         raise ArgumentError(
             f"tol: the loop's midpoint steps once per output interval, without a tolerance; "
             f"found tol={opts.tol!r}"
         )
+    at = point_outputs(nm, opts.at, "at")  # an unknown field is refused before any work
     system = assemble(discretize(nm, opts.method, opts.resolution), loop)
     d, n = system.discrete, system.dim
     t = opts.times()
@@ -201,7 +204,7 @@ def simulate_loop(
     audits = {"error system": energy_balance_residual(d.E, A_err, err, t, opts.scheme)}
     if V is None:  # the loop is autonomous only without free inputs
         audits["loop"] = energy_balance_residual(system.E, A_Z, Z, t, opts.scheme)
-    return _result(nm, system, opts, t, Z[:, :n], err, V, audits)
+    return _result(nm, system, opts, t, (Z[:, :n], err), V, audits, at)
 
 
 def _free_inputs(U: np.ndarray, system: LoopSystem) -> np.ndarray | None:
@@ -226,13 +229,17 @@ def _result(
     system: LoopSystem,
     options: SimulationOptions,
     t: np.ndarray,
-    eh: np.ndarray,
-    err: np.ndarray,
+    states: tuple[np.ndarray, np.ndarray],
     V: np.ndarray | None,
     audits: dict[str, float],
+    at: tuple[Functional, ...],
 ) -> LoopSimulation:
-    """Return the loop's series: inputs and outputs from the assembled maps, energies."""
+    """Return the loop's series: inputs and outputs from the assembled maps, energies.
+
+    ``states`` are the plant's ê and the error's ẽ; the observer's is ê − ẽ.
+    """
     d, loop = system.discrete, system.loop
+    eh, err = states
     X = np.hstack([eh, eh - err])
     inputs = X @ system.C_u.T + (0.0 if V is None else V @ system.D_u.T)
     y = X @ system.C_y.T + (0.0 if V is None else V @ system.D_y.T)
@@ -276,4 +283,5 @@ def _result(
         },
         warnings=warnings,
         units=dict(nm.units),
+        **point_series(at, d, eh, eh - err),
     )

@@ -38,7 +38,14 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.functionals import Functional, displacement_at, field_names
 from phdesign.numeric.discretization.phs import DiscretePHS
 
-__all__ = ["estimate_name", "field_names", "point_outputs", "point_rows", "unit_key"]
+__all__ = [
+    "estimate_name",
+    "field_names",
+    "point_outputs",
+    "point_rows",
+    "point_series",
+    "unit_key",
+]
 
 _FIELD_AT = re.compile(r"\s*(?P<field>[^\W\d]\w*)\s*\((?P<point>[^()]*)\)\s*\Z")
 
@@ -126,6 +133,32 @@ def point_rows(d: DiscretePHS, outputs: Sequence[Functional]) -> np.ndarray:
     if not outputs:
         return np.zeros((0, d.dim))
     return np.vstack([f.row(d) for f in outputs])
+
+
+def point_series(
+    outputs: Sequence[Functional],
+    d: DiscretePHS,
+    states: np.ndarray,
+    states_hat: np.ndarray | None = None,
+    d_hat: DiscretePHS | None = None,
+) -> dict[str, Any]:
+    r"""Return the point outputs of a run, as the fields of a simulation result.
+
+    ``at`` (the names), ``at_values`` = :math:`X r^\top` for the states X ``(nt, dim)`` on
+    ``d`` and ``at_values_hat`` likewise for the observer's states on ``d_hat`` (default
+    ``d``; a lower-order observer has its own discretization, so its rows are its own).
+    Empty without outputs: the result's defaults (no point outputs) stand.
+    """
+    if not outputs:
+        return {}
+    hat = None
+    if states_hat is not None:
+        hat = states_hat @ point_rows(d if d_hat is None else d_hat, outputs).T
+    return {
+        "at": tuple(f.name for f in outputs),
+        "at_values": states @ point_rows(d, outputs).T,
+        "at_values_hat": hat,
+    }
 
 
 def estimate_name(output: Functional, suffix: str = "_hat") -> str:

@@ -26,7 +26,9 @@ from phdesign.core.errors import NumericError
 from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_periods
+from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.phs import DiscretePHS
+from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.sampled.runs import LoopRun, run_against_continuous, run_loop
@@ -90,7 +92,9 @@ def simulate_sampled(
         (the observer's front end) and ``observer_resolution`` (the observer's degree,
         default the plant's).  About ``samples`` records are kept: every ``s`` periods,
         ``s = round(T / ((samples - 1) dt))`` (every one of ``samples - 1`` equal steps for
-        a continuous observer).  ``method`` and ``resolution`` are the plant's.
+        a continuous observer).  ``method`` and ``resolution`` are the plant's; ``at``
+        (point outputs, as for ``simulate``) is read on the plant's and on the observer's
+        own discretization.
 
     Returns
     -------
@@ -99,9 +103,9 @@ def simulate_sampled(
     """
     opts = SimulationOptions.merged(options)
     opts.require("simulate_sampled", "sampled", "continuous")
-    opts.refuse_at("simulate_sampled")
     if opts.scheme != "expm":
         raise NumericError(SAMPLED_SCHEME.format(scheme=opts.scheme))
+    at = point_outputs(nm, opts.at, "at")  # an unknown field is refused before any work
     if opts.dt is not None:
         check_periods(opts.dt, opts.t_end)
     plant = discretize(nm, opts.method, opts.resolution)
@@ -130,7 +134,7 @@ def simulate_sampled(
             n_steps=grid.steps, stride=grid.stride, u=U,
         )  # fmt: skip
         warnings = () if warning is None else (warning,)
-    return _result(nm, plant, d_obs, observer, P, run, opts, warnings)
+    return _result(nm, (plant, d_obs), observer, P, run, opts, warnings, at)
 
 
 @dataclass(frozen=True)
@@ -153,15 +157,20 @@ class _Grid:
 
 def _result(
     nm: NumericModel,
-    plant: DiscretePHS,
-    d_obs: DiscretePHS,
+    discretizations: tuple[DiscretePHS, DiscretePHS],
     observer: ContinuousObserver,
     P: np.ndarray,
     run: LoopRun,
     options: SimulationOptions,
     warnings: tuple[str, ...],
+    at: tuple[Functional, ...],
 ) -> SimulationResult:
-    """Return the run's series as a :class:`SimulationResult` (module docstring's energies)."""
+    """Return the run's series as a :class:`SimulationResult` (module docstring's energies).
+
+    The point outputs ``at`` of the observer are read on its own discretization (its
+    states are its efforts there), those of the plant on the plant's.
+    """
+    plant, d_obs = discretizations
     m = nm.n_ports
     gap = run.x - run.xhat @ P.T
     has_w = bool(observer.points)
@@ -189,4 +198,5 @@ def _result(
             **({"dt": options.dt, "sampler": options.sampler_name} if sampled else {}),
         },
         warnings=warnings,
+        **point_series(at, plant, run.x, run.xhat, d_obs),
     )

@@ -111,8 +111,8 @@ class SimulationOptions:
     at : sequence of str or float, optional
         Point outputs reported beside ``w(z)``: a number is the displacement there,
         ``"rotation(1)"`` a named field of the model (read against the model by the
-        simulator, :mod:`phdesign.numeric.discretization.points`); the continuous simulation
-        reports them (the sampled, noisy and loop simulations refuse them).
+        simulator, :mod:`phdesign.numeric.discretization.points`); every simulator reports
+        them (continuous, sampled, noisy and the loop), for the plant and the observer.
 
     Raises
     ------
@@ -254,15 +254,6 @@ class SimulationOptions:
         """``z_w``, or 21 uniform points of ``interval``."""
         a, b = interval
         return np.linspace(a, b, 21) if self.z_w is None else np.asarray(self.z_w, dtype=float)
-
-    def refuse_at(self, simulator: str) -> None:
-        """Refuse ``at`` in a simulator that reports only ``w(z)``."""
-        if self.at is not None:
-            raise ArgumentError(
-                f"at: {simulator} does not read point outputs; drop `at`, or run the "
-                "continuous observer (without `dt`, `sampler`, `observer_resolution` and "
-                "the noise)"
-            )
 
     def require(self, simulator: str, *kinds: str) -> None:
         """Refuse options of a kind of run that ``simulator`` does not do.

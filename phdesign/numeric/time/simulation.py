@@ -51,7 +51,7 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_simulate_arguments
 from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.phs import ClosedLoop
-from phdesign.numeric.discretization.points import point_outputs, point_rows
+from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.threads import limited_threads
@@ -302,7 +302,6 @@ def _result(nm: NumericModel, run: _Run) -> SimulationResult:
         Wd = d.displacement_basis(zw)
         w = eh @ Wd.T
         w_hat = None if eo is None else eo @ Wd.T
-    rows = point_rows(d, run.at)
     return SimulationResult(
         t=run.t,
         H=d.hamiltonian(eh),
@@ -323,9 +322,7 @@ def _result(nm: NumericModel, run: _Run) -> SimulationResult:
         resolved_floor=None if error is None else error.floor,
         resolved_until=None if error is None else error.until,
         units=dict(nm.units),
-        at=tuple(f.name for f in run.at),
-        at_values=eh @ rows.T if run.at else None,
-        at_values_hat=eo @ rows.T if run.at and eo is not None else None,
+        **point_series(run.at, d, eh, eo),
     )
 
 

@@ -50,6 +50,8 @@ import scipy.linalg as sl
 from phdesign.core.errors import NumericError, ObserverError
 from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.discretization.functionals import Functional
+from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.noise.figures import noise_intensities
@@ -149,7 +151,8 @@ def simulate_noisy(
     nm, C_m, L, x0, xhat0, u, discrete
         As for :func:`phdesign.numeric.time.simulation.simulate`.
     options : SimulationOptions, optional
-        As for ``simulate``, with the noise: ``noise_intensity`` (sensor intensities
+        As for ``simulate`` (``at`` too: point outputs of the noisy plant and observer), with
+        the noise: ``noise_intensity`` (sensor intensities
         σᵢ², one per sensor or one for all; needs sensors), ``input_intensity`` (plant
         input intensities, one per input or one for all) and ``seed`` (the same seed gives
         the same path).  The stepping is exact (``scheme="expm"``): implicit midpoint does
@@ -163,13 +166,13 @@ def simulate_noisy(
     """
     opts = SimulationOptions.merged(options)
     opts.require("simulate_noisy", "noisy", "continuous")
-    opts.refuse_at("simulate_noisy")
     if opts.scheme != "expm":
         raise NumericError(NOISY_SCHEME.format(scheme=opts.scheme))
     if opts.noise_intensity is not None and C_m is None:
         raise ObserverError("sensor noise needs an observer: give the sensors C_m and gain L")
     q = 0 if C_m is None else np.atleast_2d(C_m).shape[0]
     sigma, w_in = noise_intensities(nm, q, opts.noise_intensity, opts.input_intensity, default=0.0)
+    at = point_outputs(nm, opts.at, "at")  # an unknown field is refused before any work
     d = discrete if discrete is not None else discretize(nm, opts.method, opts.resolution)
     base = simulate(nm, C_m, L, x0=x0, xhat0=xhat0, u=u, options=opts.deterministic(), discrete=d)
     report("simulate: the noise's sample path")
@@ -186,7 +189,7 @@ def simulate_noisy(
         "noise": "; ".join(described) or "none",
         "seed": -1 if opts.seed is None else int(opts.seed),
     }
-    return replace(base, info=info, **_noisy_series(d, C_m, L, base, extra, U))
+    return replace(base, info=info, **_noisy_series(d, C_m, L, base, extra, U, at))
 
 
 def _noise_paths(
@@ -213,8 +216,12 @@ def _noisy_series(
     base: SimulationResult,
     extra: np.ndarray,
     U: np.ndarray | None,
+    at: tuple[Functional, ...] = (),
 ) -> dict[str, Any]:
-    """Return the series of the noise-free run ``base`` with the noise's response added."""
+    """Return the series of the noise-free run ``base`` with the noise's response added.
+
+    The displacement and the point outputs ``at`` are read from the noisy states.
+    """
     n = d.dim
     eh = np.asarray(base.states) + extra[:, :n]
     changes: dict[str, Any] = {"states": eh, "H": d.hamiltonian(eh), "y": d.output(eh, U)}
@@ -233,4 +240,4 @@ def _noisy_series(
         changes["w"] = eh @ Wd.T
         if "states_hat" in changes:
             changes["w_hat"] = changes["states_hat"] @ Wd.T
-    return changes
+    return {**changes, **point_series(at, d, eh, changes.get("states_hat"))}

@@ -90,8 +90,3 @@ def test_the_rotation_rate_at_the_tip_is_the_output_y4() -> None:
 def test_bad_point_outputs_are_refused_before_any_work(at, exc, message) -> None:
     with pytest.raises(exc, match=message):
         _observer().simulate("x1: 1", t_end=0.1, samples=2, at=at)
-
-
-def test_a_sampled_run_refuses_point_outputs() -> None:
-    with pytest.raises(ArgumentError, match=r"^at: simulate_sampled does not read point outputs"):
-        _observer().simulate("x1: 1", t_end=0.1, samples=2, dt=0.01, at="rotation(1)")
