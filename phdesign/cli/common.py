@@ -18,11 +18,11 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 __all__ = [
     "add_discretization_arguments",
-    "add_simulation_outputs",
     "add_json_argument",
     "add_method_argument",
     "add_model_argument",
     "add_quiet_argument",
+    "add_simulation_outputs",
     "check_finite_series",
     "emit",
     "emit_json",
