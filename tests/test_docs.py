@@ -40,29 +40,40 @@ def test_cli_reference_lists_every_command_and_option():
     assert build_parser().prog == "phdesign"
 
 
-def test_markdown_conversion_of_the_constructs_the_notebooks_use():
-    text = (
-        "# Title\n\nSome $x_1$ and `code`, |λ| and a [link](https://example.org).\n"
-        "A list:\n- one $a$\n- two\n\n$$\nE = mc^2\n$$\n\n| a | b |\n|---|---|\n| 1 | 2 |"
-    )
-    rst = phdesign_docs.markdown_to_rst(text)
-    tree = parse(rst)
-    assert "Title\n=====" in rst
-    assert ":math:`x_1`" in rst
-    assert "``code``" in rst
-    assert "\\|λ\\|" in rst
-    assert ".. math::" in rst
-    assert ".. list-table::" in rst
-    assert tree.astext().count("one") == 1
+def test_the_gallery_has_a_card_for_every_notebook_picked_up_by_name(tmp_path):
+    """Notebooks 08 and 09 will appear without an edit: the list is ``notebooks/NN_*.py``."""
+    import notebook_cache
+
+    for name in ("01_first.py", "09_later.py", "README.md", "helper.py"):
+        (tmp_path / name).write_text("# %%\n")
+    assert [p.name for p in notebook_cache.notebook_paths(tmp_path)] == [
+        "01_first.py",
+        "09_later.py",
+    ]
+    names = [p.stem for p in notebook_cache.notebook_paths()]
+    page = phdesign_docs.gallery_page([(name, name != names[0]) for name in names])
+    body = page.split(".. toctree::")[0].replace(":doc:", ":code:")
+    parse(body)  # valid rst; docutils alone knows no :doc: role and no toctree
+    for name in names:
+        assert f":doc:`notebooks/{name}`" in page
+        assert f"   notebooks/{name}\n" in page  # in the (hidden) toctree
+    assert f"gallery/{names[0]}.png" not in page  # no figure: a link, no thumbnail
+    assert f".. figure:: gallery/{names[1]}.png" in page
 
 
 @pytest.mark.parametrize("path", sorted((DOCS.parent / "notebooks").glob("[0-9][0-9]_*.py")))
-def test_every_notebook_becomes_a_valid_page(path):
-    page = phdesign_docs.notebook_page(path)
-    parse(page)
-    code = [c for kind, c in phdesign_docs.notebook_cells(path.read_text()) if kind == "code"]
-    assert code
-    assert all(line in page for line in code[0].splitlines() if line.strip())
+def test_the_page_source_of_a_notebook_hashes_as_the_execution_the_tests_store(path):
+    """myst-nb looks the page's notebook up in jupyter-cache by this hash: equal, no rerun."""
+    nbformat = pytest.importorskip("nbformat", reason="install the notebooks extra")
+    pytest.importorskip("jupytext", reason="install the notebooks extra")
+    cache_main = pytest.importorskip("jupyter_cache.cache.main", reason="install the docs extra")
+    import notebook_cache
+
+    stored = notebook_cache.read(path)  # what tests/test_notebooks.py executes and stores
+    page = nbformat.reads(nbformat.writes(stored), as_version=4)  # what myst-nb reads
+    cache = cache_main.JupyterCacheBase(str(DOCS / "_build" / "unused-cache"))
+    assert cache.create_hashed_notebook(page)[1] == cache.create_hashed_notebook(stored)[1]
+    assert stored.metadata["kernelspec"]["name"] == notebook_cache.KERNEL
 
 
 def _flat(text: str) -> str:

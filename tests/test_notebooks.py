@@ -1,35 +1,37 @@
 """Execute every design notebook headless, as CI does on a clean machine.
 
-Each ``notebooks/*.py`` (jupytext percent format) is read with jupytext and executed with
-nbclient in a Jupyter kernel that runs *this* interpreter (a kernel spec written to a
-temporary folder, so the test never depends on which ``python3`` kernel happens to be
-installed). Any error in any cell fails the test, and so does an ``assert`` of a number
-the notebook discusses. Budget: all notebooks together within 5 minutes (issue 6).
+Each ``notebooks/NN_*.py`` (jupytext percent format) is read with jupytext and executed
+with nbclient in a Jupyter kernel that runs *this* interpreter
+(``docs/_ext/notebook_cache.py``: a kernel spec written to a temporary folder, so the test
+never depends on which ``python3`` kernel happens to be installed). Any error in any cell
+fails the test, and so does an ``assert`` of a number the notebook discusses. Budget: all
+notebooks together within 5 minutes (issue 6).
+
+What a test executes is stored in the jupyter-cache the documentation build reads
+(myst-nb's ``cache`` mode), so that the site shows these executions and CI runs each
+notebook once (docs/developer.md, "Notebooks").
 """
 
 from __future__ import annotations
 
 import ast
-import json
 import sys
-import time
 from pathlib import Path
 
 import pytest
 
 jupytext = pytest.importorskip("jupytext", reason="install the notebooks extra")
-nbclient = pytest.importorskip("nbclient", reason="install the notebooks extra")
+pytest.importorskip("nbclient", reason="install the notebooks extra")
 pytest.importorskip("ipykernel", reason="install the notebooks extra")
+pytest.importorskip("jupyter_cache", reason="install the notebooks extra")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "_ext"))
+import notebook_cache  # noqa: E402  (docs/_ext: the one execution of tests and site)
 
-NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
-PATHS = sorted(NOTEBOOKS.glob("[0-9][0-9]_*.py"))
-KERNEL = "phdesign-notebook-test"
+PATHS = notebook_cache.notebook_paths()
 TOTAL_BUDGET = 300.0  # seconds, all notebooks together (issue 6)
-# seconds; a single cell over this is a hang, not slowness.  Measured (load 6.8 on two
-# cores, default BLAS threads): the slowest cell, notebook 02's six simulations, 28 s;
-# its gain map and tuning 17 s (the numeric layer runs its small eigenproblems on one BLAS
-# thread).  240 s is more than three times either.
-PER_CELL_TIMEOUT = 240
+# A single cell over notebook_cache.CELL_TIMEOUT (240 s) is a hang, not slowness.
+# Measured (load 6.8 on two cores, default BLAS threads): the slowest cell, notebook 02's
+# six simulations, 28 s; its gain map and tuning 17 s.  240 s is more than three times either.
 DURATIONS: dict[str, float] = {}
 #: What a notebook needs beyond the notebooks extra, and the extra that installs it.
 NEEDS = {
@@ -105,22 +107,6 @@ def test_notebooks_use_the_public_api(path: Path):
     )
 
 
-@pytest.fixture(scope="module")
-def kernel_name(tmp_path_factory: pytest.TempPathFactory) -> str:
-    """A kernel spec for the running interpreter, found through JUPYTER_PATH."""
-    root = tmp_path_factory.mktemp("jupyter")
-    spec = root / "kernels" / KERNEL
-    spec.mkdir(parents=True)
-    argv = [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"]
-    spec.joinpath("kernel.json").write_text(
-        json.dumps({"argv": argv, "display_name": "phdesign tests", "language": "python"})
-    )
-    mp = pytest.MonkeyPatch()
-    mp.setenv("JUPYTER_PATH", str(root))
-    yield KERNEL
-    mp.undo()
-
-
 def test_there_are_seven_notebooks():
     assert [p.stem for p in PATHS] == [
         "01_quickstart",
@@ -135,21 +121,16 @@ def test_there_are_seven_notebooks():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("path", PATHS, ids=[p.stem for p in PATHS])
-def test_notebook_runs_without_error(path: Path, kernel_name: str):
+def test_notebook_runs_without_error(path: Path):
     modules, extra = NEEDS.get(path.stem, ((), ""))
     for module in modules:
         pytest.importorskip(module, reason=f"{path.stem} needs {module}: install extra {extra}")
     notebook = jupytext.read(path)
     assert any(c.cell_type == "markdown" for c in notebook.cells), "a notebook tells a story"
-    client = nbclient.NotebookClient(
-        notebook,
-        kernel_name=kernel_name,
-        timeout=PER_CELL_TIMEOUT,
-        resources={"metadata": {"path": str(NOTEBOOKS)}},
-    )
-    start = time.perf_counter()
-    client.execute()  # raises CellExecutionError, naming the cell, on any error
-    DURATIONS[path.stem] = time.perf_counter() - start
+    # raises CellExecutionError, naming the cell, on any error (and stores nothing then)
+    notebook, DURATIONS[path.stem] = notebook_cache.execute(path)
+    # the documentation build finds this execution: it will not run the notebook again
+    assert notebook_cache.cached(path) is not None
     outputs = [o for c in notebook.cells if c.cell_type == "code" for o in c.get("outputs", [])]
     assert not [o for o in outputs if o.get("output_type") == "error"]
     # the figures are shown inline (plots made inside a kernel go through pyplot)

@@ -2,19 +2,22 @@
 
 * ``_generated/cli.rst``: the command-line reference, read from the argument parser
   itself (``phdesign.cli.build_parser``), so that it never disagrees with ``--help``.
-* ``_generated/notebooks/*.rst``: each design notebook (``notebooks/*.py``, jupytext
-  percent format) as a page: its narrative (Markdown, converted here: headings,
-  paragraphs, lists, inline and display math, code, emphasis, links) and its code cells.
-  The notebooks are executed by the test suite, not by the documentation build, so the
-  build stays offline and fast.
+* ``_generated/notebooks/NN_*.ipynb``: each design notebook (every ``notebooks/NN_*.py``,
+  jupytext percent format, picked up by name), which myst-nb renders executed, with its
+  figures.  Each is executed once for the tests and the site (``notebook_cache.py``): the
+  build executes only what the tests have not stored.
+* ``_generated/gallery.rst`` with ``_generated/gallery/NN_*.png``: the gallery, one card
+  per notebook (its first figure, linked to its page, and its title).
 
-Both are written when the builder starts (``builder-inited``) and are not committed.
+They are written when the builder starts (``builder-inited``) for the site's own sources
+(a page built elsewhere with this conf.py, as tests/test_docs_offline.py does, gets none),
+and are not committed.
 """
 
 from __future__ import annotations
 
 import argparse
-import re
+import base64
 from pathlib import Path
 from typing import Any
 
@@ -143,164 +146,91 @@ def cli_page() -> str:
     return "\n".join(lines) + "\n"
 
 
-# --------------------------------------------------------------------------- notebooks
-def notebook_cells(text: str) -> list[tuple[str, str]]:
-    """Split a jupytext percent script into ``(kind, source)`` cells (header dropped)."""
-    lines = text.splitlines()
-    if lines and lines[0].startswith("# ---"):
-        end = next(i for i in range(1, len(lines)) if lines[i].startswith("# ---"))
-        lines = lines[end + 1 :]
-    cells: list[tuple[str, list[str]]] = []
-    for line in lines:
-        if line.startswith("# %%"):
-            cells.append(("markdown" if "[markdown]" in line else "code", []))
-        elif cells:
-            cells[-1][1].append(line)
-    out = []
-    for kind, body in cells:
-        if kind == "markdown":
-            body = [re.sub(r"^# ?", "", line) for line in body]
-        source = "\n".join(body).strip("\n")
-        if source.strip():
-            out.append((kind, source))
-    return out
+# --------------------------------------------------------------------------- gallery
+def first_figure(notebook: Any) -> bytes | None:
+    """Return the first PNG an executed notebook displays, or None."""
+    for cell in notebook.cells:
+        for output in cell.get("outputs", []):
+            png = output.get("data", {}).get("image/png")
+            if png:
+                return base64.b64decode(png)
+    return None
 
 
-def _inline(text: str) -> str:
-    """Markdown inline markup to rst: math, code, links, emphasis; rst specials escaped."""
-    pieces: list[str] = []
-    pattern = re.compile(
-        r"\$(?P<math>[^$]+)\$|`(?P<code>[^`]+)`|\[(?P<text>[^\]]+)\]\((?P<url>[^)]+)\)"
-    )
-    position = 0
-    for match in pattern.finditer(text):
-        pieces.append(_plain(text[position : match.start()]))
-        if match["math"] is not None:
-            pieces.append(f"\\ :math:`{' '.join(match['math'].split())}`\\ ")
-        elif match["code"] is not None:
-            pieces.append(f"\\ ``{match['code']}``\\ ")
-        else:
-            pieces.append(f"\\ `{match['text']} <{match['url']}>`__\\ ")
-        position = match.end()
-    pieces.append(_plain(text[position:]))
-    return "".join(pieces)
-
-
-def _plain(text: str) -> str:
-    text = text.replace("\\", "\\\\").replace("|", "\\|")
-    text = re.sub(r"(?<![\w*])_(\S[^_]*?)_(?!\w)", r"*\1*", text)  # _emphasis_
-    return re.sub(r"(\w)_(?=\s|$)", r"\1\\_", text)  # a trailing _ is not a reference
-
-
-def _table(rows: list[str]) -> list[str]:
-    cells = [[c.strip() for c in row.strip().strip("|").split("|")] for row in rows]
-    cells = [r for r in cells if not all(re.fullmatch(r":?-+:?", c) for c in r)]
-    out = [".. list-table::", "   :header-rows: 1", ""]
-    for row in cells:
-        out.append(f"   * - {_inline(row[0]) or ' '}")
-        out += [f"     - {_inline(c) or ' '}" for c in row[1:]]
-    return [*out, ""]
-
-
-def markdown_to_rst(text: str) -> str:
-    """Convert the Markdown of a notebook's narrative cell to reStructuredText."""
-    out: list[str] = []
-    blocks = re.split(r"\n\s*\n", text)
-    for block in blocks:
-        lines = block.split("\n")
-        if block.strip().startswith("$$"):
-            body = block.strip().strip("$").strip()
-            out += [".. math::", "", *("   " + line for line in body.split("\n")), ""]
-            continue
-        if all(line.strip().startswith("|") for line in lines if line.strip()):
-            out += _table([line for line in lines if line.strip()])
-            continue
-        heading = re.match(r"(#+)\s+(.*)", lines[0])
-        if heading and len(lines) == 1:
-            title = _inline(heading[2]).strip()
-            level = min(len(heading[1]), len(LEVELS)) - 1
-            out += [title, LEVELS[level] * max(len(title), 3), ""]
-            continue
-        paragraph: list[str] = []
-        in_list = False
-        for line in lines:
-            item = re.match(r"(\s*)([-*]|\d+\.)\s+(.*)", line)
-            if item:
-                if paragraph:
-                    out += [_inline("\n".join(paragraph)), ""]
-                    paragraph = []
-                out.append(f"{item[1]}{'-' if item[2] in '-*' else item[2]} {_inline(item[3])}")
-                in_list = True
-            elif in_list and line.startswith((" ", "\t")):
-                out.append("  " + _inline(line.strip()))
-            else:
-                if in_list:
-                    out.append("")
-                    in_list = False
-                paragraph.append(line)
-        if paragraph:
-            out.append(_inline("\n".join(paragraph)))
-        out.append("")
-    return "\n".join(out)
-
-
-def notebook_page(path: Path) -> str:
-    """Return a notebook as an rst page: the narrative converted, the code as code blocks."""
-    lines = [f".. Generated from notebooks/{path.name}; edit the notebook, not this page.", ""]
-    titled = False
-    for kind, source in notebook_cells(path.read_text(encoding="utf-8")):
-        if kind == "markdown":
-            text = markdown_to_rst(source)
-            titled = titled or bool(re.match(r"#\s", source))
-            lines.append(text)
-        else:
-            lines += [
-                ".. code:: python",
-                "",
-                *("   " + line for line in source.split("\n")),
-                "",
-            ]
-    if not titled:
-        lines[2:2] = [path.stem, "=" * len(path.stem), ""]
-    lines += [
+def gallery_page(cards: list[tuple[str, bool]]) -> str:
+    """Return the gallery: a card per notebook, ``(name, whether it has a thumbnail)``."""
+    lines = [
+        "Gallery",
+        "=======",
         "",
-        f"*Run it:* ``jupytext --to notebook --execute notebooks/{path.name}``, or as a script,",
-        f"``python notebooks/{path.name}``.",
+        "The design notebooks, executed when this site was built, with their outputs and",
+        "figures: each card is a notebook's first figure and its title.  They are jupytext",
+        "scripts in ``notebooks/``; ``notebooks/README.md`` says how to open and run them.",
+        "The figures of the paper's beam are on :doc:`../getting_started`.",
         "",
     ]
+    for name, has_figure in cards:
+        link = f":doc:`notebooks/{name}`"
+        if has_figure:
+            lines += [f".. figure:: gallery/{name}.png", "   :width: 70%",
+                      f"   :target: notebooks/{name}.html", "", f"   {link}", ""]  # fmt: skip
+        else:
+            lines += [f"- {link}", ""]
+    lines += [".. toctree::", "   :hidden:", "", *(f"   notebooks/{n}" for n, _ in cards), ""]
     return "\n".join(lines)
 
 
 # --------------------------------------------------------------------------- sphinx
-def _write(path: Path, text: str) -> None:
+def _write(path: Path, content: str | bytes) -> None:
+    """Write ``path`` unless it holds ``content`` already (no needless rebuilds)."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    if not path.exists() or path.read_text(encoding="utf-8") != text:
-        path.write_text(text, encoding="utf-8")
+    data = content.encode("utf-8") if isinstance(content, str) else content
+    if not path.exists() or path.read_bytes() != data:
+        path.write_bytes(data)
+
+
+def notebooks() -> list[tuple[str, bool]]:
+    """Write each notebook's page source and thumbnail; return the gallery's cards.
+
+    Every notebook is executed here unless the cache holds it as it is now, so that the
+    thumbnails exist before the pages are read and myst-nb only merges stored outputs.
+    """
+    import nbformat
+    import notebook_cache
+    from sphinx.util import logging
+
+    log = logging.getLogger(__name__)
+    cards = []
+    paths = notebook_cache.notebook_paths()
+    names = {f"{p.stem}{suffix}" for p in paths for suffix in (".ipynb", ".png")}
+    for folder in ("notebooks", "gallery"):  # pages of notebooks renamed or removed
+        for stale in (GENERATED / folder).glob("*"):
+            if stale.name not in names:
+                stale.unlink()
+    for path in paths:
+        source = nbformat.writes(notebook_cache.read(path))
+        _write(GENERATED / "notebooks" / f"{path.stem}.ipynb", source)
+        ran = notebook_cache.cached(path)
+        if ran is None:
+            log.info(f"executing notebooks/{path.name} (not in the cache as it is now)")
+            ran, seconds = notebook_cache.execute(path)
+            log.info(f"executed notebooks/{path.name} in {seconds:.0f} s")
+        figure = first_figure(ran)
+        if figure is not None:
+            _write(GENERATED / "gallery" / f"{path.stem}.png", figure)
+        cards.append((path.stem, figure is not None))
+    return cards
 
 
 def generate(app: Any = None) -> None:
-    """Write the generated pages (unchanged files are left alone: no needless rebuilds)."""
+    """Write the generated pages of the site's own sources (unchanged files are left alone)."""
+    if app is not None and Path(app.srcdir).resolve() != DOCS:
+        return
+    for stale in GENERATED.glob("*.rst"):  # pages of an earlier layout (notebooks.rst)
+        if stale.name not in ("cli.rst", "gallery.rst"):
+            stale.unlink()
     _write(GENERATED / "cli.rst", cli_page())
-    notebooks = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.py"))
-    names = []
-    for path in notebooks:
-        _write(GENERATED / "notebooks" / f"{path.stem}.rst", notebook_page(path))
-        names.append(path.stem)
-    index = [
-        "Notebooks",
-        "=========",
-        "",
-        "The design notebooks, as pages: their narrative and code.  They are jupytext",
-        "scripts in ``notebooks/``, executed by the test suite (``tests/test_notebooks.py``);",
-        "``notebooks/README.md`` says how to open and run them.",
-        "",
-        ".. toctree::",
-        "   :maxdepth: 1",
-        "",
-        *(f"   notebooks/{name}" for name in names),
-        "",
-    ]
-    _write(GENERATED / "notebooks.rst", "\n".join(index))
+    _write(GENERATED / "gallery.rst", gallery_page(notebooks()))
 
 
 def setup(app: Any) -> dict[str, Any]:
