@@ -84,6 +84,10 @@ class SweepError(PhdesignError, ValueError):
     """A sweep's grid, store or scheduler is invalid or unreachable."""
 
 
+class RateProofError(PhdesignError, ValueError):
+    """No decay rate can be proved for a closed system (its order, its data or the search)."""
+
+
 def check_shape(
     name: str,
     matrix: Any,

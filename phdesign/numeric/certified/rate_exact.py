@@ -1,0 +1,228 @@
+r"""The exact half of the decay-rate proof: the inequalities, built and checked in the rationals.
+
+For the functional of :mod:`.rate` (its docstring derives everything),
+
+.. math::
+
+    V(x) = \int_a^b x^\top \Pi(z)\, x\, dz, \qquad
+    \Pi(z) = t^{-1}\Pi_- + t\,\Pi_+, \quad t = e^{\mu (z - a)}, \quad
+    \mu = \frac{\ln \tau}{b - a},
+
+with rational :math:`\Pi_\pm`, :math:`\tau`, :math:`\sigma`, :math:`c_1`, :math:`c_2`,
+the decay estimate follows from finitely many strict matrix inequalities, every one
+between rational matrices (:func:`inequalities`):
+
+* :math:`\Pi_\pm \succ 0` and :math:`\Pi_\pm P_1 \mathcal H` symmetric (checked
+  exactly; the SDP's unknowns are coordinates in an exact rational basis of that
+  subspace, :func:`lyapunov_basis`);
+* the norm bounds :math:`\tau^{-1}\Pi_- + \Pi_+ - c_1\mathcal H \succ 0` and
+  :math:`c_2 \mathcal H - \Pi_- - \tau\Pi_+ \succ 0`;
+* the boundary form on the admissible traces
+  :math:`K_b^\top \operatorname{diag}\big(\mathcal H^{-1}\Pi(b)P_1,
+  -\mathcal H^{-1}\Pi(a)P_1\big) K_b \prec 0`,
+  with :math:`\Pi(b) = \tau^{-1}\Pi_- + \tau\Pi_+` and :math:`\Pi(a) = \Pi_- + \Pi_+`;
+* the pointwise form :math:`C_-(\mu) + s\,C_+(\mu) \prec 0` at the four corners
+  :math:`\mu \in \{\mu_{lo}, \mu_{hi}\}`, :math:`s \in \{1, \tau^2\}`, where
+  :math:`\mu_{lo} \le \ln(\tau)/(b - a) \le \mu_{hi}` is a rational enclosure
+  (:func:`mu_enclosure`, mpmath's interval logarithm) and
+
+  .. math::
+
+      C_\mp(\mu) = \pm\mu\,\Pi_\mp P_1\mathcal H + \Pi_\mp P_0\mathcal H
+      + \mathcal H P_0^\top \Pi_\mp + 2\sigma\,\Pi_\mp .
+
+  :math:`t\,G(z) = C_-(\mu) + t^2 C_+(\mu)` is affine in :math:`s = t^2 \in [1, \tau^2]`
+  and in :math:`\mu`, so negative definiteness at the corners covers every
+  :math:`z \in [a, b]` and the true :math:`\mu`.
+
+Definiteness is decided by Sylvester's criterion on exact leading principal minors
+(sympy's ``DomainMatrix`` over QQ); the independent checker
+(:mod:`phdesign.proofcheck.rate`) decides it by an LDLᵀ factorization in
+:class:`fractions.Fraction`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+
+import sympy
+from sympy.polys.matrices import DomainMatrix
+
+from phdesign.numeric.certified.rate_problem import RateProblem
+
+__all__ = [
+    "CORNERS",
+    "Inequality",
+    "LyapunovData",
+    "failures",
+    "inequalities",
+    "lyapunov_basis",
+    "mu_enclosure",
+    "to_fraction",
+]
+
+#: The corners (mu end, s end) of the pointwise inequality, in the proof file's names.
+CORNERS = (("lo", "1"), ("lo", "tau^2"), ("hi", "1"), ("hi", "tau^2"))
+
+
+@dataclass(frozen=True)
+class Inequality:
+    """One matrix inequality of the proof: ``matrix`` is claimed ``claim`` definite."""
+
+    name: str
+    claim: str  # "positive" or "negative"
+    matrix: sympy.ImmutableMatrix
+    meaning: str
+
+    @property
+    def holds(self) -> bool:
+        """Whether the claim holds, by Sylvester's criterion on exact minors."""
+        sign = 1 if self.claim == "positive" else -1
+        return _positive_definite(sign * self.matrix)
+
+
+@dataclass(frozen=True)
+class LyapunovData:
+    """The rational unknowns of the proof (see the module docstring)."""
+
+    Pi_minus: sympy.ImmutableMatrix
+    Pi_plus: sympy.ImmutableMatrix
+    tau: sympy.Rational
+    mu: tuple[sympy.Rational, sympy.Rational]
+    sigma: sympy.Rational
+    c1: sympy.Rational
+    c2: sympy.Rational
+
+
+def to_fraction(value: sympy.Rational) -> Fraction:
+    """Return an exact sympy rational as a :class:`fractions.Fraction`."""
+    return Fraction(int(value.p), int(value.q))
+
+
+def _positive_definite(M: sympy.ImmutableMatrix) -> bool:
+    dm = DomainMatrix.from_Matrix(sympy.Matrix(M)).convert_to(sympy.QQ)
+    n = M.rows
+    return all(dm[:k, :k].det() > 0 for k in range(1, n + 1))
+
+
+def lyapunov_basis(problem: RateProblem) -> tuple[sympy.ImmutableMatrix, ...]:
+    r"""Return a rational basis of the symmetric Π with :math:`\Pi P_1\mathcal H` symmetric.
+
+    The nullspace (over the rationals) of the linear map from the upper triangle of
+    :math:`\Pi` to the antisymmetric part of :math:`\Pi P_1 \mathcal H`.
+    """
+    n = problem.size
+    unknowns = [(i, j) for i in range(n) for j in range(i, n)]
+    symbols = sympy.symbols(f"p0:{len(unknowns)}")
+    Pi = sympy.zeros(n, n)
+    for s, (i, j) in zip(symbols, unknowns, strict=True):
+        Pi[i, j] = Pi[j, i] = s
+    S = Pi * problem.P1 * problem.H
+    rows = [S[i, j] - S[j, i] for i in range(n) for j in range(i + 1, n)]
+    A = sympy.Matrix([[sympy.diff(r, s) for s in symbols] for r in rows])
+    null = A.nullspace() if rows else [sympy.eye(len(symbols))[:, k] for k in range(len(symbols))]
+    return tuple(
+        sympy.ImmutableMatrix(Pi.xreplace(dict(zip(symbols, v, strict=True)))) for v in null
+    )
+
+
+def mu_enclosure(
+    tau: sympy.Rational, length: sympy.Rational, digits: int = 30
+) -> tuple[sympy.Rational, sympy.Rational]:
+    r"""Rationals :math:`\mu_{lo} \le \ln(\tau)/\ell \le \mu_{hi}`, about ``10**-digits`` apart.
+
+    mpmath's interval logarithm (200 bits) encloses :math:`\ln\tau`; its endpoints are
+    exact binary rationals, rounded outward to ``digits`` decimals.
+    """
+    from mpmath import iv, mp
+
+    saved, iv.prec = iv.prec, 200  # iv has no workprec; restore what the caller had
+    try:
+        enclosure = iv.log(iv.mpf(int(tau.p)) / iv.mpf(int(tau.q)))
+    finally:
+        iv.prec = saved
+    lo, hi = (_binary_fraction(mp.make_mpf(end).man_exp) for end in enclosure._mpi_)
+    scale = 10**digits
+    ell = to_fraction(length)
+    # one more unit outward, so the enclosure is at least 10**-digits wider than the truth
+    # on each side and a re-check with its own logarithm decides it quickly
+    mu_lo = Fraction(math.floor(lo / ell * scale) - 1, scale)
+    mu_hi = Fraction(math.ceil(hi / ell * scale) + 1, scale)
+    return sympy.Rational(mu_lo.numerator, mu_lo.denominator), sympy.Rational(
+        mu_hi.numerator, mu_hi.denominator
+    )
+
+
+def _binary_fraction(man_exp: tuple[int, int]) -> Fraction:
+    mantissa, exponent = man_exp
+    return Fraction(mantissa) * Fraction(2) ** exponent
+
+
+def _pointwise(problem: RateProblem, data: LyapunovData, mu: sympy.Rational, s: sympy.Expr):
+    A = problem.P1 * problem.H
+    B = problem.P0 * problem.H
+
+    def part(Pi: sympy.ImmutableMatrix, sign: int) -> sympy.Matrix:
+        return sign * mu * Pi * A + Pi * B + (Pi * B).T + 2 * data.sigma * Pi
+
+    return sympy.ImmutableMatrix(part(data.Pi_minus, 1) + s * part(data.Pi_plus, -1))
+
+
+def _boundary(problem: RateProblem, data: LyapunovData) -> sympy.ImmutableMatrix:
+    H_inv = problem.H.inv()
+    at_b = H_inv * (data.Pi_minus / data.tau + data.tau * data.Pi_plus) * problem.P1
+    at_a = H_inv * (data.Pi_minus + data.Pi_plus) * problem.P1
+    form = sympy.diag(at_b, -at_a)
+    return sympy.ImmutableMatrix(problem.kernel.T * form * problem.kernel)
+
+
+def inequalities(problem: RateProblem, data: LyapunovData) -> tuple[Inequality, ...]:
+    """Every matrix inequality the decay estimate rests on (the module docstring's list)."""
+    H, tau = problem.H, data.tau
+    found = [
+        Inequality("Pi_minus", "positive", data.Pi_minus, "Π₋ ≻ 0"),
+        Inequality("Pi_plus", "positive", data.Pi_plus, "Π₊ ≻ 0"),
+        Inequality(
+            "lower bound",
+            "positive",
+            sympy.ImmutableMatrix(data.Pi_minus / tau + data.Pi_plus - data.c1 * H),
+            "τ⁻¹Π₋ + Π₊ − c₁H ≻ 0, so V ≥ c₁‖x‖²",
+        ),
+        Inequality(
+            "upper bound",
+            "positive",
+            sympy.ImmutableMatrix(data.c2 * H - data.Pi_minus - tau * data.Pi_plus),
+            "c₂H − Π₋ − τΠ₊ ≻ 0, so V ≤ c₂‖x‖²",
+        ),
+        Inequality(
+            "boundary",
+            "negative",
+            _boundary(problem, data),
+            "K_bᵀ diag(H⁻¹Π(b)P₁, −H⁻¹Π(a)P₁) K_b ≺ 0: the boundary term of dV/dt",
+        ),
+    ]
+    ends = {"lo": data.mu[0], "hi": data.mu[1]}
+    for mu_end, s_end in CORNERS:
+        s = sympy.Integer(1) if s_end == "1" else tau**2
+        found.append(
+            Inequality(
+                f"pointwise mu={mu_end} s={s_end}",
+                "negative",
+                _pointwise(problem, data, ends[mu_end], s),
+                f"C₋(μ_{mu_end}) + s C₊(μ_{mu_end}) ≺ 0 at s = {s_end}: dV/dt + 2σV inside",
+            )
+        )
+    return tuple(found)
+
+
+def failures(problem: RateProblem, data: LyapunovData) -> list[str]:
+    """Return what fails of the exact proof (empty: every inequality and identity holds)."""
+    found = [f"{q.name}: {q.meaning} fails" for q in inequalities(problem, data) if not q.holds]
+    for label, Pi in (("Pi_minus", data.Pi_minus), ("Pi_plus", data.Pi_plus)):
+        if Pi != Pi.T or (Pi * problem.P1 * problem.H) != (Pi * problem.P1 * problem.H).T:
+            found.append(f"{label}: Π and Π P₁ H must be symmetric")
+    if not (data.sigma > 0 and data.c1 > 0 and data.tau > 1 and data.mu[0] <= data.mu[1]):
+        found.append("σ > 0, c₁ > 0, τ > 1 and μ_lo ≤ μ_hi are required")
+    return found
