@@ -179,13 +179,14 @@ def _inequalities(d: dict[str, Any]) -> dict[str, tuple[str, Matrix]]:
     """Recompute the claims: name -> (claim, matrix)."""
     tau, one = d["tau"], Fraction(1)
     Pm, Pp, H = d["Pi_minus"], d["Pi_plus"], d["H"]
-    found = {
-        "Pi_minus": ("positive", Pm),
-        "Pi_plus": ("positive", Pp),
-        "lower bound": ("positive", _add((1 / tau, Pm), (one, Pp), (-d["c1"], H))),
-        "upper bound": ("positive", _add((d["c2"], H), (-one, Pm), (-tau, Pp))),
-        "boundary": ("negative", _boundary(d)),
-    }
+    found: dict[str, tuple[str, Matrix]] = {}
+    for s_end, s in (("1", one), ("tau^2", tau * tau)):
+        # Π(z) = t⁻¹(Π₋ + sΠ₊), s = t²: (1 + s)/2 ≥ √s ≥ the chord 1 + (s − 1)/(τ + 1)
+        lower = _add((one, Pm), (s, Pp), (-d["c1"] * (1 + s) / 2, H))
+        upper = _add((d["c2"] * (1 + (s - 1) / (tau + 1)), H), (-one, Pm), (-s, Pp))
+        found[f"lower bound s={s_end}"] = ("positive", lower)
+        found[f"upper bound s={s_end}"] = ("positive", upper)
+    found["boundary"] = ("negative", _boundary(d))
     for mu_end, mu in (("lo", d["mu"][0]), ("hi", d["mu"][1])):
         for s_end, s in (("1", one), ("tau^2", tau * tau)):
             found[f"pointwise mu={mu_end} s={s_end}"] = ("negative", _pointwise(d, mu, s))

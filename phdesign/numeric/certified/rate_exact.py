@@ -181,21 +181,25 @@ def _boundary(problem: RateProblem, data: LyapunovData) -> sympy.ImmutableMatrix
 def inequalities(problem: RateProblem, data: LyapunovData) -> tuple[Inequality, ...]:
     """Every matrix inequality the decay estimate rests on (the module docstring's list)."""
     H, tau = problem.H, data.tau
-    found = [
-        Inequality("Pi_minus", "positive", data.Pi_minus, "Π₋ ≻ 0"),
-        Inequality("Pi_plus", "positive", data.Pi_plus, "Π₊ ≻ 0"),
-        Inequality(
-            "lower bound",
-            "positive",
-            sympy.ImmutableMatrix(data.Pi_minus / tau + data.Pi_plus - data.c1 * H),
-            "τ⁻¹Π₋ + Π₊ − c₁H ≻ 0, so V ≥ c₁‖x‖²",
-        ),
-        Inequality(
-            "upper bound",
-            "positive",
-            sympy.ImmutableMatrix(data.c2 * H - data.Pi_minus - tau * data.Pi_plus),
-            "c₂H − Π₋ − τΠ₊ ≻ 0, so V ≤ c₂‖x‖²",
-        ),
+    found = []
+    for s_end, s in (("1", sympy.Integer(1)), ("tau^2", tau**2)):
+        weighted = data.Pi_minus + s * data.Pi_plus
+        chord = 1 + (s - 1) / (tau + 1)  # ≤ √s on [1, τ²]
+        found += [
+            Inequality(
+                f"lower bound s={s_end}",
+                "positive",
+                sympy.ImmutableMatrix(weighted - data.c1 * (1 + s) / 2 * H),
+                f"Π₋ + sΠ₊ − c₁(1 + s)/2 H ≻ 0 at s = {s_end}, so Π(z) ≻ c₁H",
+            ),
+            Inequality(
+                f"upper bound s={s_end}",
+                "positive",
+                sympy.ImmutableMatrix(data.c2 * chord * H - weighted),
+                f"c₂(1 + (s − 1)/(τ + 1))H − Π₋ − sΠ₊ ≻ 0 at s = {s_end}, so Π(z) ≺ c₂H",
+            ),
+        ]
+    found += [
         Inequality(
             "boundary",
             "negative",

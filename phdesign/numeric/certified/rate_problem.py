@@ -101,11 +101,11 @@ def exact_rational_matrix(name: str, matrix: Any, model: str) -> sympy.Immutable
         if getattr(value, "is_Rational", False):
             M[i, j] = value
             continue
-        z = sympy.Symbol("z")
+        names = {s.name for s in getattr(entry, "free_symbols", set())}
         why = (
             "depends on z: for a z-dependent coefficient phdesign has no rigorous bound on "
             "the pointwise inequality over [a, b] and refuses rather than sample z"
-            if z in getattr(entry, "free_symbols", set())
+            if "z" in names
             else "is not a rational number (the exact check works in the rationals)"
         )
         raise RateProofError(

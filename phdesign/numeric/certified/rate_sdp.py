@@ -89,10 +89,11 @@ class LyapunovProgram:
         at_a = H_inv @ (Pm + Pp) @ P1
         boundary = K[:n].T @ at_b @ K[:n] - K[n:].T @ at_a @ K[n:]
         constraints = [
-            sym(Pm) >> eps * H,
-            sym(Pp) >> eps * H,
-            sym(p["inv_tau"] * Pm + Pp) >> (1 + eps) * H,
-            sym(Pm + p["tau"] * Pp) << (self.c2 - eps) * H,
+            # the norm bounds at s = 1 and s = τ² (c₁ = 1; chord = 1 + (s − 1)/(τ + 1))
+            sym(Pm + Pp) >> (1 + eps) * H,
+            sym(Pm + p["s"] * Pp) >> ((1 + p["s"]) / 2 + eps) * H,
+            sym(Pm + Pp) << (self.c2 - eps) * H,
+            sym(Pm + p["s"] * Pp) << (p["tau"] * self.c2 - eps) * H,
             sym(boundary) << -eps * np.eye(K.shape[1]),
             pointwise(1.0, p["mu"], p["two_sigma"]) << -eps * H,
             pointwise(p["s"], p["s_mu"], p["s_two_sigma"]) << -eps * H,
