@@ -31,31 +31,16 @@ import mpmath
 import pytest
 import sympy
 
+from rate_models import TRANSPORT, closed
+
 from phdesign.core.errors import RateProofError
 from phdesign.models import load_builtin
 from phdesign.numeric.certified.rate import prove_rate
 from phdesign.numeric.certified.rate_exact import failures
 from phdesign.numeric.certified.rate_problem import rate_problem
 from phdesign.symbolic.model import BCPHS
-from phdesign.symbolic.observer import ObserverDesign, gain_matrix, sensor_matrix
 
 pytest.importorskip("cvxpy", reason="the proved decay rate needs the certify extra")
-
-
-def closed(model: BCPHS, sensors: list[int], gain: str):
-    """The exact closed error system's data, read as the prover reads it."""
-    design = ObserverDesign(model, sensor_matrix(sensors, model.n_ports), gain_matrix(gain, len(sensors)))
-    err = design.error_system()
-    defaults = model.parameter_defaults
-    return rate_problem(
-        name=model.name,
-        order=model.order,
-        interval=model.interval,
-        H=model.H.xreplace(defaults),
-        P=tuple(P.xreplace(defaults) for P in model.P),
-        boundary=err.boundary_matrix,
-        kernel=err.K,
-    )
 
 
 def string_rate(gain: str) -> float:
@@ -69,17 +54,6 @@ def string_rate(gain: str) -> float:
         root = mpmath.findroot(lambda s: mpmath.cosh(s) + k * mpmath.sinh(s), start)
         assert abs(root - closed_form) < 1e-25  # the closed form is a root (30 digits)
         return -float(closed_form.real)
-
-
-TRANSPORT = BCPHS.define(
-    name="transport",
-    interval=[0, 1],
-    order=1,
-    P={1: [[1]]},
-    H=[[1]],
-    inputs=["e1(1) - e1(0)"],
-    outputs=["(e1(1) + e1(0))/2"],
-)
 
 
 @pytest.fixture(scope="module")
