@@ -25,11 +25,12 @@ CHECKER = Path(__file__).parents[2] / "phdesign" / "proofcheck" / "rate.py"
 
 @pytest.fixture(scope="module")
 def section():
-    from phdesign.models import load_builtin
-    from phdesign.numeric.certified.rate import prove_rate
     from rate_models import closed
 
-    proof = prove_rate(closed(load_builtin("wave"), [2], "2"), target=0.5)
+    from phdesign.models import load_builtin
+    from phdesign.numeric.certified.rate import prove_decay_rate
+
+    proof = prove_decay_rate(closed(load_builtin("wave"), [2], "2"), target=0.5)
     return json.loads(json.dumps(proof.to_json()))
 
 
@@ -90,7 +91,8 @@ def test_a_malformed_section_is_a_message_not_a_traceback(section, change, messa
     bad = copy.deepcopy(section)
     change(bad)
     found = check_rate(bad)
-    assert len(found) == 1 and message in found[0], found
+    assert len(found) == 1, found
+    assert message in found[0], found
 
 
 def test_the_checker_imports_the_standard_library_only():

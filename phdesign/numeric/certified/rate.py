@@ -58,6 +58,7 @@ from typing import Any
 import sympy
 
 from phdesign.core.errors import RateProofError
+from phdesign.numeric.certified.exact_system import ExactClosedSystem
 from phdesign.numeric.certified.rate_exact import (
     Inequality,
     LyapunovData,
@@ -67,10 +68,10 @@ from phdesign.numeric.certified.rate_exact import (
     mu_enclosure,
     to_fraction,
 )
-from phdesign.numeric.certified.rate_problem import RateProblem
+from phdesign.numeric.certified.rate_problem import RateProblem, read_system
 from phdesign.numeric.certified.rate_sdp import Candidate, LyapunovProgram, search
 
-__all__ = ["ASSUMPTIONS", "DecayRateProof", "prove_rate"]
+__all__ = ["ASSUMPTIONS", "DecayRateProof", "prove_decay_rate", "prove_rate"]
 
 #: What every proved rate rests on besides the exact inequalities.
 ASSUMPTIONS = (
@@ -139,6 +140,40 @@ class DecayRateProof:
         from phdesign.numeric.certified.rate_json import proof_text
 
         return proof_text(self)
+
+
+def prove_decay_rate(system: ExactClosedSystem, *, target: float | None = None) -> DecayRateProof:
+    r"""Prove :math:`\|\tilde x(t)\| \le M e^{-\sigma t}\|\tilde x(0)\|` for a closed system.
+
+    Parameters
+    ----------
+    system : ExactClosedSystem
+        The exact closed plant or error system (:func:`~.exact_system.closed_system`), of
+        order 1 with constant rational coefficients.
+    target : float, optional
+        Prove this rate (rounded down to 6 decimals) instead of the best one found.
+
+    Raises
+    ------
+    ArgumentError
+        ``system`` is not an :class:`~.exact_system.ExactClosedSystem`.
+    RateProofError
+        Order 2 or more (the message says what is proved instead: the spectral bound),
+        a z-dependent or irrational coefficient, no functional found, or ``target`` out
+        of reach.
+
+    Examples
+    --------
+    The string with the damper :math:`e_2(1) = -\tfrac12 e_1(1)`, whose every mode
+    decays like :math:`e^{-t\ln(3)/2}`, :math:`\ln(3)/2 \approx 0.5493`:
+
+    >>> from phdesign.models import load_builtin
+    >>> from phdesign.numeric.certified.exact_system import closed_system
+    >>> proof = prove_decay_rate(closed_system(load_builtin("wave-damper")), target=0.5)
+    >>> proof.sigma
+    Fraction(1, 2)
+    """
+    return prove_rate(read_system(system), target=target)
 
 
 def prove_rate(problem: RateProblem, *, target: float | None = None) -> DecayRateProof:

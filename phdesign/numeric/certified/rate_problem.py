@@ -28,13 +28,15 @@ from typing import Any
 
 import sympy
 
-from phdesign.core.errors import RateProofError
+from phdesign.core.errors import ArgumentError, RateProofError
+from phdesign.numeric.certified.exact_system import ExactClosedSystem
 
 __all__ = [
     "BEAM_REFUSAL",
     "RateProblem",
     "exact_rational_matrix",
     "rate_problem",
+    "read_system",
 ]
 
 #: What is proved for a model of order N >= 2 instead of a decay rate.
@@ -150,4 +152,42 @@ def rate_problem(
         P0=exact["P0"],
         boundary=exact_rational_matrix("boundary matrix U + G Y", boundary, name),
         kernel=exact_rational_matrix("kernel basis", kernel, name),
+    )
+
+
+def read_system(system: ExactClosedSystem) -> RateProblem:
+    r"""Read an exact closed system (:func:`~.exact_system.closed_system`) for the proof.
+
+    The kernel basis :math:`K_b` is the exact rational nullspace of the boundary rows
+    :math:`U + GY`; it has dimension :math:`n` for every admissible closed system.
+
+    Raises
+    ------
+    ArgumentError
+        ``system`` is not an :class:`~.exact_system.ExactClosedSystem`.
+    RateProofError
+        As :func:`rate_problem`.
+    """
+    if not isinstance(system, ExactClosedSystem):
+        raise ArgumentError(
+            "system must be an ExactClosedSystem (phdesign.numeric.certified.exact_system."
+            f"closed_system(model, C_m, L)); found {type(system).__name__}"
+        )
+    if system.order != 1:
+        raise RateProofError(f"{system.name}: {BEAM_REFUSAL.format(order=system.order)}")
+    boundary = exact_rational_matrix("boundary matrix U + G Y", system.boundary, system.name)
+    null = boundary.nullspace()
+    if len(null) != system.size:  # pragma: no cover - closed_system checked dim K = Nn
+        raise RateProofError(
+            f"{system.name}: the closed boundary rows must leave an n = {system.size} "
+            f"dimensional kernel; found {len(null)}"
+        )
+    return rate_problem(
+        name=system.name,
+        order=system.order,
+        interval=system.interval,
+        H=system.H,
+        P=system.P,
+        boundary=boundary,
+        kernel=sympy.Matrix.hstack(*null),
     )
