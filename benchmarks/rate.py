@@ -1,0 +1,93 @@
+"""Benchmark: the proved decay rate (issue 25, part 2) on the damped string and Timoshenko.
+
+For each error system (the string with the damper k = 1/2 at its end, sensor y2; the
+Timoshenko beam with tip dampers, sensors y3, y4, L = I), in this process:
+
+* ``prove_decay_rate`` (the SDP search in cvxpy/Clarabel, the rounding and the exact
+  check in sympy) against one cold converged ``spectrum()`` of the same error system (a
+  freshly loaded model, so no cached discretization: what ``phdesign spectrum`` pays;
+  the baseline, after one warm-up call for the imports);
+* the independent re-check ``check_rate`` (standard library) of the proof's JSON section,
+  against the proof itself.
+
+Targets: the proof takes at most 150x one cold converged spectrum, the re-check at most
+0.5x the proof.  The proof solves about two hundred small SDPs (a bisection in σ at each
+of about twenty weight ratios τ); Clarabel spends about 0.3 ms on each, cvxpy's
+parameter update and result unpacking 10-20 ms (measured with cProfile under a load of
+14 on two processors), so the search's cost is cvxpy's overhead: first measured at 60x
+(Timoshenko) and 110x (string), when the target was set.  Also printed: the proved σ against
+the converged abscissa (σ/|α|, the method's conservatism).  The machine's load is printed
+before and after: under load the ratios stay meaningful, the absolute times do not.
+
+Run:  python benchmarks/rate.py            (exit status 1 if a target is missed)
+"""
+
+from __future__ import annotations
+
+import json
+import statistics
+import sys
+from fractions import Fraction
+
+import numpy as np
+from _timing import load, timed
+
+from phdesign.models import load_builtin
+from phdesign.numeric.bridge import to_numeric
+from phdesign.numeric.certified.exact_system import closed_system
+from phdesign.numeric.certified.rate import prove_decay_rate
+from phdesign.numeric.spectrum.converged import spectrum
+from phdesign.proofcheck.rate import check_rate
+from phdesign.symbolic.observer import sensor_matrix
+
+CASES = {
+    "string, damper k = 1/2": ("wave", [2], ["1/2"]),
+    "Timoshenko, tip dampers L = I": ("timoshenko", [3, 4], ["1", "1"]),
+}
+PROOF_TARGET = 150.0
+CHECK_TARGET = 0.5
+
+
+def _case(label: str, name: str, sensors: list[int], gain: list[str]) -> bool:
+    model = load_builtin(name)
+    C = sensor_matrix(sensors, model.n_ports)
+    system = closed_system(model, C, gain)
+    C_float = np.array(C.tolist(), dtype=float)
+    L_float = np.diag([float(Fraction(g)) for g in gain])
+
+    def baseline():  # a cold spectrum, as `phdesign spectrum` pays it: a fresh model, no cache
+        return spectrum(to_numeric(load_builtin(name)), C_float, L_float)
+
+    report = baseline()  # warm-up (imports, Gauss rules)
+    proof, walls, _ = timed(lambda: prove_decay_rate(system), 3)
+    _, base, _ = timed(baseline, 3)
+    section = json.loads(json.dumps(proof.to_json()))
+    failures, checks, _ = timed(lambda: check_rate(section), 3)
+    proof_ratio = statistics.median(walls) / statistics.median(base)
+    check_ratio = statistics.median(checks) / statistics.median(walls)
+    ok = proof_ratio <= PROOF_TARGET and check_ratio <= CHECK_TARGET and not failures
+    print(
+        f"{label}: prove_decay_rate median {statistics.median(walls):.2f} s, one converged "
+        f"spectrum() {statistics.median(base):.3f} s: {proof_ratio:.1f}x (target <= "
+        f"{PROOF_TARGET:g}x); check_rate {statistics.median(checks):.3f} s: "
+        f"{check_ratio:.3f}x the proof (target <= {CHECK_TARGET:g}x); "
+        f"{'met' if ok else 'MISSED'}"
+    )
+    print(
+        f"  sigma = {float(proof.sigma):.6f}, M = {float(proof.M):.4f}, abscissa "
+        f"{report.spectral_abscissa:.6f}: sigma/|alpha| = "
+        f"{float(proof.sigma) / abs(report.spectral_abscissa):.4f}"
+    )
+    return ok
+
+
+def main() -> int:
+    print(load())
+    results = [_case(label, *case) for label, case in CASES.items()]  # run every case
+    ok = all(results)
+    print(load())
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
