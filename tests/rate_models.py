@@ -26,3 +26,16 @@ def closed(model: BCPHS, sensors: list[int], gain: str) -> ExactClosedSystem:
     """The exact error system of ``model`` with the unit ``sensors`` and one ``gain`` each."""
     gains = [gain] * len(sensors)
     return closed_system(model, sensor_matrix(sensors, model.n_ports), gains)
+
+
+# rho = T = 1 with a force input at each end: u = (e2(0), e2(1)), y = (-e1(0), e1(1)),
+# u y = e1(1) e2(1) - e1(0) e2(0), the power; sensors y1, y2 put a damper at each end
+STRING_TWO_ENDS = BCPHS.define(
+    name="string with a force input at each end",
+    interval=[0, 1],
+    order=1,
+    P={1: [[0, 1], [1, 0]]},
+    H=[[1, 0], [0, 1]],
+    inputs=["e2(0)", "e2(1)"],
+    outputs=["-e1(0)", "e1(1)"],
+)

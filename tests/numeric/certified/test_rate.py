@@ -21,6 +21,14 @@ y = (e(1) + e(0))/2 (u y = (e(1)^2 - e(0)^2)/2, the power), closed by u = -k y: 
 (1 + k/2) e(1) = (1 - k/2) e(0), e(1) = r e(0) with r = (2 - k)/(2 + k); a value
 travels from 1 to 0 in unit time, so
 e(0, t + 1) = r e(0, t): lambda = ln|r| + i pi (2m or 2m + 1) and the rate is -ln|r|.
+
+String with a damper at each end (tests/rate_models.STRING_TWO_ENDS, sensors y1, y2, gains
+k0, k1): e2(0) = k0 e1(0), e2(1) = -k1 e1(1).  With H = I, lambda e = P1 e', so
+e(1) = expm(lambda P1) e(0) = (cosh + k0 sinh, sinh + k0 cosh) for e(0) = (1, k0), and the
+condition at 1 is Delta(lambda) = (1 + k0 k1) sinh(lambda) + (k0 + k1) cosh(lambda) = 0,
+i.e. e^(2 lambda) = r0 r1 with r_i = (1 - k_i)/(1 + k_i) (the reflections at the two
+ends): Re lambda = 1/2 ln|r0 r1| for every mode.  k0 = 1/2, k1 = 2: r0 r1 = -1/9, so
+lambda = -ln 3 + i pi (m + 1/2), rate ln 3.
 """
 
 from __future__ import annotations
@@ -31,14 +39,16 @@ from dataclasses import replace
 import mpmath
 import pytest
 import sympy
-from rate_models import TRANSPORT, closed
+from rate_models import STRING_TWO_ENDS, TRANSPORT, closed
 
 from phdesign.core.errors import ArgumentError, RateProofError
 from phdesign.models import load_builtin
+from phdesign.numeric.certified.exact_system import closed_system
 from phdesign.numeric.certified.rate import prove_decay_rate
 from phdesign.numeric.certified.rate_exact import failures
 from phdesign.numeric.certified.rate_problem import rate_problem
 from phdesign.symbolic.model import BCPHS
+from phdesign.symbolic.observer import sensor_matrix
 
 pytest.importorskip("cvxpy", reason="the proved decay rate needs the certify extra")
 
@@ -152,3 +162,18 @@ def test_an_irrational_entry_is_refused():
             boundary=[[1, 1]],
             kernel=[[sympy.sqrt(2)], [-sympy.sqrt(2)]],
         )
+
+
+def test_a_string_with_a_damper_at_each_end_reaches_ninety_percent_of_its_rate():
+    k0, k1 = mpmath.mpf(1) / 2, mpmath.mpf(2)
+    with mpmath.workdps(30):
+        closed_form = -mpmath.log(3) + 1j * mpmath.pi / 2  # e^(2 lambda) = r0 r1 = -1/9
+        root = mpmath.findroot(
+            lambda s: (1 + k0 * k1) * mpmath.sinh(s) + (k0 + k1) * mpmath.cosh(s),
+            closed_form + mpmath.mpf("0.01"),
+        )
+        assert abs(root - closed_form) < 1e-25
+    true = math.log(3)
+    system = closed_system(STRING_TWO_ENDS, sensor_matrix([1, 2], 2), ["1/2", "2"])
+    proof = prove_decay_rate(system, target=0.9 * true)
+    assert 0.9 * true - 1e-6 <= proof.sigma < true
