@@ -26,7 +26,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from phdesign.cli import messages
-from phdesign.cli.common import progress_display
+from phdesign.cli.common import pause_collection, progress_display, resume_collection
 from phdesign.cli.design_arguments import join_negative_values
 from phdesign.core.errors import ModelError, ModelFileError, PhdesignError, PortError
 
@@ -176,5 +176,14 @@ def _fail(message: str) -> int:
 
 
 def run() -> None:
-    """Console-script entry point."""
-    sys.exit(main())
+    """Console-script entry point (``phdesign``, ``python -m phdesign``).
+
+    The garbage collector is paused while the command starts up, until its model is loaded
+    (:func:`~phdesign.cli.common.pause_collection`).
+    """
+    pause_collection()
+    try:
+        status = main()
+    finally:
+        resume_collection()
+    sys.exit(status)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -29,9 +30,11 @@ __all__ = [
     "load_model",
     "non_negative_int",
     "parse_parameter_overrides",
+    "pause_collection",
     "printable",
     "progress_display",
     "result_text",
+    "resume_collection",
     "run_outputs",
     "simulation_text",
     "split_items",
@@ -133,11 +136,48 @@ def parse_parameter_overrides(items: list[str]) -> dict[str, str]:
 
 
 def load_model(args: argparse.Namespace) -> BCPHS:
-    """Load MODEL (a built-in name, else a TOML file, :func:`phdesign.load`); apply ``--param``."""
+    """Load MODEL (a built-in name, else a TOML file, :func:`phdesign.load`); apply ``--param``.
+
+    The start-up of a run ends here: the garbage collector paused by :func:`pause_collection`
+    resumes.
+    """
     from phdesign.models import load
 
     overrides = parse_parameter_overrides(getattr(args, "param", []))
-    return load(args.model, overrides or None)
+    try:
+        return load(args.model, overrides or None)
+    finally:
+        resume_collection()
+
+
+#: Whether :func:`pause_collection` paused the garbage collector (and so may resume it).
+_PAUSED = [False]
+
+
+def pause_collection() -> None:
+    """Pause Python's cyclic garbage collector for the start-up of a command-line run.
+
+    The start-up (sympy's import, phdesign's modules, the model) creates about 6e4 objects
+    that live as long as the process; every collection meanwhile scans them and finds
+    nothing to free.  Paused, ``import sympy`` alone takes about 0.89x its CPU seconds
+    (benchmarks/cli_startup.py).  :func:`resume_collection` ends the pause; the library
+    (:func:`phdesign.cli.main` called in a process of one's own) never pauses.
+    """
+    if gc.isenabled():
+        gc.disable()
+        _PAUSED[0] = True
+
+
+def resume_collection() -> None:
+    """End :func:`pause_collection`'s pause: the start-up's objects are frozen, then collect.
+
+    Frozen (:func:`gc.freeze`), the objects made so far are left out of later collections,
+    which therefore cost what the run itself allocates.  Nothing happens without a pause.
+    """
+    if _PAUSED[0]:
+        _PAUSED[0] = False
+        gc.freeze()
+        gc.enable()
 
 
 #: Characters that would act on a terminal (escape sequences, bidirectional overrides):
