@@ -41,24 +41,24 @@ True
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import tomllib
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import sympy
-import tomli_w
 
 from phdesign.core.checks import require_path
 from phdesign.core.errors import ExpressionError, ModelError, ModelFileError, PhdesignError
-from phdesign.core.files import atomic_write, check_output_path
 from phdesign.core.limits import MAX_MODEL_FILE_BYTES, check_file_size
 from phdesign.symbolic.expressions import exact_number, parse_scalar
 from phdesign.symbolic.fields import Displacement, Field, Term, field_from_table
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.printing import format_expression
+
+if TYPE_CHECKING:  # pragma: no cover - re-exported on first use (module __getattr__ below)
+    from phdesign.core.files import atomic_write, check_output_path
 
 __all__ = [
     "atomic_write",
@@ -365,6 +365,8 @@ def model_to_toml(model: BCPHS) -> str:
     ModelFileError
         If the model holds something the file format cannot express exactly.
     """
+    import tomli_w  # a writer only: reading a model (every command) needs none
+
     text = tomli_w.dumps(model_to_dict(model))
     try:
         again = model_from_toml(text, source="the written model file")
@@ -377,6 +379,8 @@ def model_to_toml(model: BCPHS) -> str:
 
 def write_model(model: BCPHS, path: str | os.PathLike[str], force: bool = False) -> None:
     """Write ``model`` as a TOML file (atomically; refuses to overwrite unless ``force``)."""
+    from phdesign.core.files import atomic_write
+
     atomic_write(path, model_to_toml(model), force=force)
 
 
@@ -407,4 +411,19 @@ def dumps_json(value: Any, indent: int | None = 2) -> str:
     This is phdesign's one JSON writer: non-finite floats become ``null`` and
     ``allow_nan=False`` guarantees that no bare ``NaN`` or ``Infinity`` is ever printed.
     """
+    import json  # only a --json run writes JSON (``phdesign classify`` starts without it)
+
     return json.dumps(json_value(value), indent=indent, ensure_ascii=False, allow_nan=False)
+
+
+def __getattr__(name: str) -> Any:
+    """Return the output-file helpers of :mod:`phdesign.core.files` when first asked.
+
+    Reading a model (what every command does) writes nothing, so its start does not import
+    them.
+    """
+    if name in ("atomic_write", "check_output_path"):
+        from phdesign.core import files
+
+        return getattr(files, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

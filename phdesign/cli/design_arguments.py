@@ -19,7 +19,6 @@ Forms:
 from __future__ import annotations
 
 import argparse
-import json
 import re
 from typing import Any
 
@@ -73,6 +72,8 @@ def parse_sensors_text(text: str) -> list[int]:
 
 def parse_rows_text(text: str, option: str) -> Any:
     """Read a JSON list of rows (``--cm``, ``--gain '[[..]]'``); the entries stay as given."""
+    import json  # rows only: ``--sensors 3,4 --gain 0.1,1`` starts without it
+
     try:
         return json.loads(text)
     except json.JSONDecodeError as error:

@@ -18,7 +18,6 @@ Examples
 
 from __future__ import annotations
 
-import html
 from collections.abc import Iterable, Sequence
 from typing import Any
 
@@ -198,6 +197,8 @@ def html_table(
     >>> html_table([], [["order", 12]], caption="export")
     '<p><b>export</b></p><table><tbody><tr><td>order</td><td>12</td></tr></tbody></table>'
     """
+    import html  # the notebook view only; the command line prints text
+
     head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
     body = "".join(
         "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows
