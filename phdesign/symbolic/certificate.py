@@ -324,18 +324,34 @@ def _root_size(poly: sympy.Poly) -> str | None:
     The measure: the bits of the integer coefficients of its numerator, a polynomial in
     :math:`\mu` and the constants it holds (``E`` for ``exp(1)``, ``pi``), and its degree
     in those constants (``exp(100)`` is ``E**100``).  Degree 1 is a division: no budget.
+    With rational coefficients :math:`c_i = p_i/q_i` (no constants: degree 0) that numerator
+    is :math:`\operatorname{lcm}(q_i)` times ``poly``, read off without building the
+    expression (tests/symbolic/test_certificate_budget.py compares the two).
     """
     if poly.degree() <= 1:
         return None
+    if poly.domain.is_ZZ or poly.domain.is_QQ:
+        _, full = poly.clear_denoms(convert=True)
+        return _over_budget(_bits(full), 0)
     try:
         numerator, _ = sympy.fraction(sympy.together(poly.as_expr()))
         _, full = sympy.Poly(numerator).clear_denoms(convert=True)
-        bits = max(abs(int(c)).bit_length() for c in full.coeffs())
+        bits = _bits(full)
     except (sympy.PolynomialError, sympy.DomainError, TypeError, ValueError):
         return "coefficients that are not polynomials in constants"
     degree = max(
         (d for gen, d in zip(full.gens, full.degree_list(), strict=True) if gen != _MU), default=0
     )
+    return _over_budget(bits, degree)
+
+
+def _bits(integer_poly: sympy.Poly) -> int:
+    """Return the bits of the largest integer coefficient of ``integer_poly``."""
+    return max(abs(int(c)).bit_length() for c in integer_poly.coeffs())
+
+
+def _over_budget(bits: int, degree: int) -> str | None:
+    """Say which of :func:`_root_size`'s budgets ``bits`` and ``degree`` exceed, if any."""
     if bits > EXACT_KAPPA_BITS:
         return f"coefficients of {bits} bits > {EXACT_KAPPA_BITS}"
     if degree > EXACT_KAPPA_DEGREE:
