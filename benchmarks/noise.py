@@ -14,14 +14,29 @@ Targets (medians of the ratios of interleaved rounds; the machine's load is prin
 3. ``phdesign tune euler-bernoulli --sensors 3,4 --max-rms 0.3 --at 1`` at most 10x one
    ``phdesign noise euler-bernoulli --sensors 3,4 --gain 0.1,1`` (whole commands, as a
    user runs them).  The same ratio inside one process (``tune_noise()`` against
-   ``obs.noise()``, no start-up) is printed beside it: it is not the target.
+   ``obs.noise()``, no start-up) is printed beside it, with the search's evaluations: it
+   is not the target.
+
+How target 3 is read (issue 24: "``tune --max-rms`` <= 10x one ``noise`` report"): as
+whole commands.  The issue writes its left side as the command and its option, and the
+row of its table that the target answers timed the command (76 s of CPU, minutes of wall
+time without progress); the targets it means inside a process name the Python call
+(``obs.noise()``, ``obs.spectrum()``), and the one other target between two commands,
+``export --verify`` against one spectrum command, is read the same way.  In one process
+the tuning is a search (a log-grid of starts, then Nelder-Mead on an exact penalty,
+:mod:`phdesign.numeric.noise.tuning`): it evaluates its merit, a resolved abscissa on a
+resolution pair and the Lyapunov variances at one gain, about 500 times and verifies the
+optimum with a full spectrum and noise report, so its ratio to one ``obs.noise()`` is about
+90x; reaching 10x there would mean fewer evaluations, hence another tuned gain, and the
+printed numbers must stay as they are (to 1e-12).
+
+Run:  python benchmarks/noise.py   (exit 1 if a target is missed);
+      python benchmarks/noise.py tune   (target 3 only, a few minutes)
 
 Threads: default everywhere.  phdesign's entry points run BLAS on one thread inside
 (``phdesign/numeric/threads.py``); the peers run with the default BLAS threads.  Printed
 beside, not targets: the peers on one thread (like for like) and ``obs.noise()`` with the
 thread policy switched off (``small_dense_threads(False)``: what the policy buys).
-
-Run:  python benchmarks/noise.py   (exit 1 if a target is missed)
 """
 
 from __future__ import annotations
@@ -196,9 +211,10 @@ def tuning(beam) -> bool:  # type: ignore[no-untyped-def]
     """Target 3: ``tune --max-rms`` against one ``noise`` report (whole commands)."""
     obs = phd.Observer(beam, sensors=[3, 4], gain=[0.1, 1])
     walls = interleaved({"tune": command(TUNE_COMMAND), "noise": command(NOISE_COMMAND)}, 3)
+    tuned: list = []  # the in-process results, for the search's evaluations
     inside = interleaved(
         {
-            "tune_noise()": lambda: obs.tune_noise(max_rms=0.3, performance="w(1)"),
+            "tune_noise()": lambda: tuned.append(obs.tune_noise(max_rms=0.3, performance="w(1)")),
             "obs.noise()": obs.noise,
         },
         rounds=3,
@@ -207,14 +223,18 @@ def tuning(beam) -> bool:  # type: ignore[no-untyped-def]
     for name, times in walls.items():
         print(f"  {name} command: median {statistics.median(times):.2f} s")
     within = ratio(inside, "tune_noise()", "obs.noise()")
+    evaluations = tuned[-1].evaluations
     print(
-        f"  in one process (no start-up; not the target): tune_noise() {within:.1f}x obs.noise()"
+        f"  in one process (no start-up; not the target): tune_noise() {within:.1f}x "
+        f"obs.noise(), {evaluations} evaluations of the search"
     )
     return verdict("tune --max-rms / noise (commands)", ratio(walls, "tune", "noise"), 10.0)
 
 
 def main() -> int:
     beam = phd.load("euler-bernoulli")
+    if sys.argv[1:] == ["tune"]:
+        return 0 if tuning(beam) else 1
     ok = noise_report(beam)
     ok = trade_off(beam) and ok
     ok = tuning(beam) and ok
