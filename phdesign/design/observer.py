@@ -161,8 +161,15 @@ class Observer(ObserverNoise, ObserverExport):
 
     def with_gain(self, gain: Any) -> Observer:
         """Return an observer with the same sensors and another gain."""
-        L = observer_sensors(None, self.C_m, gain, self.C_m.cols)[1] if self.q == 0 else None
-        return self._copy(gain=gain_matrix(gain, self.q) if L is None else L, tuning=None)
+        if self.q == 0:  # refuses any gain: no sensors
+            return self._copy(observer_sensors(None, self.C_m, gain, self.C_m.cols)[1], None)
+        # these sensors are checked already, and gain_matrix checks L (shape, L + Lᵀ ≻ 0):
+        # the copy is not read and checked again (half of classify's observer)
+        L = gain_matrix(gain, self.q)
+        copy = object.__new__(Observer)
+        for name, value in (("plant", self.plant), ("C_m", self.C_m), ("L", L), ("tuning", None)):
+            object.__setattr__(copy, name, value)
+        return copy
 
     def _copy(self, gain: Any, tuning: TuneResult | None) -> Observer:
         return Observer(self.plant, C_m=self.C_m, gain=gain, tuning=tuning)

@@ -384,6 +384,9 @@ def _exact_kappa(poly: sympy.Poly) -> sympy.Expr | None:
 
     ``None`` if its roots cannot be isolated exactly.
     """
+    roots = _rational_quadratic_roots(poly)
+    if roots is not None:
+        return _reciprocal_of_largest(roots)
     try:
         roots = sympy.real_roots(poly)
     except (sympy.PolynomialError, NotImplementedError, sympy.DomainError):
@@ -394,6 +397,34 @@ def _exact_kappa(poly: sympy.Poly) -> sympy.Expr | None:
         if sum(all_roots.values()) != poly.degree():  # not every root has a closed form
             return None
         roots = [r for r in all_roots if r.is_real]
+    return _reciprocal_of_largest(roots)
+
+
+def _rational_quadratic_roots(poly: sympy.Poly) -> list[sympy.Rational] | None:
+    r"""Return the roots of a rational quadratic whose discriminant is a rational square.
+
+    ``None`` for any other polynomial.
+
+    :math:`a\mu^2 + b\mu + c` has the roots :math:`(-b \pm \sqrt{b^2 - 4ac})/(2a)`: with
+    :math:`b^2 - 4ac = (p/q)^2` they are rational, what :func:`sympy.real_roots` returns
+    after factoring (two Rationals, a double root twice), at a fraction of its cost.
+    """
+    if poly.degree() != 2 or not (poly.domain.is_QQ or poly.domain.is_ZZ):
+        return None
+    a, b, c = (sympy.Rational(x) for x in poly.all_coeffs())
+    discriminant = b * b - 4 * a * c
+    if discriminant < 0:
+        return None
+    p, q = discriminant.p, discriminant.q
+    root_p, root_q = math.isqrt(p), math.isqrt(q)
+    if root_p * root_p != p or root_q * root_q != q:
+        return None
+    s = sympy.Rational(root_p, root_q)
+    return sorted([(-b - s) / (2 * a), (-b + s) / (2 * a)])
+
+
+def _reciprocal_of_largest(roots: Sequence[sympy.Expr]) -> sympy.Expr | None:
+    r"""Return :math:`1/\mu_{\max}` over real roots (radicals rationalized); None without one."""
     if not roots:
         return None
     mu_max = max(roots, key=lambda r: float(r.evalf(30)))

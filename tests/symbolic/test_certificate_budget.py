@@ -1,4 +1,5 @@
-"""The exact-κ* budget of a pencil's characteristic polynomial (certificate._root_size).
+"""The exact κ* of a pencil's characteristic polynomial: its budget (certificate._root_size)
+and the rational roots of a quadratic (certificate._rational_quadratic_roots).
 
 A polynomial with rational coefficients is measured without building its expression: the
 numerator of ``together`` of :math:`\\sum_i (p_i/q_i)\\mu^i` is
@@ -15,7 +16,7 @@ import random
 import sympy
 
 from phdesign.core.limits import EXACT_KAPPA_BITS
-from phdesign.symbolic.certificate import _MU, _root_size
+from phdesign.symbolic.certificate import _MU, _exact_kappa, _rational_quadratic_roots, _root_size
 
 
 def _general(poly: sympy.Poly) -> str | None:
@@ -42,3 +43,20 @@ def test_rational_coefficients_are_measured_as_the_general_path_does():
     assert _root_size(polys[2]) == f"coefficients of 301 bits > {EXACT_KAPPA_BITS}"
     assert _root_size(polys[3]) == f"coefficients of 270 bits > {EXACT_KAPPA_BITS}"
     assert _root_size(polys[0]) is None
+
+
+def test_rational_quadratic_roots_are_those_real_roots_finds():
+    # the beam's pencil with L = diag(0.1, 1): mu^2 - 121/10 mu + 101/5 = (mu - 2)(mu - 101/10)
+    # (sum 121/10, product 101/5), so kappa* = 1/mu_max = 10/101, as classify prints
+    beam = sympy.Poly([1, sympy.Rational(-121, 10), sympy.Rational(101, 5)], _MU)
+    assert _rational_quadratic_roots(beam) == [2, sympy.Rational(101, 10)]
+    assert _exact_kappa(beam) == sympy.Rational(10, 101)
+    rng = random.Random(25)
+    for _ in range(60):
+        r1, r2 = (sympy.Rational(rng.randint(-50, 50), rng.randint(1, 20)) for _ in range(2))
+        a = sympy.Rational(rng.randint(1, 30), rng.randint(1, 9)) * rng.choice([1, -1])
+        poly = sympy.Poly(a * (_MU - r1) * (_MU - r2), _MU)
+        assert _rational_quadratic_roots(poly) == sympy.real_roots(poly), poly  # a double root too
+    # irrational or complex roots, and other degrees, go the general way
+    for coefficients in ([1, 0, -2], [1, 0, 1], [1, -6, 11, -6], [3, 1]):
+        assert _rational_quadratic_roots(sympy.Poly(coefficients, _MU)) is None
