@@ -12,11 +12,16 @@ with rational :math:`\Pi_\pm`, :math:`\tau`, :math:`\sigma`, :math:`c_1`, :math:
 the decay estimate follows from finitely many strict matrix inequalities, every one
 between rational matrices (:func:`inequalities`):
 
-* :math:`\Pi_\pm \succ 0` and :math:`\Pi_\pm P_1 \mathcal H` symmetric (checked
-  exactly; the SDP's unknowns are coordinates in an exact rational basis of that
-  subspace, :func:`lyapunov_basis`);
-* the norm bounds :math:`\tau^{-1}\Pi_- + \Pi_+ - c_1\mathcal H \succ 0` and
-  :math:`c_2 \mathcal H - \Pi_- - \tau\Pi_+ \succ 0`;
+* :math:`\Pi_\pm` and :math:`\Pi_\pm P_1 \mathcal H` symmetric (checked exactly; the
+  SDP's unknowns are coordinates in an exact rational basis of that subspace,
+  :func:`lyapunov_basis`); :math:`\Pi_\pm` need not be definite each;
+* the norm bounds at :math:`s \in \{1, \tau^2\}`,
+  :math:`\Pi_- + s\Pi_+ - c_1\tfrac{1+s}{2}\mathcal H \succ 0` and
+  :math:`c_2\big(1 + \tfrac{s-1}{\tau+1}\big)\mathcal H - \Pi_- - s\Pi_+ \succ 0`:
+  they are affine in :math:`s = t^2`, and :math:`\tfrac{1+s}{2} \ge t \ge
+  1 + \tfrac{s-1}{\tau+1}` on :math:`[1, \tau^2]`, so with
+  :math:`\Pi(z) = t^{-1}(\Pi_- + s\Pi_+)` they give
+  :math:`c_1\mathcal H \prec \Pi(z) \prec c_2\mathcal H` for every :math:`z`;
 * the boundary form on the admissible traces
   :math:`K_b^\top \operatorname{diag}\big(\mathcal H^{-1}\Pi(b)P_1,
   -\mathcal H^{-1}\Pi(a)P_1\big) K_b \prec 0`,

@@ -11,7 +11,8 @@ parameter times an affine expression), so each :math:`(\tau, \sigma)` re-solves 
 recompiling.
 
 Feasibility is monotone in :math:`\sigma` (lowering :math:`\sigma` subtracts
-:math:`2\Delta\sigma\,\Pi_\pm \succ 0` from the pointwise forms), so the largest
+:math:`2\Delta\sigma\,(\Pi_- + s\Pi_+) \succ 0`, positive by the lower norm bound,
+from the pointwise forms), so the largest
 :math:`\sigma(\tau)` is found by bisection; :math:`\ln\tau` is chosen by a geometric scan
 and a golden-section refinement around the best point (:func:`search`).  Nothing here is
 trusted: :mod:`.rate` rounds the result and proves it exactly.
