@@ -28,6 +28,14 @@ expression strings in ``z`` and the parameters, and omitted ``P_k`` are zero::
     gain = [["k"]]                             # K, K + K^T >= 0
     [units]                                    # optional: t, z, energy, displacement,
     t = "s"                                    # parameters and states
+    [[boundary_systems]]                       # optional, repeatable: a tip mass m with a
+    name = "mass"                              # damper c joined to input 2 (a velocity)
+    ports = [2]                                # by u2 = -y_c, u_c = y2 (the gyrator)
+    J = [[0]]                                  # dx_c/dt = (J - R) Q x_c + G u_c + B w
+    R = [["c"]]                                # y_c = G^T Q x_c (+ D u_c)
+    Q = [["1/m"]]
+    G = [[-1]]
+    B = [[1]]                                  # optional: an external force w on the mass
 
 Every model phdesign can read it can write, and ``read(write(model)) == model``.
 
@@ -52,6 +60,7 @@ import sympy
 from phdesign.core.checks import require_path
 from phdesign.core.errors import ExpressionError, ModelError, ModelFileError, PhdesignError
 from phdesign.core.limits import MAX_MODEL_FILE_BYTES, check_file_size
+from phdesign.symbolic.boundary_systems import boundary_system_to_dict
 from phdesign.symbolic.expressions import exact_number, parse_scalar
 from phdesign.symbolic.fields import Displacement, Field, Term, field_from_table
 from phdesign.symbolic.model import BCPHS
@@ -74,7 +83,16 @@ __all__ = [
 ]
 
 _REQUIRED = ("name", "interval", "order", "matrices", "ports")
-_OPTIONAL = ("description", "states", "parameters", "displacement", "fields", "feedback", "units")
+_OPTIONAL = (
+    "description",
+    "states",
+    "parameters",
+    "displacement",
+    "fields",
+    "feedback",
+    "units",
+    "boundary_systems",
+)
 
 
 def read_model(path: str | os.PathLike[str]) -> BCPHS:
@@ -145,6 +163,7 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
         feedback=feedback,
         units=units,
         fields=_read_fields(data, source),
+        boundary_systems=data.get("boundary_systems"),
     )
 
 
@@ -331,6 +350,10 @@ def model_to_dict(model: BCPHS) -> dict[str, Any]:
         }
     if model.units:
         data["units"] = dict(model.units)
+    if model.boundary_systems:
+        data["boundary_systems"] = [
+            boundary_system_to_dict(bs, rows) for bs in model.boundary_systems
+        ]
     return data
 
 

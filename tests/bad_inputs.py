@@ -36,6 +36,12 @@ def beam_with(**changes):
     return data
 
 
+def tip_mass(**changes):
+    """A tip mass's [[boundary_systems]] table for the beam's input 4, with keys replaced."""
+    table = {"name": "mass", "ports": [4], "J": [[0]], "R": [[0]], "Q": [[1]], "G": [[1]]}
+    return {**table, **changes}
+
+
 # (changes to the beam file, exception, regex naming the culprit)
 BAD_MODELS = [
     ({"order": 0}, ModelError, "order must be an integer N >= 1; found 0"),
@@ -286,4 +292,68 @@ BAD_MODELS = [
     ({"states": ["e1", "curvature"]}, ModelError, r"'e1' of component 1 is ambiguous"),
     ({"states": ["w: 1", "curvature"]}, ModelError, r"holds a separator"),
     ({"states": ["momentum", "momentum"]}, ModelError, r"state labels must be distinct"),
+    # ---- issue 26: boundary systems (a tip mass joined to the beam's shear-force input 4)
+    (
+        {"boundary_systems": [tip_mass(R=[[-1]])]},
+        ModelError,
+        r"boundary system 'mass' R_c must be positive semidefinite \(exact\); found "
+        r"eigenvalues \[-1\]; its principal minor on rows and columns \{1\} is -1",
+    ),
+    (
+        {"boundary_systems": [tip_mass(J=[[1]])]},
+        ModelError,
+        r"boundary system 'mass' J must be skew \(J_c = -J_c\^T.*found J_c \+ J_c\^T = \[\[2\]\]",
+    ),
+    (
+        {"boundary_systems": [tip_mass(interconnection=[[0, 1], [1, 0]])]},
+        ModelError,
+        r"boundary system 'mass' interconnection must be skew \(S = -S\^T: power-preserving\); "
+        r"found S \+ S\^T = \[\[0, 2\], \[2, 0\]\]",
+    ),
+    (
+        {
+            "boundary_systems": [
+                tip_mass(Q=[[1, 2], [2, 1]], J=[[0, 0], [0, 0]], R=[[0, 0], [0, 0]], G=[[1], [0]])
+            ]
+        },
+        ModelError,
+        r"Q_c must be positive definite \(exact\); found eigenvalues \[-1, 3\]; its leading "
+        r"principal minor on rows and columns \{1, 2\} is -3",
+    ),
+    (
+        {"boundary_systems": [tip_mass(D=[[-1]])]},
+        ModelError,
+        r"'mass' D_c \+ D_c\^T must be positive semidefinite",
+    ),
+    (
+        {"boundary_systems": [tip_mass(ports=[5])]},
+        ModelError,
+        r"'mass' ports\[1\] = 5 is not an input of the model; expected an index in 1..4",
+    ),
+    (
+        {"boundary_systems": [tip_mass(), tip_mass(name="other")]},
+        ModelError,
+        r"'other' ports\[1\] = 4 is already closed by boundary system 'mass'",
+    ),
+    (
+        {"boundary_systems": [tip_mass(G=[[1, 0]])]},
+        ModelError,
+        r"Incompatible dimensions of boundary system 'mass' G matrix; expected \(1, 1\) but "
+        r"found \(1, 2\)",
+    ),
+    (
+        {"boundary_systems": [tip_mass(mass=1)]},
+        ModelError,
+        r"boundary_systems\[1\]: expected the keys ports, J, R, Q, G .*unknown \['mass'\]",
+    ),
+    (
+        {"boundary_systems": [tip_mass(R=[["q"]])]},
+        ExpressionError,
+        r"unknown symbol 'q'",
+    ),
+    (
+        {"boundary_systems": {"name": "mass"}},
+        ModelError,
+        r"boundary_systems must be a list of boundary systems",
+    ),
 ]

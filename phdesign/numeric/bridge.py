@@ -29,6 +29,7 @@ import numpy as np
 
 from phdesign.core.checks import found_text
 from phdesign.core.errors import ArgumentError, ModelError, ParameterError, check_shape
+from phdesign.numeric.boundary import NumericBoundary, numeric_boundaries
 from phdesign.symbolic.ports import trace_index
 from phdesign.symbolic.printing import format_expression
 
@@ -112,6 +113,9 @@ class NumericModel:
         How to reconstruct a physical displacement, if the model has one.
     fields : tuple of (str, DisplacementSpec)
         The named fields (rotations, strains) of ``[fields.<name>]``.
+    boundary : tuple of NumericBoundary
+        The boundary systems joined to some open ports (:mod:`phdesign.numeric.boundary`);
+        their external inputs follow the PDE's external ports.
     H_constant : bool
         True when H does not depend on z (lets discretizations skip quadrature work).
     feedback : PortFeedback or None
@@ -147,6 +151,7 @@ class NumericModel:
     units: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
     parameters: Mapping[str, float] = field(default_factory=dict, compare=False, repr=False)
     fields: tuple[tuple[str, DisplacementSpec], ...] = ()
+    boundary: tuple[NumericBoundary, ...] = field(default=(), compare=False, repr=False)
 
     def field_spec(self, name: str) -> DisplacementSpec | None:
         """Return the field ``name`` (``"w"`` is the displacement), or None."""
@@ -236,9 +241,15 @@ class NumericModel:
 
     @property
     def n_ports(self) -> int:
-        """Number of external inputs (= outputs): ``N n`` less the closed ones."""
+        """Number of external inputs (= outputs).
+
+        ``N n`` less those closed by the feedback or joined to a boundary system, then the
+        boundary systems' external inputs.
+        """
         closed = 0 if self.feedback is None else len(self.feedback.closed)
-        return self.order * self.size - closed
+        joined = sum(len(b.joined) for b in self.boundary)
+        extra = sum(b.n_external for b in self.boundary)
+        return self.order * self.size - closed - joined + extra
 
     @property
     def P0_constant(self) -> bool:
@@ -335,6 +346,9 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
     ports = model.ports
     inputs = getattr(model, "external_inputs", model.inputs)
     outputs = getattr(model, "external_outputs", model.outputs)
+    boundary = numeric_boundaries(model, sub.matrix, sub.array)
+    extra_in = tuple(x for b in boundary for x in b.input_labels)
+    extra_out = tuple(x for b in boundary for x in b.output_labels)
     d = getattr(model, "displacement", None)
     # H > 0, P0 + P0^T <= 0 and K + K^T >= 0 after substitution are checked by NumericModel
     # itself (its invariants)
@@ -347,10 +361,10 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         H=constant_H(sub.array(Hs)) if H_constant else _matrix_function(Hs, n),
         U=sub.array(sub.matrix("U", ports.U)),
         Y=sub.array(sub.matrix("Y", ports.Y)),
-        input_labels=tuple(str(e) for e in inputs),
-        output_labels=tuple(str(e) for e in outputs),
-        input_traces=tuple(format_expression(e, model.interval) for e in inputs),
-        output_traces=tuple(format_expression(e, model.interval) for e in outputs),
+        input_labels=(*(str(e) for e in inputs), *extra_in),
+        output_labels=(*(str(e) for e in outputs), *extra_out),
+        input_traces=(*(format_expression(e, model.interval) for e in inputs), *extra_in),
+        output_traces=(*(format_expression(e, model.interval) for e in outputs), *extra_out),
         state_names=tuple(model.state_names),
         displacement=None if d is None else _numeric_field(sub, d),
         fields=tuple((name, _numeric_field(sub, f)) for name, f in getattr(model, "fields", ())),
@@ -359,6 +373,7 @@ def to_numeric(model: Any, parameters: Mapping[str, Any] | None = None) -> Numer
         P0=P0fun,
         units=dict(getattr(model, "units", ())),
         parameters={str(k): float(v) for k, v in values.items()},
+        boundary=boundary,
     )
 
 

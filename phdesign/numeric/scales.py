@@ -51,6 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from phdesign.core.cache import MODEL_WORK
+from phdesign.numeric.boundary import scaled_boundaries
 from phdesign.numeric.bridge import NumericModel, trace_index
 
 __all__ = ["ProblemScales", "dimensionless_model", "problem_scales"]
@@ -124,13 +125,16 @@ def problem_scales(nm: NumericModel) -> ProblemScales:
     # the ports a sensor set indexes are the external ones: the plant's own feedback has
     # closed the rest (bridge.NumericModel.n_ports), in the order of feedback.close_ports
     closed = set() if nm.feedback is None else {int(c) for c in nm.feedback.closed}
+    closed |= {j for b in nm.boundary for j in b.joined}
     external = [j for j in range(nm.order * nm.size) if j not in closed]
+    # a boundary system's own ports scale as u = sigma u', y = sigma y' (numeric.boundary)
+    extra = np.full(sum(b.n_external for b in nm.boundary), np.sqrt(rate * length))
     return ProblemScales(
         length=length,
         rate=rate,
         effort=effort,
-        input_scale=np.max(np.abs(nm.U * D), axis=1)[external],
-        output_scale=np.max(np.abs(nm.Y * D), axis=1)[external],
+        input_scale=np.concatenate([np.max(np.abs(nm.U * D), axis=1)[external], extra]),
+        output_scale=np.concatenate([np.max(np.abs(nm.Y * D), axis=1)[external], extra]),
     )
 
 
@@ -193,5 +197,6 @@ def _dimensionless_model(nm: NumericModel) -> tuple[NumericModel, ProblemScales]
         # u = U v and y = Y v both scale by 1/sigma, so u_c = -K y_c keeps its K
         feedback=nm.feedback,
         P0=P0_dimensionless,
+        boundary=scaled_boundaries(nm.boundary, rate),
     )
     return dimensionless, sc

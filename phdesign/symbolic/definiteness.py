@@ -157,6 +157,7 @@ class _Check(Question):
             return on_grid(self, S)
         raise ModelError(
             f"{self.name} must be {self.kind} ({how}); found eigenvalues {_eigenvalues(M)}"
+            f"{_failing_minor(S, self.strict)}"
         )
 
     # ------------------------------------------------------------------ exact path
@@ -316,6 +317,26 @@ def _minimum(minor: sympy.Expr, a: sympy.Expr, b: sympy.Expr) -> str:
     samples = [a + (b - a) * sympy.Rational(k, 400) for k in range(401)]
     lowest = min(samples, key=lambda c: float(minor.subs(Z, c)))
     return f"about {float(minor.subs(Z, lowest)):.6g} at z = {float(lowest):g}"
+
+
+def _failing_minor(S: sympy.MatrixBase, strict: bool) -> str:
+    r"""Name the first principal minor of a constant ``S`` that refutes the relation.
+
+    Sylvester's criterion: :math:`S \succ 0` iff every leading principal minor is
+    :math:`> 0`; :math:`S \succeq 0` iff every principal minor is :math:`\ge 0`.
+    """
+    n = S.rows
+    if strict:
+        candidates: Sequence[tuple[int, ...]] = [tuple(range(k)) for k in range(1, n + 1)]
+    else:
+        candidates = [c for k in range(1, n + 1) for c in itertools.combinations(range(n), k)]
+    for rows in candidates:
+        minor = sympy.expand(S.extract(list(rows), list(rows)).det())
+        if (minor <= 0) if strict else (minor < 0):
+            kind = "leading principal minor" if strict else "principal minor"
+            where = ", ".join(str(i + 1) for i in rows)
+            return f"; its {kind} on rows and columns {{{where}}} is {_brief(minor)}"
+    return ""
 
 
 def _eigenvalues(M: sympy.MatrixBase) -> str:

@@ -170,9 +170,12 @@ def parse_units(units: object) -> tuple[tuple[Any, Any], ...]:
 
 
 def parse_matrix(
-    value: Any, name: str, parameters: Sequence[str], allow_z: bool = False
+    value: Any, name: str, parameters: Sequence[str], allow_z: bool = False, square: bool = True
 ) -> sympy.ImmutableMatrix:
-    """Read a square matrix of numbers or expression strings (rows of a list) exactly."""
+    """Read a matrix of numbers or expression strings (rows of a list) exactly.
+
+    It must be square unless ``square`` is false (a boundary system's input matrices).
+    """
     if isinstance(value, sympy.MatrixBase):
         rows = value.tolist()
     elif isinstance(value, Sequence) and not isinstance(value, str):
@@ -182,16 +185,14 @@ def parse_matrix(
     elif hasattr(value, "tolist"):  # numpy arrays, without importing numpy here
         rows = value.tolist()
     else:
-        raise ModelError(
-            f"{name} must be a square matrix given as a list of rows; found {value!r}"
-        )
+        raise ModelError(f"{name} must be a matrix given as a list of rows; found {value!r}")
     if not rows or not all(isinstance(r, list) for r in rows):
         raise ModelError(f"{name} must be a non-empty list of rows; found {value!r}")
     width = len(rows[0])
     for i, row in enumerate(rows):
         if len(row) != width:
             raise ModelError(f"{name} row {i + 1} has {len(row)} entries; expected {width}")
-    if len(rows) != width:
+    if square and len(rows) != width:
         raise ModelError(f"{name} must be square; found {len(rows)} x {width}")
     entries = [
         [_entry(x, f"{name}[{i + 1},{j + 1}]", parameters, allow_z) for j, x in enumerate(row)]

@@ -100,6 +100,7 @@ def model_text(model: BCPHS) -> str:
     lines.append(f"outputs: {_port_text(model, model.outputs, 'y')}")
     if model.feedback is not None:  # what --sensors, --u and the exports index
         lines.append(external_numbering(len(model.inputs), model.feedback))
+    lines += boundary_text(model)
     lines += [f"check: {c}" for c in model.checks]
     return "\n".join(lines)
 
@@ -203,3 +204,48 @@ def ports_html(ports: Ports) -> str:
         ),
     ]
     return html_table(["", ""], rows, caption=_heading(ports))
+
+
+def energy_identity_text(model: BCPHS) -> str:
+    """Return the coupled energy identity of ``model`` as ``phdesign show`` prints it."""
+    terms = ["1/2 int e^T (P0 + P0^T) e dz"]
+    for bs in model.boundary_systems:
+        if not bs.R.is_zero_matrix:
+            terms.append(f"- e_c^T R_c e_c ({bs.name})")
+        if bs.D is not None and not (bs.D + bs.D.T).is_zero_matrix:
+            terms.append(f"- u_c^T D_c u_c ({bs.name})")
+    if model.feedback is not None:
+        terms.append("- y_f^T K y_f ([feedback])")
+    terms.append("+ u_ext^T y_ext")
+    return (
+        "dH_tot/dt = d/dt (H + "
+        + " + ".join(f"H_{bs.name}" for bs in model.boundary_systems)
+        + ") = "
+        + " ".join(terms)
+    )
+
+
+def boundary_text(model: BCPHS) -> list[str]:
+    """Return the lines ``phdesign show`` prints for the boundary systems (none without)."""
+    lines = []
+    for bs in model.boundary_systems:
+        joined = ", ".join(f"u{i}" for i in bs.ports)
+        how = "gyrator u_p = -y_c, u_c = y_p" if bs.interconnection is None else "S"
+        lines.append(
+            f"boundary system {bs.name}: x_c = ({', '.join(bs.state_labels)}) joined to "
+            f"{joined} ({how})"
+        )
+        for key in ("J", "R", "Q", "G", "D", "B"):
+            matrix = getattr(bs, key)
+            if matrix is not None:
+                lines.append(f"  {key}_c = {_rows(matrix)}")
+        if bs.interconnection is not None:
+            lines.append(f"  S = {_rows(bs.interconnection)}")
+        if bs.n_external:
+            pairs = ", ".join(
+                f"{u} -> {y}" for u, y in zip(bs.input_labels, bs.output_labels, strict=True)
+            )
+            lines.append(f"  external inputs -> outputs: {pairs}")
+    if lines:
+        lines.append(energy_identity_text(model))
+    return lines

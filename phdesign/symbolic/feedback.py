@@ -34,6 +34,7 @@ from phdesign.symbolic.definition import parse_matrix
 __all__ = [
     "Feedback",
     "check_feedback_indices",
+    "check_input_index",
     "external_indices",
     "external_numbering",
     "feedback_from_mapping",
@@ -95,6 +96,23 @@ def external_numbering(n_ports: int, feedback: Feedback) -> str:
     )
 
 
+def check_input_index(what: str, index: object, n_inputs: int) -> None:
+    """Refuse an ``index`` that is not a 1-based index into the model's ``[ports].inputs``.
+
+    Raises
+    ------
+    ModelError
+        Naming ``what`` (``feedback.inputs[1]``) with the expected range.
+    """
+    if isinstance(index, bool) or not isinstance(index, int):
+        raise ModelError(f"{what} must be a 1-based input index; found {index!r}")
+    if not 1 <= index <= n_inputs:
+        raise ModelError(
+            f"{what} = {index} is not an input of the model; "
+            f"expected an index in 1..{n_inputs} into [ports].inputs"
+        )
+
+
 def check_feedback_indices(feedback: Feedback, n_inputs: int) -> None:
     """Refuse indices that are not inputs of the model, repeated ones and a misshapen K.
 
@@ -107,15 +125,7 @@ def check_feedback_indices(feedback: Feedback, n_inputs: int) -> None:
         raise ModelError("feedback.inputs must name at least one input; found none")
     seen: set[int] = set()
     for position, index in enumerate(feedback.inputs, start=1):
-        if isinstance(index, bool) or not isinstance(index, int):
-            raise ModelError(
-                f"feedback.inputs[{position}] must be a 1-based input index; found {index!r}"
-            )
-        if not 1 <= index <= n_inputs:
-            raise ModelError(
-                f"feedback.inputs[{position}] = {index} is not an input of the model; "
-                f"expected an index in 1..{n_inputs} into [ports].inputs"
-            )
+        check_input_index(f"feedback.inputs[{position}]", index, n_inputs)
         if index in seen:
             raise ModelError(
                 f"feedback.inputs[{position}] = {index} is repeated; expected distinct inputs"

@@ -31,6 +31,12 @@ import sympy
 from phdesign.core.errors import ExpressionError, ModelError, ParameterError
 from phdesign.core.text import did_you_mean
 from phdesign.symbolic import display
+from phdesign.symbolic.boundary_checks import check_boundary_systems
+from phdesign.symbolic.boundary_systems import (
+    BoundarySystem,
+    boundary_systems_from_value,
+    coupled_indices,
+)
 from phdesign.symbolic.closing import ClosedPorts, closed_ports
 from phdesign.symbolic.definition import (
     Displacement,
@@ -148,6 +154,11 @@ class BCPHS(PortedSystem):
     fields : tuple of (str, Field)
         Named performance outputs (``[fields.<name>]``: rotations, strains), in the form
         of the displacement (:mod:`phdesign.symbolic.fields`).
+    boundary_systems : tuple of BoundarySystem
+        Finite-dimensional port-Hamiltonian systems joined to some inputs by a
+        power-preserving interconnection (``[[boundary_systems]]``,
+        :mod:`phdesign.symbolic.boundary_systems`); their external inputs follow the
+        PDE's in :attr:`n_ports`.
     checks : tuple of str
         How each condition was verified (exactly, or at the defaults on a grid).
     """
@@ -168,12 +179,14 @@ class BCPHS(PortedSystem):
     units: tuple[tuple[str, str], ...] = ()
     derived_outputs: bool = False
     fields: tuple[tuple[str, Field], ...] = ()
+    boundary_systems: tuple[BoundarySystem, ...] = ()
     checks: tuple[str, ...] = field(default=(), compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if not self.state_names:
             object.__setattr__(self, "state_names", tuple(f"x{i + 1}" for i in range(self.size)))
-        object.__setattr__(self, "checks", tuple(validate(self)))
+        checks = validate(self)
+        object.__setattr__(self, "checks", (*checks, *check_boundary_systems(self)))
 
     # ------------------------------------------------------------------ printing
     def __repr__(self) -> str:
@@ -206,6 +219,7 @@ class BCPHS(PortedSystem):
         feedback: Feedback | Mapping[str, Any] | None = None,
         units: Mapping[str, str] | None = None,
         fields: Mapping[str, Field] | None = None,
+        boundary_systems: Sequence[BoundarySystem | Mapping[str, Any]] | None = None,
     ) -> BCPHS:
         r"""Build a model from numbers, strings and nested lists.
 
@@ -244,6 +258,10 @@ class BCPHS(PortedSystem):
             and the named fields.
         fields : mapping {name: Field}, optional
             Named performance outputs (rotations, strains), read as ``name(z0)``.
+        boundary_systems : sequence of BoundarySystem or mappings, optional
+            Boundary systems joined to some inputs (keys ``name``, ``ports``, ``J``,
+            ``R``, ``Q``, ``G`` and optionally ``D``, ``B``, ``states``, ``inputs``,
+            ``interconnection``: :mod:`phdesign.symbolic.boundary_systems`).
         """
         if not isinstance(order, int) or isinstance(order, bool) or order < 1:
             raise ModelError(f"order must be an integer N >= 1; found {order!r}")
@@ -270,6 +288,7 @@ class BCPHS(PortedSystem):
             units=parse_units(units),
             derived_outputs=derived,
             fields=_named_fields(fields),
+            boundary_systems=boundary_systems_from_value(boundary_systems, names),
         )
 
     # ------------------------------------------------------------------ views
@@ -288,18 +307,29 @@ class BCPHS(PortedSystem):
 
     @property
     def n_ports(self) -> int:
-        """Number of external inputs (= outputs): ``N n`` less the closed ones."""
-        return len(external_indices(self.order * self.size, self.feedback))
+        """Number of external inputs (= outputs).
+
+        ``N n`` less those closed by :attr:`feedback` or joined to a boundary system, and
+        then the boundary systems' own external inputs.
+        """
+        extra = sum(bs.n_external for bs in self.boundary_systems)
+        return len(self.external_inputs) + extra
 
     @property
     def external_inputs(self) -> tuple[sympy.Expr, ...]:
-        """The inputs left open by :attr:`feedback` (all inputs without feedback)."""
-        return tuple(self.inputs[j] for j in external_indices(len(self.inputs), self.feedback))
+        """The trace inputs left open by :attr:`feedback` and the boundary systems."""
+        return tuple(self.inputs[j] for j in self._open_indices)
 
     @property
     def external_outputs(self) -> tuple[sympy.Expr, ...]:
         """The outputs conjugate to :attr:`external_inputs`."""
-        return tuple(self.outputs[j] for j in external_indices(len(self.outputs), self.feedback))
+        return tuple(self.outputs[j] for j in self._open_indices)
+
+    @property
+    def _open_indices(self) -> tuple[int, ...]:
+        joined = set(coupled_indices(self))
+        kept = external_indices(len(self.inputs), self.feedback)
+        return tuple(j for j in kept if j not in joined)
 
     @property
     def unit_map(self) -> dict[str, str]:

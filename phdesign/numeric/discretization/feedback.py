@@ -15,8 +15,9 @@ closed system is again port-Hamiltonian, exactly:
 so its energy balance :math:`\dot H_d = -\hat e^\top R \hat e - y_c^\top
 \operatorname{sym}(K) y_c + u_r^\top y_r` carries the damper's dissipation in :math:`R`.
 This is the discrete counterpart of :mod:`phdesign.symbolic.closing`;
-:func:`close_plant_feedback` applies a model's own ``[feedback]`` to its discretization,
-and :func:`close_ports` is the reusable step (a controller's :math:`u = -K y` as well).
+:func:`~phdesign.numeric.discretization.coupled.close_and_couple` applies a model's own
+``[feedback]`` (and its boundary systems) to its discretization, and :func:`close_ports` is
+the reusable step (a controller's :math:`u = -K y` as well).
 
 Examples
 --------
@@ -43,7 +44,7 @@ from phdesign.core.errors import NumericError, check_shape
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.phs import DiscretePHS
 
-__all__ = ["close_plant_feedback", "close_ports", "open_port_gain"]
+__all__ = ["close_ports", "open_port_gain"]
 
 
 def close_ports(d: DiscretePHS, closed: Sequence[int], K: np.ndarray) -> DiscretePHS:
@@ -87,23 +88,12 @@ def close_ports(d: DiscretePHS, closed: Sequence[int], K: np.ndarray) -> Discret
     )
 
 
-def close_plant_feedback(d: DiscretePHS) -> DiscretePHS:
-    """Apply the model's own ``[feedback]`` (``d.model.feedback``) to a discretization.
-
-    A discretization of a model without feedback is returned unchanged; one whose ports
-    are already the model's external ones (``n_ports`` equal) as well.
-    """
-    feedback = d.model.feedback
-    if feedback is None or d.n_ports == d.model.n_ports:
-        return d
-    return close_ports(d, feedback.closed, feedback.gain)
-
-
 def open_port_gain(nm: NumericModel, K: np.ndarray | None) -> np.ndarray:
     """Gain on all N n open ports: the plant's own feedback and ``K`` on the external ones.
 
     The loop is u = -K_full y on the open ports, so its boundary condition is
-    (U + K_full Y) v = 0.
+    (U + K_full Y) v = 0.  For a model with boundary systems it is the high-frequency
+    limit of the coupled boundary condition (the static part of each interconnection).
 
     Examples
     --------
@@ -118,7 +108,12 @@ def open_port_gain(nm: NumericModel, K: np.ndarray | None) -> np.ndarray:
     if nm.feedback is not None:
         closed = [int(c) for c in nm.feedback.closed]
         full[np.ix_(closed, closed)] = np.asarray(nm.feedback.gain, dtype=float)
+    for b in nm.boundary:
+        # far above the boundary systems' own frequencies e_c -> 0: only u_p = -K y_p is left
+        full[np.ix_(b.joined, b.joined)] = b.K
+        closed += list(b.joined)
     if K is not None:
         external = [j for j in range(ports) if j not in closed]
-        full[np.ix_(external, external)] = np.asarray(K, dtype=float)
+        t = len(external)  # a gain on the boundary systems' own ports acts through e_c only
+        full[np.ix_(external, external)] = np.asarray(K, dtype=float)[:t, :t]
     return full

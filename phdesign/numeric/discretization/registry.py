@@ -46,7 +46,7 @@ from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization import galerkin, staggered
 from phdesign.numeric.discretization.base import Method, check_registered
-from phdesign.numeric.discretization.feedback import close_plant_feedback
+from phdesign.numeric.discretization.coupled import close_and_couple
 from phdesign.numeric.discretization.phs import ClosedLoop, DiscretePHS, feedback_matrix
 
 __all__ = ["ClosedLoop", "DiscretePHS", "check_basis", "discretize", "feedback_matrix"]
@@ -119,8 +119,9 @@ def _build(nm: NumericModel, method: str, resolution: int, basis: str | None) ->
             f"the method {method!r} built a discretization that says method="
             f"{discrete.method!r}; expected its own name"
         )
-    # the model's own [feedback] closes the open discretization (numeric.feedback)
-    closed = close_plant_feedback(discrete)
+    # the model's own [feedback] closes the open discretization and its boundary systems
+    # join it (numeric.discretization.coupled)
+    closed = close_and_couple(discrete)
     for matrix in (closed.E, closed.J, closed.R, closed.B, closed.D):
         matrix.setflags(write=False)  # shared by every caller (phdesign.core.cache)
     return closed

@@ -59,7 +59,9 @@ def test_discretize_and_spectrum_read_the_table(name):
     assert (d.method, d.resolution) == ("galerkin", row.resolution)
     assert d.info["basis"] == row.basis == resolve_basis(None, nm.order)
     assert default_resolutions(nm, "galerkin") == (row.spectrum_start, row.spectrum_max)
-    if nm.order <= 2:
+    # staggered FD needs mixed causality; a tip mass or a motor imposes the end's velocity,
+    # so the string and beam that carry one have velocity inputs at both ends (galerkin only)
+    if nm.order <= 2 and name not in ("string-tip-mass", "beam-tip-body", "string-motor"):
         fd = current().discretization("fd", nm.order)
         assert default_resolutions(nm, "fd") == (fd.spectrum_start, fd.spectrum_max)
         assert discretize(nm, "fd").resolution == fd.resolution

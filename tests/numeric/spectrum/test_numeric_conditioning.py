@@ -20,7 +20,7 @@ from numeric_models import BUILTINS, PAPER_SENSORS, VARYING, numeric
 from phdesign.core.errors import NumericError
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
-from phdesign.numeric.discretization.feedback import close_plant_feedback
+from phdesign.numeric.discretization.coupled import close_and_couple
 from phdesign.numeric.discretization.functionals import parse_functionals
 from phdesign.numeric.discretization.galerkin import galerkin, resolve_basis
 from phdesign.numeric.discretization.legendre import trace_scaling
@@ -176,7 +176,7 @@ def test_shift_and_invert_serves_both_bases_and_the_noise_figures_need_the_scale
     functional = parse_functionals(["x1: 1"], nm, load_builtin("airy"))[0]
     variance = {}
     for basis in ("scaled", "legendre"):
-        d = close_plant_feedback(galerkin(nm, 40, basis))
+        d = close_and_couple(galerkin(nm, 40, basis))
         stats = error_statistics(d, np.eye(3), np.eye(3), np.ones(3))
         row = functional.row(d)
         variance[basis] = float(row @ stats.covariance @ row)
