@@ -58,6 +58,7 @@ from phdesign.core.text import (
 )
 from phdesign.symbolic.assumption import AssumptionCheck, Partition, model_assumption
 from phdesign.symbolic.certificate import Certificate, certify
+from phdesign.symbolic.coupled_classify import classify_coupled
 from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import ErrorSystem, ObserverDesign
 from phdesign.symbolic.ports import trace_list
@@ -459,6 +460,8 @@ def classify(model: BCPHS, C_m: Any, L: Any, method: str = "auto") -> Classifica
         definite), or an unknown ``method``.
     """
     choice(method, "method", ("auto", "exact", "float"), ObserverError)
+    if getattr(model, "boundary_systems", ()):  # dynamic boundary conditions: other theorems
+        return classify_coupled(model, C_m, L, method, static=classify)  # type: ignore[return-value]
     design = ObserverDesign(model, C_m, L)
     es = design.error_system()
     interval = model.interval

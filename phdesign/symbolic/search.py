@@ -53,11 +53,13 @@ from phdesign.core import limits
 from phdesign.core.errors import ObserverError
 from phdesign.core.text import matrix_text, number_text
 from phdesign.symbolic.assumption import model_assumption
+from phdesign.symbolic.classify import classify
 from phdesign.symbolic.closing import plant_feedback
+from phdesign.symbolic.coupled_classify import classify_coupled
 from phdesign.symbolic.expressions import vanishes
 from phdesign.symbolic.feedback import external_indices
 from phdesign.symbolic.model import BCPHS
-from phdesign.symbolic.observer import gain_matrix, port_inverse
+from phdesign.symbolic.observer import gain_matrix, port_inverse, sensor_matrix
 from phdesign.symbolic.propositions import VERDICTS, strength, variant_cases, verdict_of
 from phdesign.symbolic.search_kappa import (
     Job,
@@ -154,6 +156,8 @@ def search_sensors(
     limits.check_sensor_outputs(model.n_ports)
     nn = model.n_ports
     gains = _gain_vector(gain, nn)
+    if model.boundary_systems:
+        return _coupled_search(model, gains)
     cands = candidates(model)
     total = 2**nn - 1
     holds = _decisions(cands, total)
@@ -177,6 +181,50 @@ def search_sensors(
         if gains is None
         else tuple(number_text(g) for g in gains),
         candidates=cands,
+        subsets=tuple(results),
+        minimal=_minimal_sets(verdict_code, VERDICTS, nn),
+    )
+
+
+def _coupled_search(model: BCPHS, gains: tuple[sympy.Expr, ...] | None) -> SensorSearch:
+    """Classify every subset of a coupled model's outputs (the boundary systems' too).
+
+    Each subset is classified by :func:`~phdesign.symbolic.coupled_classify.classify_coupled`
+    with the diagonal gains it measures (numbers: the theorems' hypotheses are checked at
+    them).
+    """
+    if gains is None:
+        raise ObserverError(
+            "gain: the sensor search of a model with boundary systems needs numeric gains; "
+            "found 'symbolic'"
+        )
+    nn = model.n_ports
+    total = 2**nn - 1
+    verdict_code = [VERDICTS.index("inconclusive")] * (total + 1)
+    results = []
+    for mask in sorted(range(1, total + 1), key=lambda m: (bin(m).count("1"), members(m))):
+        picked = members(mask)
+        C_m = sensor_matrix(picked, nn)
+        L = sympy.diag(*[gains[j - 1] for j in picked])
+        found = classify_coupled(model, C_m, L, "auto", static=classify)
+        best = found.best
+        verdict_code[mask] = VERDICTS.index(found.verdict)
+        results.append(
+            SubsetResult(
+                sensors=picked,
+                verdict=found.verdict,
+                best=None if best is None else best.convergence,
+                kappa=None if best is None else best.kappa,
+                unbounded=False,
+                holding=tuple(r.convergence for r in found.results if r.holds),
+            )
+        )
+    return SensorSearch(
+        model=model.name,
+        order=model.order,
+        size=model.size,
+        gains=tuple(number_text(g) for g in gains),
+        candidates=(),
         subsets=tuple(results),
         minimal=_minimal_sets(verdict_code, VERDICTS, nn),
     )
