@@ -27,6 +27,7 @@ _EXPORTS: dict[str, str] = {
     # models
     "BCPHS": "phdesign.symbolic.model",
     "Displacement": "phdesign.symbolic.definition",
+    "BoundarySystem": "phdesign.symbolic.boundary_systems",
     "load": "phdesign.models",
     "load_builtin": "phdesign.models",
     "builtin_names": "phdesign.models",
@@ -43,6 +44,7 @@ _EXPORTS: dict[str, str] = {
     "gain_matrix": "phdesign.symbolic.observer",
     "classify": "phdesign.symbolic.classify",
     "Classification": "phdesign.symbolic.classify",
+    "CoupledClassification": "phdesign.symbolic.coupled_classify",
     "search_sensors": "phdesign.symbolic.search",
     "SensorSearch": "phdesign.symbolic.search_result",
     # the design objects
@@ -68,7 +70,9 @@ _EXPORTS: dict[str, str] = {
 
 __all__ = [
     "BCPHS",
+    "BoundarySystem",
     "Classification",
+    "CoupledClassification",
     "Displacement",
     "Loop",
     "NoiseReport",
@@ -123,7 +127,9 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
     from phdesign.numeric.time.result import SimulationResult
     from phdesign.numeric.time.simulation import simulate
     from phdesign.numeric.tuning.search import TuneResult, tune
+    from phdesign.symbolic.boundary_systems import BoundarySystem
     from phdesign.symbolic.classify import Classification, classify
+    from phdesign.symbolic.coupled_classify import CoupledClassification
     from phdesign.symbolic.definition import Displacement
     from phdesign.symbolic.model import BCPHS
     from phdesign.symbolic.observer import (

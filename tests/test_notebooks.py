@@ -107,7 +107,7 @@ def test_notebooks_use_the_public_api(path: Path):
     )
 
 
-def test_there_are_seven_notebooks():
+def test_there_are_eight_notebooks():
     assert [p.stem for p in PATHS] == [
         "01_quickstart",
         "02_euler_bernoulli_paper",
@@ -116,6 +116,7 @@ def test_there_are_seven_notebooks():
         "05_noise_tradeoff",
         "06_implementation",
         "07_observer_based_control",
+        "08_boundary_dynamics",
     ]
 
 
