@@ -79,13 +79,16 @@ def state_labels(d: DiscretePHS, prefix: str = "") -> list[str]:
     """Names of the discrete states: ``<prefix>e<i>[<j>]`` (effort i, basis index/node j).
 
     The pairs (component, index) are the discretization's ``info["coordinates"]``, which
-    every registered method gives; a system without them is read as n equal blocks.
+    every registered method gives; a system without them is read as n equal blocks.  A
+    model's boundary-system efforts e_c = Q_c x_c follow, ``e(<label>)`` by the labels of
+    their states (``info["boundary_labels"]``).
     """
+    boundary = [f"{prefix}e({control_signal_name(b)})" for b in d.info.get("boundary_labels", ())]
     coords = d.info.get("coordinates")
     if coords is None:
-        per = d.dim // d.model.size
+        per = (d.dim - len(boundary)) // d.model.size
         coords = [(i, j) for i in range(d.model.size) for j in range(per)]
-    return [f"{prefix}e{i + 1}[{j}]" for i, j in coords]
+    return [f"{prefix}e{i + 1}[{j}]" for i, j in coords] + boundary
 
 
 def control_signal_name(label: str) -> str:

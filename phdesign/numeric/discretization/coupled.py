@@ -25,7 +25,8 @@ is built) whose energy :math:`\tfrac12\hat e^\top E\hat e + \sum H_c` obeys
 :math:`\dot H = -\hat e^\top R\hat e - e_c^\top R_c e_c + u_r^\top y_r + w^\top z_c` to
 round-off.  The appended coordinates are zero in every field basis (they are no part of
 the PDE's state) and in a projected initial state (the boundary systems start at rest);
-``info["boundary_states"]`` says where they are.
+``info["boundary_states"]`` says where they are (``(first index, count)``) and
+``info["boundary_labels"]`` what they are.
 """
 
 from __future__ import annotations
@@ -78,7 +79,8 @@ def _append(d: DiscretePHS, static: DiscretePHS) -> DiscretePHS:
         J[offset : offset + b.size, :n] -= coupling.T
         offset += b.size
     extra = E.shape[0] - n
-    info = {**static.info, "boundary_states": (n, extra)}
+    labels = tuple(label for b in nm.boundary for label in b.state_labels)
+    info = {**static.info, "boundary_states": (n, extra), "boundary_labels": labels}
     return replace(
         static,
         E=E,

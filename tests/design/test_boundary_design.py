@@ -1,0 +1,36 @@
+"""The design objects on models with boundary systems (issue 26): observer, export, noise."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import phdesign as phd
+
+
+def test_observer_of_the_tip_mass_string_measures_the_mass_and_never_decays_uniformly():
+    # y2 is the mass's velocity (a boundary-system output), injected as a force on the mass
+    obs = phd.Observer(phd.load("string-tip-mass"), sensors=[2], gain=2)
+    assert obs.classify().verdict == "asymptotic"
+    report = obs.spectrum()
+    assert report.no_decay
+    assert report.spectral_abscissa == 0.0
+    assert report.system == "observer error system"
+
+
+def test_exports_carry_the_boundary_states():
+    obs = phd.Observer(phd.load("string-motor"), sensors=[2], gain=1)
+    for system, prefix in (("plant", ""), ("observer", "hat_"), ("error", "err_")):
+        labels = obs.statespace(system).state_labels
+        assert labels[-2:] == [f"{prefix}e(winding flux)", f"{prefix}e(rotor momentum)"]
+    exported = obs.export(dt=1e-3)
+    d = phd.discretize(phd.to_numeric(phd.load("string-motor")), "galerkin", 20)
+    assert exported.A.shape[0] == d.dim  # the PDE's states and the motor's two
+    assert d.info["boundary_states"][1] == 2
+
+
+def test_simulated_error_energy_includes_the_mass_and_never_grows():
+    obs = phd.Observer(phd.load("string-tip-mass"), sensors=[2], gain=1)
+    run = obs.simulate(x0="x1: sin(pi*z)", t_end=4, samples=81)
+    assert np.all(np.diff(run.H_err) <= 1e-12 * run.H_err[0])  # dissipative error system
+    assert run.H_err[-1] < 0.5 * run.H_err[0]
+    assert run.output_labels[-1] == "mass velocity"
