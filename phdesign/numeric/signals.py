@@ -40,10 +40,15 @@ __all__ = [
 ]
 
 
-def model_port(nm: NumericModel, index: int) -> int:
-    """Return the model file's 1-based number of external port ``index`` (0-based)."""
+def model_port(nm: NumericModel, index: int) -> int | None:
+    """Return the model file's 1-based number of external port ``index`` (0-based).
+
+    ``None`` for a boundary system's own port (they follow the PDE's open ports).
+    """
     closed = set(() if nm.feedback is None else nm.feedback.closed)
-    return [j for j in range(nm.order * nm.size) if j not in closed][index] + 1
+    closed |= {j for b in nm.boundary for j in b.joined}
+    kept = [j for j in range(nm.order * nm.size) if j not in closed]
+    return kept[index] + 1 if index < len(kept) else None
 
 
 def port_description(nm: NumericModel, letter: str, index: int) -> str:
@@ -54,7 +59,9 @@ def port_description(nm: NumericModel, letter: str, index: int) -> str:
     traces = nm.input_traces if letter == "u" else nm.output_traces
     text = f"{letter}{index + 1} = {traces[index]}"
     original = model_port(nm, index)
-    return text if original == index + 1 else f"{text} (the model's {letter}{original})"
+    if original is None or original == index + 1:
+        return text
+    return f"{text} (the model's {letter}{original})"
 
 
 def sensor_descriptions(nm: NumericModel, C_m: np.ndarray) -> tuple[str, ...]:
@@ -98,7 +105,11 @@ def renumbering(nm: NumericModel) -> str | None:
     """
     if nm.feedback is None:
         return None
-    moved = [(i + 1, model_port(nm, i)) for i in range(nm.n_ports) if model_port(nm, i) != i + 1]
+    moved = [
+        (i + 1, model_port(nm, i))
+        for i in range(nm.n_ports)
+        if model_port(nm, i) not in (None, i + 1)
+    ]
     closed = ", ".join(f"u{c + 1}" for c in nm.feedback.closed)
     if not moved:
         return f"[feedback] closes {closed}; the external ports keep the model's numbers"
