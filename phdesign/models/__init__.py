@@ -3,13 +3,16 @@
 ``wave``, ``timoshenko``, ``euler-bernoulli`` and ``airy`` (described in the documentation's
 model gallery); ``wave-damper`` (the string with a damper at z = 1) and
 ``beam-tip-damper`` (the clamped beam with a damper at its tip) close one input with a
-boundary feedback (``[feedback]``).  Each is stored as a TOML model file in this package;
+boundary feedback (``[feedback]``); ``string-tip-mass``, ``beam-tip-body``, ``flexible-arm``
+and ``string-motor`` join boundary systems (a tip mass, a tip body, a hub, a DC motor:
+``[[boundary_systems]]``).  Each is stored as a TOML model file in this package;
 :func:`load` reads a built-in model by name or a model file by path.
 
 Examples
 --------
->>> builtin_names()
-('airy', 'beam-tip-damper', 'euler-bernoulli', 'timoshenko', 'wave', 'wave-damper')
+>>> builtin_names()  # doctest: +NORMALIZE_WHITESPACE
+('airy', 'beam-tip-body', 'beam-tip-damper', 'euler-bernoulli', 'flexible-arm',
+ 'string-motor', 'string-tip-mass', 'timoshenko', 'wave', 'wave-damper')
 >>> load_builtin("euler-bernoulli").order
 2
 """
