@@ -61,7 +61,7 @@ A tip mass ``m`` with a damper ``c`` on a string's velocity port (x_c = momentum
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import sympy
@@ -69,6 +69,7 @@ import sympy
 from phdesign.core.errors import ModelError
 from phdesign.symbolic.definition import parse_matrix
 from phdesign.symbolic.expressions import canonical
+from phdesign.symbolic.printing import format_expression
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.model import BCPHS
@@ -80,8 +81,11 @@ __all__ = [
     "boundary_system_from_mapping",
     "boundary_system_to_dict",
     "boundary_systems_from_value",
+    "close_boundary_inputs",
     "coupled_indices",
     "coupling",
+    "external_input_labels",
+    "split_actuated",
 ]
 
 #: The keys of one ``[[boundary_systems]]`` table (and of the mapping ``define`` reads).
@@ -347,3 +351,76 @@ def boundary_system_to_dict(
     if bs.interconnection is not None:
         table["interconnection"] = rows(bs.interconnection)
     return table
+
+
+def external_input_labels(model: BCPHS) -> tuple[str, ...]:
+    """Name every external input: the PDE's open traces, then the boundary systems' own."""
+    traces = (format_expression(u, model.interval) for u in model.external_inputs)
+    return (*traces, *(label for bs in model.boundary_systems for label in bs.input_labels))
+
+
+def split_actuated(
+    model: BCPHS, actuate: Sequence[int], K: sympy.MatrixBase
+) -> tuple[list[int], sympy.Matrix, list[int], sympy.Matrix]:
+    """Split actuated inputs (1-based external) into the PDE's and the boundary systems' own.
+
+    Returns the trace inputs with their block of K, and the boundary inputs (0-based among
+    the boundary systems' inputs) with theirs.
+
+    Raises
+    ------
+    ModelError
+        If K couples an actuated trace input with a boundary system's input.
+    """
+    t = len(model.external_inputs)
+    rows = [i for i, a in enumerate(actuate) if a <= t]
+    others = [i for i, a in enumerate(actuate) if a > t]
+    K = sympy.Matrix(K)
+    if not K.extract(rows, others).is_zero_matrix or not K.extract(others, rows).is_zero_matrix:
+        raise ModelError(
+            "feedback K couples a trace input with a boundary system's input; expected K "
+            "block-diagonal between the two"
+        )
+    return (
+        [actuate[i] for i in rows],
+        K.extract(rows, rows),
+        [actuate[i] - t - 1 for i in others],
+        K.extract(others, others),
+    )
+
+
+def close_boundary_inputs(model: BCPHS, positions: Sequence[int], K: sympy.MatrixBase) -> BCPHS:
+    r"""Close boundary systems' own inputs with :math:`w_a = -K z_a`; return the new model.
+
+    ``positions`` are 0-based among all the boundary systems' inputs.  Inside a system
+    :math:`\dot x_c = (J_c - R_c)Q_c x_c + \dots + B_a w_a` with :math:`z_a = B_a^	op Q_c x_c`
+    the loop gives :math:`J_c - B_a \operatorname{skew}(K) B_a^	op` and
+    :math:`R_c + B_a \operatorname{sym}(K) B_a^	op` (a motor's voltage fed back its current:
+    more resistance).  K must not couple two systems.
+    """
+    K = sympy.Matrix(K)
+    systems, start = [], 0
+    for bs in model.boundary_systems:
+        mine = [p - start for p in positions if start <= p < start + bs.n_external]
+        rows = [i for i, p in enumerate(positions) if start <= p < start + bs.n_external]
+        start += bs.n_external
+        if not mine:
+            systems.append(bs)
+            continue
+        other = [i for i in range(len(positions)) if i not in rows]
+        if not K.extract(rows, other).is_zero_matrix:
+            raise ModelError("feedback K couples the inputs of two boundary systems")
+        Ks, B = K.extract(rows, rows), sympy.Matrix(bs.external)
+        B_a = B.extract(list(range(bs.size)), mine)
+        keep = [j for j in range(bs.n_external) if j not in mine]
+        systems.append(
+            replace(
+                bs,
+                J=sympy.ImmutableMatrix(sympy.Matrix(bs.J) - B_a * (Ks - Ks.T) / 2 * B_a.T),
+                R=sympy.ImmutableMatrix(sympy.Matrix(bs.R) + B_a * (Ks + Ks.T) / 2 * B_a.T),
+                B=sympy.ImmutableMatrix(B.extract(list(range(bs.size)), keep)) if keep else None,
+                inputs=tuple(bs.inputs[j] for j in keep) if bs.inputs else (),
+                outputs=tuple(bs.outputs[j] for j in keep) if bs.outputs else (),
+            )
+        )
+    return replace(model, boundary_systems=tuple(systems))

@@ -148,7 +148,8 @@ def close_inputs(model: BCPHS, inputs: Sequence[int], gain: Any) -> BCPHS:
     """
     _require_model(model)
     nn = model.order * model.size
-    external = external_indices(nn, model.feedback)
+    joined = {j for bs in model.boundary_systems for j in bs.joined}
+    external = [j for j in external_indices(nn, model.feedback) if j not in joined]
     picked = list(inputs)
     for position, index in enumerate(picked, start=1):
         if isinstance(index, bool) or not isinstance(index, int):

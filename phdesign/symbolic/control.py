@@ -91,6 +91,7 @@ import sympy
 
 from phdesign.core.errors import LoopError, ObserverError
 from phdesign.core.text import html_table, matrix_text, sensors_text
+from phdesign.symbolic import boundary_systems as bsys
 from phdesign.symbolic.classify import Classification, classify
 from phdesign.symbolic.closing import close_inputs
 from phdesign.symbolic.expressions import vanishes
@@ -145,7 +146,7 @@ def actuated_indices(actuate: Any, model: BCPHS) -> tuple[int, ...]:
         If an index is not an input of the model, is repeated, or none is given.
     """
     values = [actuate] if isinstance(actuate, int) else list(actuate)
-    inputs = [format_expression(u, model.interval) for u in model.external_inputs]
+    inputs = bsys.external_input_labels(model)  # the PDE's open inputs, then the boundary systems'
     if not values:
         raise LoopError("actuate: expected at least one input index; found none")
     seen: list[int] = []
@@ -263,7 +264,9 @@ def controlled_plant(model: BCPHS, actuate: Sequence[int], K: sympy.MatrixBase) 
 
     Its external inputs are the others (:func:`~phdesign.symbolic.closing.close_inputs`).
     """
-    return close_inputs(model, list(actuate), sympy.Matrix(K).tolist())
+    trace, K_t, own, K_b = bsys.split_actuated(model, actuate, K)  # a motor's voltage: its own
+    closed = bsys.close_boundary_inputs(model, own, K_b) if own else model
+    return close_inputs(closed, trace, K_t.tolist()) if trace else closed
 
 
 # --------------------------------------------------------------------------- certificates
@@ -448,7 +451,7 @@ def _variant_lines(result: Classification, plant: bool) -> list[str]:
             continue
         status = "holds" if r.holds else "fails"
         reason = _plant_words(r.reason) if plant else r.reason
-        lines.append(f"  {r.proposition}.{r.variant} {status}: {reason}")
+        lines.append(f"  {r.name} {status}: {reason}")
     return lines
 
 
@@ -489,6 +492,7 @@ def classify_loop(
     closed = controlled_plant(model, actuate, K)
     plant = classify(closed, sympy.zeros(0, closed.n_ports), sympy.zeros(0, 0), method=method)
     error = classify(model, C_m, L, method=method)
-    bounded = error.verdict != "inconclusive" and error_output_bounded(error, actuate)
+    bounded = not model.boundary_systems and error.verdict != "inconclusive"  # coupled: no bound
+    bounded = bounded and error_output_bounded(error, actuate)
     verdict, reason = loop_verdict(plant.verdict, error.verdict, source, bounded)
     return LoopClassification(model, actuate, K, source, plant, error, bounded, verdict, reason)

@@ -34,3 +34,24 @@ def test_simulated_error_energy_includes_the_mass_and_never_grows():
     assert np.all(np.diff(run.H_err) <= 1e-12 * run.H_err[0])  # dissipative error system
     assert run.H_err[-1] < 0.5 * run.H_err[0]
     assert run.output_labels[-1] == "mass velocity"
+
+
+def test_observer_based_control_through_the_motor():
+    # u2 is the motor's voltage: V = -k i_hat. Fed its own current, the motor's winding gets
+    # the resistance Rw + k (hand-derived: R_c + B k B^T with B = (1, 0)^T), the string none.
+    obs = phd.Observer(phd.load("string-motor"), sensors=[2], gain=1)
+    loop = phd.Loop(obs, actuate=2, feedback=3)
+    plant = loop.controlled_plant()
+    (motor,) = plant.boundary_systems
+    Rw = next(s for s, _ in plant.parameters if s.name == "Rw")
+    assert motor.R.tolist() == [[Rw + 3, 0], [0, 0]]
+    assert motor.B is None
+    assert plant.n_ports == 1  # the string's far end e1(1) is left
+    result = loop.classify()
+    assert result.plant.verdict == result.error.verdict == "asymptotic"
+    assert result.verdict != "exponential"
+    report = loop.spectrum()
+    # separation (block-triangular in (x, x~)): the loop's abscissa is the larger of the two
+    assert report.spectral_abscissa == max(
+        report.plant.spectral_abscissa, report.error.spectral_abscissa
+    )
