@@ -36,7 +36,7 @@ def prepare(
     """Prepare the job's evaluator (see :mod:`phdesign.sweep.jobs`)."""
     if sensors is None:  # the description refuses this job without sensors
         raise ValueError("the classify job needs a sensor set")
-    C_m = sensor_matrix(sensors, model.order * model.size)
+    C_m = sensor_matrix(sensors, model.n_ports)
 
     def evaluate(gain: tuple[float, ...] | None) -> dict[str, Any]:
         entries = gain if gain is not None else (1.0,) * len(sensors)
@@ -47,7 +47,7 @@ def prepare(
         return {
             "verdict": result.verdict,
             "kappa": kappa if isinstance(kappa, float) else None,
-            "best": "" if best is None else f"{best.proposition}.{best.variant}",
+            "best": "" if best is None else best.name,
         }
 
     return evaluate

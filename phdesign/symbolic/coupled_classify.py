@@ -86,20 +86,30 @@ StaticClassifier = Callable[[Any, Any, Any, str], Any]
 
 @dataclass(frozen=True)
 class TheoremResult:
-    """One theorem tried on the coupled error system: whether its hypotheses hold, and why."""
+    """One theorem tried on the coupled error system: whether its hypotheses hold, and why.
+
+    ``name`` is short (``"RLMZ"``, ``"ABLV"``: the authors' initials, as a sweep stores
+    it), ``theorem`` the citation (:data:`EXPONENTIAL`, :data:`ASYMPTOTIC`).
+    """
 
     name: str
+    theorem: str
     convergence: str
     applicable: bool
     holds: bool
     reason: str
     kappa: float | None = None
 
+    def kappa_json(self) -> float | None:
+        r""":math:`\kappa^*` of the static part's Proposition 3.2 (None when not proved)."""
+        return self.kappa if self.holds else None
+
     def to_dict(self) -> dict[str, Any]:
         """JSON form (the keys of a proposition's row, and the theorem's words)."""
         return {
             "proposition": self.name,
             "variant": 1,
+            "theorem": self.theorem,
             "applicable": self.applicable,
             "holds": self.holds if self.applicable else None,
             "kappa": self.kappa,
@@ -155,10 +165,10 @@ class CoupledClassification:
         lines = [*self._header(), ""]
         for r in self.results:
             state = "holds" if r.holds else ("not applicable" if not r.applicable else "fails")
-            lines.append(f"{r.convergence}: {state}: {r.name}")
+            lines.append(f"{r.convergence}: {state}: {r.theorem}")
             lines.append(f"  ↳ {r.reason}")
         best = self.best
-        tail = f" (by {best.name})" if best is not None else ""
+        tail = f" (by {best.theorem})" if best is not None else ""
         lines += ["", f"verdict: {self.verdict}{tail}"]
         return "\n".join(lines)
 
@@ -312,6 +322,7 @@ def _asymptotic(model: BCPHS, C: sympy.Matrix, L: sympy.Matrix) -> TheoremResult
     N = system.null()
     if not N.cols:
         return TheoremResult(
+            "ABLV",
             ASYMPTOTIC,
             "asymptotic",
             True,
@@ -327,6 +338,7 @@ def _asymptotic(model: BCPHS, C: sympy.Matrix, L: sympy.Matrix) -> TheoremResult
             if not N[system.traces + o : system.traces + o + bs.size, :].is_zero_matrix
         ]
         return TheoremResult(
+            "ABLV",
             ASYMPTOTIC,
             "asymptotic",
             True,
@@ -335,6 +347,7 @@ def _asymptotic(model: BCPHS, C: sympy.Matrix, L: sympy.Matrix) -> TheoremResult
             "the sensors do not see: an eigenvalue on the imaginary axis is not excluded",
         )
     return TheoremResult(
+        "ABLV",
         ASYMPTOTIC,
         "asymptotic",
         True,
@@ -367,7 +380,7 @@ def _exponential(
     model: BCPHS, C: sympy.Matrix, L: sympy.Matrix, method: str, static: StaticClassifier
 ) -> TheoremResult:
     def no(reason: str, applicable: bool = True) -> TheoremResult:
-        return TheoremResult(EXPONENTIAL, "exponential", applicable, False, reason)
+        return TheoremResult("RLMZ", EXPONENTIAL, "exponential", applicable, False, reason)
 
     if model.order != 1:
         return no(f"stated for N = 1 (N = {model.order})", applicable=False)
@@ -410,6 +423,7 @@ def _exponential(
         )
     best = max(holding, key=lambda r: r.kappa_float or 0.0)
     return TheoremResult(
+        "RLMZ",
         EXPONENTIAL,
         "exponential",
         True,

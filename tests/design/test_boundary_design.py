@@ -55,3 +55,18 @@ def test_observer_based_control_through_the_motor():
     assert report.spectral_abscissa == max(
         report.plant.spectral_abscissa, report.error.spectral_abscissa
     )
+
+
+def test_sweeps_over_the_mass():
+    # every tip mass: no exponential decay (spectrum) and asymptotic by the ABLV test
+    import pytest
+
+    pytest.importorskip("xarray", reason="install the sweep extra")
+    model = phd.load("string-tip-mass")
+    common = {"sensors": [2], "grid": {"l1": "1"}, "param_grid": {"m": "0.5:2:3"}}
+    options = {"scheduler": "synchronous", "progress": False}
+    spectra = phd.sweep(model, **common, **options)
+    assert np.all(spectra.spectral_abscissa.values == 0.0)
+    verdicts = phd.sweep(model, **common, job="classify", **options)
+    assert set(verdicts.verdict.values.ravel()) == {"asymptotic"}
+    assert set(verdicts.best.values.ravel()) == {"ABLV"}

@@ -57,10 +57,10 @@ def test_tip_mass_string_is_never_exponential(sensors):
     )
     assert result.verdict == "asymptotic"
     exponential, asymptotic = result.results
-    assert exponential.name == EXPONENTIAL
+    assert exponential.theorem == EXPONENTIAL
     assert not exponential.holds
     assert "'mass' is not strictly input passive" in exponential.reason
-    assert asymptotic.name == ASYMPTOTIC
+    assert asymptotic.theorem == ASYMPTOTIC
     assert asymptotic.holds
     assert "exponential" not in result.verdict
     assert "verdict: asymptotic" in str(result)
@@ -77,7 +77,7 @@ def test_strictly_input_passive_end_gives_exponential_and_the_spectrum_agrees():
     model = string_with_maxwell_end(d=1)
     result = classify(model, [], None)
     assert result.verdict == "exponential"
-    assert result.best.name == EXPONENTIAL
+    assert result.best.theorem == EXPONENTIAL
     assert result.best.kappa == pytest.approx(0.5, abs=1e-12)
     report = spectrum(to_numeric(model))
     assert report.converged
