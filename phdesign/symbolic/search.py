@@ -213,7 +213,7 @@ def _coupled_search(model: BCPHS, gains: tuple[sympy.Expr, ...] | None) -> Senso
             SubsetResult(
                 sensors=picked,
                 verdict=found.verdict,
-                best=None if best is None else best.convergence,
+                best=None if best is None else best.name,
                 kappa=None if best is None else best.kappa,
                 unbounded=False,
                 holding=tuple(r.convergence for r in found.results if r.holds),
