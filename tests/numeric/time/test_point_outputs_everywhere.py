@@ -105,7 +105,6 @@ def test_the_continuous_observer_of_the_sampled_simulator_matches_simulate() -> 
     assert np.max(np.abs(plain.at_values_hat[-1] - plain.at_values[-1])) > 1e-4  # not trivial
 
 
-@pytest.mark.slow
 def test_the_loops_tip_rotation_is_the_integral_of_its_rate_output() -> None:
     loop = _loop(16)
     steps = (500, 1000, 2000)
