@@ -68,6 +68,10 @@ class NumericError(PhdesignError, ValueError):
     """A numeric request cannot be honoured (bad resolution, time span, method)."""
 
 
+class CertificateError(NumericError):
+    """A certificate cannot be made for this system (z-dependent, singular, not proved)."""
+
+
 class VerificationError(NumericError):
     """A strict export whose verification failed (``strict=True``: nothing is returned)."""
 

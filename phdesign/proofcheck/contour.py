@@ -1,0 +1,143 @@
+r"""Re-checking a contour: the path, each segment's half-plane, the count of zeros.
+
+A segment :math:`[p, q]` is verified when the interval enclosure of :math:`\Delta` over
+the box spanned by p and q (:func:`.intervals.delta`) lies in an open half-plane
+:math:`\operatorname{Re} > 0`, :math:`\operatorname{Im} > 0`, :math:`\operatorname{Re} <
+0` or :math:`\operatorname{Im} < 0` (labels 0 to 3, centres at :math:`\text{label}\cdot
+\pi/2`).  The proof's label is tried first; a segment none of whose halves fit is halved
+(:data:`SPLITS` times at most), and the labels used are the checker's own.  Consecutive
+labels differ by a quarter turn or none, so the change of argument is
+:math:`\tfrac{\pi}{2}\sum_j t_j` exactly: around a closed path the count of zeros is
+:math:`\tfrac14\sum t_j`; along the upper half of a conjugate-symmetric rectangle (from a
+real point to a real point, where :math:`\Delta` is real since its data are), it is
+:math:`\tfrac12\sum t_j`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from fractions import Fraction
+
+from mpmath.libmp import fzero, mpf_gt, mpf_lt
+
+from phdesign.proofcheck.exact import number
+from phdesign.proofcheck.intervals import PRECISION, box, delta
+
+__all__ = ["SPLITS", "count_zeros", "read_segments"]
+
+SPLITS = 4
+Point = tuple[Fraction, Fraction]
+
+
+def read_segments(rows: Sequence[Sequence[object]]) -> list[tuple[Point, Point, int]]:
+    """Read ``[x0, y0, x1, y1, label]`` rows."""
+    out = []
+    for row in rows:
+        x0, y0, x1, y1 = (number(v) for v in row[:4])
+        out.append(((x0, y0), (x1, y1), int(row[4])))  # type: ignore[call-overload]
+    return out
+
+
+def _holds(value: tuple, label: int) -> bool:
+    re, im = value
+    return {
+        0: mpf_gt(re[0], fzero),
+        1: mpf_gt(im[0], fzero),
+        2: mpf_lt(re[1], fzero),
+        3: mpf_lt(im[1], fzero),
+    }[label]
+
+
+def _labels(data, p: Point, q: Point, hint: int, depth: int, prec: int) -> list[int] | None:
+    value = delta(data, box((p[0], q[0]), (p[1], q[1]), prec), prec)
+    for label in (hint, *(x for x in range(4) if x != hint)):
+        if _holds(value, label):
+            return [label]
+    if depth == 0:
+        return None
+    m = ((p[0] + q[0]) / 2, (p[1] + q[1]) / 2)
+    first = _labels(data, p, m, hint, depth - 1, prec)
+    second = _labels(data, m, q, hint, depth - 1, prec) if first is not None else None
+    return None if second is None else first + second
+
+
+def _on_path(segments, vertices: Sequence[Point]) -> str | None:
+    """Whether the segments run along the polygon through ``vertices``, in order."""
+    if not segments or segments[0][0] != vertices[0] or segments[-1][1] != vertices[-1]:
+        return "the segments do not start and end at the path's ends"
+    edge = 0
+    for (p, q, _), following in zip(segments, [*segments[1:], None], strict=True):
+        a, b = vertices[edge], vertices[edge + 1]
+        if not (_between(a, p, b) and _between(a, q, b) and _forward(a, p, q, b)):
+            return f"a segment leaves the edge {a} -> {b}"
+        if following is not None and following[0] != q:
+            return "two consecutive segments do not meet"
+        if q == b:
+            edge += 1
+    if edge != len(vertices) - 1:
+        return "the segments do not cover the path"
+    return None
+
+
+def _between(a: Point, p: Point, b: Point) -> bool:
+    if a[0] == b[0]:
+        return p[0] == a[0] and min(a[1], b[1]) <= p[1] <= max(a[1], b[1])
+    if a[1] == b[1]:
+        return p[1] == a[1] and min(a[0], b[0]) <= p[0] <= max(a[0], b[0])
+    return False
+
+
+def _forward(a: Point, p: Point, q: Point, b: Point) -> bool:
+    def distance(x: Point) -> Fraction:
+        return abs(x[0] - a[0]) + abs(x[1] - a[1])
+
+    return distance(p) < distance(q) <= distance(b)
+
+
+def count_zeros(
+    data,
+    segments,
+    vertices: Sequence[Point],
+    *,
+    symmetric: bool,
+    failures: list[str],
+    what: str,
+    prec: int = PRECISION,
+) -> int | None:
+    """Verify the path and its labels; return the number of zeros inside, or None."""
+    problem = _on_path(segments, vertices)
+    if problem:
+        failures.append(f"{what}: {problem}")
+        return None
+    labels: list[int] = []
+    for p, q, hint in segments:
+        found = _labels(data, p, q, hint, SPLITS, prec)
+        if found is None:
+            failures.append(
+                f"{what}: Δ is not separated from 0 on the segment {_text(p)} -> {_text(q)}"
+            )
+            return None
+        labels.extend(found)
+    pairs = list(zip(labels, labels[1:], strict=False))
+    if not symmetric:
+        pairs.append((labels[-1], labels[0]))
+    turns = 0
+    for x, y in pairs:
+        step = (y - x) % 4
+        if step == 2:
+            failures.append(f"{what}: consecutive segments in opposite half-planes")
+            return None
+        turns += (0, 1, 0, -1)[step]
+    if symmetric:
+        if labels[0] not in (0, 2) or labels[-1] not in (0, 2) or turns % 2:
+            failures.append(f"{what}: the upper half path does not end where Δ is real")
+            return None
+        return turns // 2
+    if turns % 4:
+        failures.append(f"{what}: the closed path's quarter turns do not sum to 4·m")
+        return None
+    return turns // 4
+
+
+def _text(p: Point) -> str:
+    return f"{float(p[0]):.6g}{float(p[1]):+.6g}i"
