@@ -19,6 +19,7 @@ from bad_inputs import BAD_MODELS, beam_with
 
 from phdesign.cli import main
 from phdesign.core.errors import (
+    CertificateError,
     ExpressionError,
     LoopError,
     ModelError,
@@ -74,6 +75,16 @@ def beams_toml(count: int) -> str:
         }
     )
 
+
+GRADED = tomli_w.dumps(
+    {
+        "name": "graded string",
+        "interval": [0, 1],
+        "order": 1,
+        "matrices": {"P1": [[0, 1], [1, 0]], "H": [[1, 0], [0, "1 + z"]]},
+        "ports": {"inputs": ["e1(0)", "e2(1)"], "outputs": ["-e2(0)", "e1(1)"]},
+    }
+)
 
 BEAM_SENSORS = "classify euler-bernoulli --sensors"
 BEAM_GAIN = "classify euler-bernoulli --sensors 3,4 --gain"
@@ -1043,6 +1054,27 @@ COMMAND_ROWS = [
         r"workers: a local cluster has at most \d+ workers on this machine .*found 100000",
         SweepError,
     ),
+    # certify and check (issue 25); the certificate's own refusals come before any work
+    row(
+        "certify euler-bernoulli --sensors 3,4 --gain 0.1,1",
+        "--band is needed: Δ is not a polynomial",
+        CertificateError,
+    ),
+    row(
+        "certify euler-bernoulli --sensors 3,4",
+        "certify --sensors/--cm needs --gain",
+        ObserverError,
+    ),
+    row("certify airy --band 5", "irrational entries", CertificateError),
+    row("certify wave --sensors 2 --gain 1 --band 0", "--band must be", NumericError),
+    row(
+        "certify {tmp}/graded.toml --sensors 2 --gain 1 --band 5",
+        "z-dependent coefficients",
+        CertificateError,
+        **{"graded.toml": GRADED},
+    ),
+    row("check {tmp}/missing.json", "cannot read the proof file", OutputFileError),
+    row("check {tmp}/bad.json", "is not JSON", OutputFileError, **{"bad.json": "{not json"}),
 ]
 
 

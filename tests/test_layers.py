@@ -29,6 +29,7 @@ LAYERS = {
     "sweep": 4,
     "codegen": 4,
     "cli": 5,
+    "proofcheck": 0,  # the independent checker: imports nothing of phdesign but itself
     "__main__": 5,
 }
 DELEGATES = ("phdesign.plots", "phdesign.codegen")  # where a result's .plot()/.write() goes
@@ -147,6 +148,18 @@ def test_the_base_layers_never_import_up_even_lazily(folder, below):
         if (layer(t) or 0) > below
     ]
     assert not up, up
+
+
+def test_the_proof_checker_imports_nothing_of_phdesign_but_itself():
+    # an independent re-check: no arrow, even lazy, leaves phdesign.proofcheck
+    top, inner = imports()
+    arrows = [(m, t) for m, ts in top.items() for t in ts] + [(m, t) for m, t, _ in inner]
+    out = [
+        f"{m} -> {t}"
+        for m, t in arrows
+        if m.startswith("phdesign.proofcheck") and not t.startswith("phdesign.proofcheck")
+    ]
+    assert not out, out
 
 
 def test_the_rule_sees_a_violation():

@@ -48,6 +48,8 @@ COMMAND_MODULES = {
     "noise": "phdesign.cli.noise_commands",
     "tradeoff": "phdesign.cli.noise_commands",
     "export": "phdesign.cli.export_command",
+    "certify": "phdesign.cli.certify_command",
+    "check": "phdesign.cli.certify_command",
     "loop": "phdesign.cli.loop_command",
     "sweep": "phdesign.cli.sweep_command",
     "plot": "phdesign.cli.sweep_command",

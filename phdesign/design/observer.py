@@ -40,6 +40,7 @@ from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, ObserverError
 from phdesign.core.progress import Progress, reports_progress
 from phdesign.core.text import REPR_LIMIT, html_table, matrix_text, sensors_text, shorten
+from phdesign.design.certify import ObserverCertify
 from phdesign.design.export import STATESPACE_SYSTEMS, ObserverExport
 from phdesign.design.noise import ObserverNoise
 from phdesign.design.plant import Plant, numeric_matrix
@@ -62,7 +63,7 @@ __all__ = ["STATESPACE_SYSTEMS", "Observer", "Plant", "numeric_matrix"]
 
 
 @dataclass(frozen=True, init=False, repr=False)
-class Observer(ObserverNoise, ObserverExport):
+class Observer(ObserverNoise, ObserverExport, ObserverCertify):
     r"""A boundary observer for a model: sensors :math:`C_m` and gain :math:`L`.
 
     Parameters

@@ -28,6 +28,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     import numpy as np
 
     from phdesign.numeric.bridge import NumericModel
+    from phdesign.numeric.certified.certificate import Certificate
     from phdesign.numeric.discretization.phs import DiscretePHS
     from phdesign.numeric.spectrum.report import SpectrumReport
     from phdesign.numeric.time.options import SimulationOptions
@@ -173,6 +174,16 @@ class Plant:
             tol=tol,
             count=count,
         )
+
+    def certify(self, band: float | None = None, *, rate: bool = False) -> Certificate:
+        r"""Prove the spectral abscissa of the plant with u = 0 (:mod:`phdesign.design.certify`).
+
+        The whole plane for first-order systems with one travel time and :math:`P_0 = 0`,
+        else the band :math:`|\operatorname{Im}\lambda| \le` ``band``.
+        """
+        from phdesign.design.certify import certify_design
+
+        return certify_design(self, None, None, band, rate)
 
     @reports_progress
     def simulate(

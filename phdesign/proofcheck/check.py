@@ -35,7 +35,7 @@ def check_all(proof: dict) -> list[str]:
 
 def _rate(section: dict) -> list[str]:
     try:
-        from phdesign.proofcheck.rate import check_rate  # type: ignore[import-not-found]
+        from phdesign.proofcheck.rate import check_rate
     except ImportError:
         return ["the proof has a 'rate' section but this checker has no decay-rate check"]
     return list(check_rate(section))

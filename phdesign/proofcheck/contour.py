@@ -17,13 +17,21 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from fractions import Fraction
+from itertools import pairwise
 
 from mpmath.libmp import fzero, mpf_gt, mpf_lt
 
 from phdesign.proofcheck.exact import number
 from phdesign.proofcheck.intervals import PRECISION, box, delta
 
-__all__ = ["SPLITS", "count_zeros", "read_segments"]
+__all__ = [
+    "SPLITS",
+    "count_zeros",
+    "delta_over",
+    "overlapping",
+    "read_segments",
+    "square_count",
+]
 
 SPLITS = 4
 Point = tuple[Fraction, Fraction]
@@ -40,24 +48,37 @@ def read_segments(rows: Sequence[Sequence[object]]) -> list[tuple[Point, Point, 
 
 def _holds(value: tuple, label: int) -> bool:
     re, im = value
-    return {
-        0: mpf_gt(re[0], fzero),
-        1: mpf_gt(im[0], fzero),
-        2: mpf_lt(re[1], fzero),
-        3: mpf_lt(im[1], fzero),
-    }[label]
+    return bool(
+        {
+            0: mpf_gt(re[0], fzero),
+            1: mpf_gt(im[0], fzero),
+            2: mpf_lt(re[1], fzero),
+            3: mpf_lt(im[1], fzero),
+        }[label]
+    )
 
 
-def _labels(data, p: Point, q: Point, hint: int, depth: int, prec: int) -> list[int] | None:
-    value = delta(data, box((p[0], q[0]), (p[1], q[1]), prec), prec)
+def delta_over(data):
+    """Return the evaluator of Δ for :func:`count_zeros`: Δ over the box of a segment."""
+
+    def evaluate(p: Point, q: Point, prec: int) -> tuple:
+        return delta(data, box((p[0], q[0]), (p[1], q[1]), prec), prec)
+
+    return evaluate
+
+
+def _labels(evaluate, p: Point, q: Point, hint: int, depth: int, prec: int) -> list[int] | None:
+    value = evaluate(p, q, prec)
     for label in (hint, *(x for x in range(4) if x != hint)):
         if _holds(value, label):
             return [label]
     if depth == 0:
         return None
     m = ((p[0] + q[0]) / 2, (p[1] + q[1]) / 2)
-    first = _labels(data, p, m, hint, depth - 1, prec)
-    second = _labels(data, m, q, hint, depth - 1, prec) if first is not None else None
+    first = _labels(evaluate, p, m, hint, depth - 1, prec)
+    if first is None:
+        return None
+    second = _labels(evaluate, m, q, hint, depth - 1, prec)
     return None if second is None else first + second
 
 
@@ -95,7 +116,7 @@ def _forward(a: Point, p: Point, q: Point, b: Point) -> bool:
 
 
 def count_zeros(
-    data,
+    evaluate,
     segments,
     vertices: Sequence[Point],
     *,
@@ -104,21 +125,24 @@ def count_zeros(
     what: str,
     prec: int = PRECISION,
 ) -> int | None:
-    """Verify the path and its labels; return the number of zeros inside, or None."""
+    """Verify the path and its labels; return the number of zeros inside, or None.
+
+    ``evaluate(p, q, prec)`` encloses the function over the box of the segment p -> q.
+    """
     problem = _on_path(segments, vertices)
     if problem:
         failures.append(f"{what}: {problem}")
         return None
     labels: list[int] = []
     for p, q, hint in segments:
-        found = _labels(data, p, q, hint, SPLITS, prec)
+        found = _labels(evaluate, p, q, hint, SPLITS, prec)
         if found is None:
             failures.append(
                 f"{what}: Δ is not separated from 0 on the segment {_text(p)} -> {_text(q)}"
             )
             return None
         labels.extend(found)
-    pairs = list(zip(labels, labels[1:], strict=False))
+    pairs = list(pairwise(labels))
     if not symmetric:
         pairs.append((labels[-1], labels[0]))
     turns = 0
@@ -137,6 +161,50 @@ def count_zeros(
         failures.append(f"{what}: the closed path's quarter turns do not sum to 4·m")
         return None
     return turns // 4
+
+
+def square_count(
+    evaluate, square: dict, *, symmetric: bool, failures: list[str], what: str, prec: int
+) -> tuple[Fraction, Fraction, Fraction, int] | None:
+    """Verify a square of the proof (``center``, ``radius``, ``count``, ``path``).
+
+    A symmetric square is centred on the real axis and counted by its upper half path;
+    another is a closed counter-clockwise path from its lower right corner.  Returns
+    ``(x, y, r, count)``, or None (with the failure recorded).
+    """
+    x, y = (number(v) for v in square["center"])
+    r = number(square["radius"])
+    if r <= 0 or (symmetric and y != 0):
+        failures.append(f"{what}: a square must have r > 0 (and y = 0 when symmetric)")
+        return None
+    if symmetric:
+        corners = [(x + r, Fraction(0)), (x + r, r), (x - r, r), (x - r, Fraction(0))]
+    else:
+        corners = [(x + r, y - r), (x + r, y + r), (x - r, y + r), (x - r, y - r)]
+        corners.append(corners[0])
+    found = count_zeros(
+        evaluate,
+        read_segments(square["path"]),
+        corners,
+        symmetric=symmetric,
+        failures=failures,
+        what=what,
+        prec=prec,
+    )
+    if found is None:
+        return None
+    if found < 1 or found != square["count"]:
+        failures.append(f"{what} holds {found} zeros, the proof says {square['count']}")
+        return None
+    return x, y, r, found
+
+
+def overlapping(squares: Sequence[tuple[Fraction, Fraction, Fraction]]) -> int | None:
+    """Return the 1-based index of a square that overlaps an earlier one, or None."""
+    for i, (x, y, r) in enumerate(squares):
+        if any(abs(x - u) < r + s and abs(y - v) < r + s for u, v, s in squares[:i]):
+            return i + 1
+    return None
 
 
 def _text(p: Point) -> str:

@@ -32,18 +32,21 @@ def read_matrix(rows: Sequence[Sequence[object]]) -> Matrix:
 
 
 def identity(size: int) -> Matrix:
-    """The identity."""
+    """Return the identity."""
     return [[Fraction(int(i == j)) for j in range(size)] for i in range(size)]
 
 
 def matmul(X: Matrix, Y: Matrix) -> Matrix:
-    """The product."""
+    """Return the product."""
     columns = list(zip(*Y, strict=True)) if Y else []
-    return [[sum((a * b for a, b in zip(row, col, strict=True)), Fraction(0)) for col in columns] for row in X]
+    return [
+        [sum((a * b for a, b in zip(row, col, strict=True)), Fraction(0)) for col in columns]
+        for row in X
+    ]
 
 
 def determinant(X: Matrix) -> Fraction:
-    """The determinant, by Bareiss-free elimination with row swaps."""
+    """Return the determinant, by Bareiss-free elimination with row swaps."""
     A = [row[:] for row in X]
     det = Fraction(1)
     for c in range(len(A)):
@@ -61,7 +64,7 @@ def determinant(X: Matrix) -> Fraction:
 
 
 def inverse(X: Matrix) -> Matrix | None:
-    """The inverse by Gauss-Jordan elimination, or None if singular."""
+    """Return the inverse by Gauss-Jordan elimination, or None if singular."""
     size = len(X)
     A = [row[:] + e for row, e in zip(X, identity(size), strict=True)]
     for c in range(size):

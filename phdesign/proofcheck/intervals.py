@@ -34,16 +34,19 @@ __all__ = ["PRECISION", "box", "delta", "interval", "parity"]
 
 PRECISION = 64
 TAYLOR_TERMS = 11  # with ||Y|| <= 1/4 the remainder is below 1.3e-16
+MINOR_NORM = (
+    0.25  # the minors are taken of e^{Ãℓ/q} with ‖Ãℓ‖/q <= this (their wrapping ~ e^{2·this})
+)
 
 
 def interval(x: Fraction, prec: int = PRECISION) -> tuple:
-    """The outward-rounded interval of the rational x."""
+    """Return the outward-rounded interval of the rational x."""
     p, q = from_int(x.numerator), from_int(x.denominator)
     return (mpf_div(p, q, prec, "f"), mpf_div(p, q, prec, "c"))
 
 
 def box(re: tuple[Fraction, Fraction], im: tuple[Fraction, Fraction], prec: int = PRECISION):
-    """The complex interval of the box ``re x im`` (each a pair lo <= hi)."""
+    """Return the complex interval of the box ``re x im`` (each a pair lo <= hi)."""
     return (
         (interval(min(re), prec)[0], interval(max(re), prec)[1]),
         (interval(min(im), prec)[0], interval(max(im), prec)[1]),
@@ -55,16 +58,18 @@ def _real(x: Fraction, prec: int) -> tuple:
 
 
 def _magnitude(z: tuple) -> float:
-    """An upper bound of |z| (as a float, rounded up generously)."""
+    """Return an upper bound of |z| (as a float, rounded up generously)."""
     re, im = z
-    bound = max(abs(_float(re[0])), abs(_float(re[1]))) + max(abs(_float(im[0])), abs(_float(im[1])))
+    bound = max(abs(_float(re[0])), abs(_float(re[1]))) + max(
+        abs(_float(im[0])), abs(_float(im[1]))
+    )
     return bound * (1 + 1e-9) + 1e-300
 
 
 def _float(x: tuple) -> float:
     from mpmath.libmp import to_float
 
-    return to_float(x)
+    return float(to_float(x))
 
 
 def _matmul(X: list, Y: list, prec: int) -> list:
@@ -90,20 +95,20 @@ def _zero_filled(X: list) -> list:
 
 
 def parity(order: tuple[int, ...]) -> int:
-    """The sign of the permutation that sorts ``order`` (by counting inversions)."""
+    """Return the sign of the permutation that sorts ``order`` (by counting inversions)."""
     inversions = sum(1 for i in range(len(order)) for j in range(i) if order[j] > order[i])
     return -1 if inversions % 2 else 1
 
 
 def _minor(F: list, rows: tuple[int, ...], cols: tuple[int, ...], prec: int) -> tuple:
-    """The determinant of F[rows, cols] by the Leibniz formula (k <= 4 here)."""
+    """Return the determinant of F[rows, cols] by the Leibniz formula (k <= 4 here)."""
     total = (L.mpi_zero, L.mpi_zero)
     for perm in permutations(range(len(rows))):
         term = None
         for r, c in enumerate(perm):
             entry = F[rows[r]][cols[c]]
             term = entry if term is None else L.mpci_mul(term, entry, prec)
-        if parity(perm) < 0:
+        if term is not None and parity(perm) < 0:
             term = (L.mpi_neg(term[0]), L.mpi_neg(term[1]))
         total = L.mpci_add(total, term, prec)
     return total
@@ -131,7 +136,7 @@ def delta(data, lam: tuple, prec: int = PRECISION) -> tuple:
         Y.append(row)
     norm = max(sum(_magnitude(x) for x in row if x is not None) for row in Y)
     s = max(0, math.ceil(math.log2(norm * 4))) if norm > 0 else 0
-    t = max(0, math.ceil(math.log2(norm / 2))) if norm > 0 else 0
+    t = max(0, math.ceil(math.log2(norm / MINOR_NORM))) if norm > 0 else 0
     t = min(t, s)
     p = _real(Fraction(1, 2**s), prec)
     Y = [[None if x is None else L.mpci_mul(x, p, prec) for x in row] for row in Y]
@@ -143,8 +148,8 @@ def delta(data, lam: tuple, prec: int = PRECISION) -> tuple:
         if k == 0:
             total = L.mpci_add(total, _real(weights[(0, 0)], prec), prec)
             continue
-        C = [[_minor(F, I, J, prec) for J in subsets] for I in subsets]
-        for _ in range(t):
+        C = [[_minor(F, rows, cols, prec) for cols in subsets] for rows in subsets]
+        for _ in range(t):  # squarings: repeated products would wrap far more
             C = _matmul(C, C, prec)
         for (a, b), w in weights.items():
             scale = sigma ** (data.weight_blocks[k][a] - data.weight_blocks[k][b])
@@ -153,7 +158,7 @@ def delta(data, lam: tuple, prec: int = PRECISION) -> tuple:
 
 
 def _exp_small(Y: list, norm: float, prec: int) -> list:
-    """:math:`e^Y` for :math:`\\|Y\\|_\\infty \\le 1/4` with the Taylor remainder enclosed."""
+    r""":math:`e^Y` for :math:`\|Y\|_\infty \le 1/4` with the Taylor remainder enclosed."""
     size = len(Y)
     m = TAYLOR_TERMS
     one = _real(Fraction(1), prec)
@@ -163,7 +168,10 @@ def _exp_small(Y: list, norm: float, prec: int) -> list:
         YT = _zero_filled(_matmul(Y, T, prec))
         inv = _real(Fraction(1, j), prec)
         T = [
-            [L.mpci_add(one if a == b else zero, L.mpci_mul(YT[a][b], inv, prec), prec) for b in range(size)]
+            [
+                L.mpci_add(one if a == b else zero, L.mpci_mul(YT[a][b], inv, prec), prec)
+                for b in range(size)
+            ]
             for a in range(size)
         ]
     bound = norm ** (m + 1) / math.factorial(m + 1) / (1 - norm / (m + 2))

@@ -109,8 +109,8 @@ def derive(system: dict, failures: list[str]) -> Delta | None:
 
 
 def _expansion(B: Matrix, nn: int, n: int) -> tuple[tuple, dict]:
-    """The Cauchy-Binet terms: for each k, the weights of the k x k minors of E."""
-    by_k: dict[int, dict[tuple[int, int], Fraction]] = {}
+    """Return the Cauchy-Binet terms: for each k, the weights of the k x k minors of E."""
+    by_k: dict[int, dict[tuple[tuple[int, ...], tuple[int, ...]], Fraction]] = {}
     for S in combinations(range(2 * nn), nn):
         coefficient = determinant([[row[c] for c in S] for row in B])
         if not coefficient:

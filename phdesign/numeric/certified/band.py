@@ -74,7 +74,7 @@ class BandCount:
 
     @property
     def abscissa_interval(self) -> tuple[Fraction, Fraction] | None:
-        """:math:`[\\alpha_{lo}, \\alpha_{up}]` for the band's abscissa; None: no zero in R."""
+        r""":math:`[\alpha_{lo}, \alpha_{up}]` for the band's abscissa; None: no zero in R."""
         if not self.rightmost:
             return None
         lo = max(e.real_interval[0] for e in self.rightmost)
@@ -88,14 +88,14 @@ class BandCount:
 
 
 def certify_band(ch: Characteristic, band: float, estimates: Sequence[complex]) -> BandCount:
-    """Certify the abscissa of the zeros of Δ with :math:`|\\operatorname{Im}| \\le` band.
+    r"""Certify the abscissa of the zeros of Δ with :math:`|\operatorname{Im}| \le` band.
 
     Parameters
     ----------
     ch : Characteristic
         Δ's exact data.
     band : float
-        :math:`\\Omega > 0`.
+        :math:`\Omega > 0`.
     estimates : sequence of complex
         Eigenvalue estimates (the converged spectrum's); those in the band's upper half
         are refined and enclosed.

@@ -47,6 +47,7 @@ encloses :math:`\Delta` over a box of :math:`\lambda` in ball arithmetic (python
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
@@ -167,7 +168,7 @@ class Characteristic:
             if k == 0:
                 total += acb(_q(W[(0, 0)]))
                 continue
-            blocks = [sum(i // n for i in I) for I in subsets(self.dimension, k)]
+            blocks = [sum(i // n for i in subset) for subset in subsets(self.dimension, k)]
             scale = [fmpq(2) ** (b * log2_sigma) for b in blocks]
             m = len(blocks)
             rows = []
@@ -181,7 +182,7 @@ class Characteristic:
                         entry += lam * acb(_q(a1) * factor)
                     row.append(entry)
                 rows.append(row)
-            E = acb_mat(rows).exp()
+            E = _exp(acb_mat(rows))
             for (i, j), w in W.items():
                 total += acb(_q(w) * scale[i] / scale[j]) * E[i, j]
         return total
@@ -198,6 +199,25 @@ class Characteristic:
     def point(self, lam: Any) -> Any:
         r"""Enclose :math:`\Delta` at the ``acb`` point ``lam``."""
         return self.evaluate(lam, self.scale(float(abs(lam).mid())))
+
+
+def _exp(X: Any) -> Any:
+    r"""Return :math:`e^X` for a ball matrix: flint's exponential of :math:`X/2^s`, squared.
+
+    flint bounds the effect of the input radii through the norm of the whole matrix,
+    :math:`\|e^{X+E} - e^X\| \le \|E\| e^{\|X\| + \|E\|}`, which for an oscillatory
+    :math:`X` (imaginary eigenvalues, :math:`\|e^X\| \approx 1 \ll e^{\|X\|}`) overstates
+    the radius by :math:`e^{\|X\|}`; with :math:`\|X/2^s\| \le 1/2` that factor is at most
+    :math:`e^{1/2}`, and the squarings propagate the radii as the entries themselves grow.
+    """
+    norm = max(sum(abs(X[i, j]).upper() for j in range(X.ncols())) for i in range(X.nrows()))
+    s = max(0, math.ceil(math.log2(max(float(norm), 1e-300) * 2)))
+    from flint import acb
+
+    E = (X * acb(2) ** -s).exp()
+    for _ in range(s):
+        E = E * E
+    return E
 
 
 def _q(x: Fraction) -> Any:

@@ -38,7 +38,7 @@ Matrix = list[list[Fraction]]
 
 
 def subsets(size: int, k: int) -> list[tuple[int, ...]]:
-    """The k-subsets of ``range(size)`` in lexicographic order (the compounds' basis)."""
+    """Return the k-subsets of ``range(size)`` in lexicographic order (the compounds' basis)."""
     return list(combinations(range(size), k))
 
 
@@ -64,29 +64,20 @@ def additive_compound(A: Sequence[Sequence[Fraction]], k: int) -> Matrix:
             for i, row in enumerate(A):
                 if row[j] == 0 or i in rest:
                     continue
-                I = tuple(sorted((*rest, i)))
-                sign = 1 if (m - I.index(i)) % 2 == 0 else -1
-                out[where[I]][col] += sign * row[j]
+                target = tuple(sorted((*rest, i)))
+                sign = 1 if (m - target.index(i)) % 2 == 0 else -1
+                out[where[target]][col] += sign * row[j]
     return out
 
 
 def _det(M: Matrix) -> Fraction:
-    """Exact determinant by Gaussian elimination over the rationals."""
-    M = [row[:] for row in M]
-    size, det = len(M), Fraction(1)
-    for c in range(size):
-        pivot = next((r for r in range(c, size) if M[r][c] != 0), None)
-        if pivot is None:
-            return Fraction(0)
-        if pivot != c:
-            M[c], M[pivot] = M[pivot], M[c]
-            det = -det
-        det *= M[c][c]
-        for r in range(c + 1, size):
-            factor = M[r][c] / M[c][c]
-            if factor:
-                M[r] = [x - factor * y for x, y in zip(M[r], M[c], strict=True)]
-    return det
+    """Exact determinant (sympy's, over the rationals)."""
+    import sympy
+
+    value = sympy.Matrix(
+        [[sympy.Rational(x.numerator, x.denominator) for x in row] for row in M]
+    ).det()
+    return Fraction(int(value.p), int(value.q))
 
 
 def binet_weights(

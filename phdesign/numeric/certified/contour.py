@@ -36,6 +36,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
+from itertools import pairwise
 from typing import Any
 
 from phdesign.core.errors import CertificateError
@@ -72,25 +73,32 @@ class Segment:
     value: str = ""
 
 
-def label_of(enclosure: Any) -> int | None:
+#: A segment is accepted when its enclosure would still lie in the half-plane if its
+#: radius were this many times larger: a re-check in another arithmetic (the checker's
+#: interval enclosures are up to 1.2 times as wide as flint's balls) then passes first time.
+MARGIN = 1.25
+
+
+def label_of(enclosure: Any, margin: float = MARGIN) -> int | None:
     """Return the label of a half-plane holding the ``acb`` enclosure, or None.
 
-    Of the half-planes that hold it, the one farthest from the enclosure is chosen (the
-    widest margin for a re-check in another arithmetic).
+    Of the half-planes that hold it with the margin, the one farthest from the
+    enclosure is chosen.
     """
     re, im = enclosure.real, enclosure.imag
-    margins = [
-        (re.lower(), 0),
-        (im.lower(), 1),
-        (-re.upper(), 2),
-        (-im.upper(), 3),
-    ]
+    x, y = float(re.mid()), float(im.mid())
+    rx, ry = float(re.rad()) * margin, float(im.rad()) * margin
+    margins = [(x - rx, 0), (y - ry, 1), (-x - rx, 2), (-y - ry, 3)]
     best = max(margins, key=lambda m: m[0])
-    return best[1] if best[0] > 0 else None
+    if best[0] <= 0:
+        return None
+    # the float margin decides the choice; the exact ball must hold it too
+    exact = (re.lower() > 0, im.lower() > 0, re.upper() < 0, im.upper() < 0)[best[1]]
+    return best[1] if exact else None
 
 
 def quarter_turns(labels: Sequence[int], closed: bool) -> int:
-    """Return :math:`\\sum_j t_j` along ``labels`` (module docstring).
+    r"""Return :math:`\sum_j t_j` along ``labels`` (module docstring).
 
     Raises
     ------
@@ -98,7 +106,7 @@ def quarter_turns(labels: Sequence[int], closed: bool) -> int:
         If two consecutive labels are opposite half-planes (impossible for a valid
         enclosure: their shared endpoint would lie in both).
     """
-    pairs = list(zip(labels, labels[1:]))
+    pairs = list(pairwise(labels))
     if closed and labels:
         pairs.append((labels[-1], labels[0]))
     total = 0
@@ -159,13 +167,13 @@ def _along(p: Point, q: Point, s: Fraction) -> Point:
 def certify_path(enclose: Enclose, vertices: Sequence[Point], **steps: Fraction) -> list[Segment]:
     """Certify the polygonal path through ``vertices`` (axis-parallel edges)."""
     segments: list[Segment] = []
-    for p, q in zip(vertices, vertices[1:]):
+    for p, q in pairwise(vertices):
         segments.extend(certify_edge(enclose, p, q, **steps))
     return segments
 
 
 def closed_count(segments: Sequence[Segment]) -> int:
-    """Zeros inside a closed, counter-clockwise path: :math:`\\tfrac14 \\sum t_j`."""
+    r"""Zeros inside a closed, counter-clockwise path: :math:`\tfrac14 \sum t_j`."""
     turns = quarter_turns([s.label for s in segments], closed=True)
     if turns % 4:
         raise CertificateError(f"the quarter turns of a closed path sum to {turns}, not 4·m")

@@ -29,7 +29,7 @@ from phdesign.numeric.certified.contour import (
     symmetric_count,
 )
 
-__all__ = ["ENCLOSURE_RADIUS", "Enclosure", "enclose_zero", "refine"]
+__all__ = ["ENCLOSURE_RADIUS", "Enclosure", "enclose_zero", "refine", "square_path"]
 
 #: Half-width of the square about a zero: 2⁻³⁶ ≈ 1.46e-11, so a real part is known to 2.9e-11.
 ENCLOSURE_RADIUS = Fraction(1, 2**36)
@@ -40,8 +40,7 @@ REAL_AXIS = 1e-9  # |Im| below this (relative) is read as a real zero, if one is
 
 @dataclass(frozen=True)
 class Enclosure:
-    r"""A square :math:`|\operatorname{Re}\lambda - x_c| \le r`, :math:`|\operatorname{Im}
-    \lambda - y_c| \le r` proved to hold ``count`` zeros.
+    r"""A square about :math:`x_c + i y_c` of half-width r proved to hold ``count`` zeros.
 
     ``symmetric``: centred on the real axis and counted by its upper half (``segments``
     is then the upper half path), else a closed counter-clockwise path.
@@ -78,7 +77,8 @@ def refine(point: Callable[[Any], Any], guess: complex) -> complex:
         return complex(float(z.real.mid()), float(z.imag.mid()))
 
 
-def _square(center: Point, r: Fraction, symmetric: bool) -> list[Point]:
+def square_path(center: Point, r: Fraction, symmetric: bool) -> list[Point]:
+    """Return the vertices of a square's path: the upper half of a symmetric one, or closed."""
     x, y = center
     if symmetric:  # upper half path of [x-r, x+r] x [-r, r], counter-clockwise
         return [(x + r, Fraction(0)), (x + r, r), (x - r, r), (x - r, Fraction(0))]
@@ -100,7 +100,7 @@ def enclose_zero(enclose: Enclose, estimate: complex, *, real: bool) -> Enclosur
     while r <= MAX_RADIUS:
         steps: dict[str, Any] = {"first_step": r / 2, "max_step": 2 * r, "min_step": r / 2**12}
         try:
-            segments = certify_path(enclose, _square((x, y), r, real), **steps)
+            segments = certify_path(enclose, square_path((x, y), r, real), **steps)
         except CertificateError:
             r *= 16
             continue

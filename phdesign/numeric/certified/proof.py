@@ -46,10 +46,8 @@ VERSION = 1
 
 
 def path_rows(segments: Sequence[Segment]) -> list[list[Any]]:
-    """The segments as ``[x0, y0, x1, y1, label, enclosure]`` rows."""
-    return [
-        [*(fraction_text(v) for v in (*s.start, *s.end)), s.label, s.value] for s in segments
-    ]
+    """Return the segments as ``[x0, y0, x1, y1, label, enclosure]`` rows."""
+    return [[*(fraction_text(v) for v in (*s.start, *s.end)), s.label, s.value] for s in segments]
 
 
 def _enclosure(e: Enclosure) -> dict[str, Any]:
@@ -63,7 +61,7 @@ def _enclosure(e: Enclosure) -> dict[str, Any]:
 
 
 def band_section(result: BandCount) -> dict[str, Any]:
-    """The ``band`` section of a proof file."""
+    """Return the ``band`` section of a proof file."""
     return {
         "omega": fraction_text(result.band),
         "left": fraction_text(result.left),

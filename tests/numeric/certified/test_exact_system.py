@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import pytest
 import sympy
-from string_models import string
+from string_models import GRADED_STRING, string
 
 from phdesign.core.errors import ObserverError, ParameterError
 from phdesign.models import load_builtin
@@ -82,15 +82,7 @@ def test_a_skew_gain_is_conservative_but_not_dissipative_only_if_its_symmetric_p
 
 
 def test_z_dependent_coefficients_are_kept_exact_and_flagged():
-    model = BCPHS.define(
-        name="graded string",
-        interval=[0, 1],
-        order=1,
-        P={1: [[0, 1], [1, 0]]},
-        H=[[1, 0], [0, "1 + z"]],
-        inputs=["e1(0)", "e2(1)"],
-        outputs=["-e2(0)", "e1(1)"],
-    )
+    model = GRADED_STRING
     system = closed_system(model)
     assert not system.constant
     assert system.H[1, 1] == 1 + system.z
