@@ -64,6 +64,7 @@ _EXPORTS: dict[str, str] = {
     "NoiseReport": "phdesign.numeric.noise.report",
     "Tradeoff": "phdesign.numeric.noise.tradeoff",
     "SampledObserver": "phdesign.numeric.sampled.export",
+    "Certificate": "phdesign.numeric.certified.certificate",
     # errors
     "PhdesignError": "phdesign.core.errors",
 }
@@ -71,6 +72,7 @@ _EXPORTS: dict[str, str] = {
 __all__ = [
     "BCPHS",
     "BoundarySystem",
+    "Certificate",
     "Classification",
     "CoupledClassification",
     "Displacement",
@@ -117,6 +119,7 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
     from phdesign.io import model_from_toml, model_to_toml, read_model, write_model
     from phdesign.models import builtin_names, load, load_builtin
     from phdesign.numeric.bridge import to_numeric
+    from phdesign.numeric.certified.certificate import Certificate
     from phdesign.numeric.discretization.registry import discretize
     from phdesign.numeric.noise.report import NoiseReport
     from phdesign.numeric.noise.tradeoff import Tradeoff

@@ -154,3 +154,13 @@ def test_a_band_certificate_needs_a_band_and_the_rate_prover_is_named():
         beam.certify()
     with pytest.raises(CertificateError, match="irrational entries"):
         phd.Plant(load_builtin("airy")).certify(band=5)
+
+
+def test_rate_refuses_in_one_line_while_the_rate_prover_is_absent():
+    import importlib.util
+
+    if importlib.util.find_spec("phdesign.numeric.certified.rate") is not None:
+        pytest.skip("the decay-rate prover is installed (its own tests cover rate=True)")
+    string = phd.Observer(load_builtin("wave"), sensors=[2], gain=[0.5])
+    with pytest.raises(CertificateError, match="the decay-rate proof is not available"):
+        string.certify(rate=True)
