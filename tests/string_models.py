@@ -38,6 +38,18 @@ def string(T: str, b: str = "1") -> BCPHS:
     )
 
 
+# A string whose stiffness grows along it: a z-dependent H (certificates refuse it)
+GRADED_STRING = BCPHS.define(
+    name="graded string",
+    interval=[0, 1],
+    order=1,
+    P={1: [[0, 1], [1, 0]]},
+    H=[[1, 0], [0, "1 + z"]],
+    inputs=["e1(0)", "e2(1)"],
+    outputs=["-e2(0)", "e1(1)"],
+)
+
+
 # Two strings (speeds 1 and sqrt(2)) coupled by a zero-order skew term between the momentum
 # of the first and the strain of the second; the damper acts on the first string only.
 COUPLED_STRINGS = BCPHS.define(
