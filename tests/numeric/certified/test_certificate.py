@@ -164,3 +164,18 @@ def test_rate_refuses_in_one_line_while_the_rate_prover_is_absent():
     string = phd.Observer(load_builtin("wave"), sensors=[2], gain=[0.5])
     with pytest.raises(CertificateError, match="the decay-rate proof is not available"):
         string.certify(rate=True)
+
+
+@pytest.mark.slow
+def test_rate_true_adds_the_proved_decay_rate_and_its_check():
+    import importlib.util
+
+    if importlib.util.find_spec("phdesign.numeric.certified.rate") is None:
+        pytest.skip("the decay-rate prover is not installed")
+    # the string with the damper k = 1/2: true rate -½ ln(1/3) (DESIGN.md); the proved σ
+    # is at most the abscissa's modulus and (issue 25) at least 90 % of it
+    cert = phd.Observer(load_builtin("wave"), sensors=[2], gain=[0.5]).certify(rate=True)
+    true_rate = -0.5 * math.log(1 / 3)
+    assert 0.9 * true_rate <= float(cert.rate) <= true_rate
+    assert cert.M >= 1
+    assert check_proof(cert.proof) == []
