@@ -72,6 +72,8 @@ CASES: dict[str, list[str]] = {
         "0.1,1",
         "--dt",
         "1e-3",
+        "--design",
+        "given",  # the gain as given: the export's numbers before gain designs existed
         "--format",
         "json",
         "-o",

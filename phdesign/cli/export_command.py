@@ -29,7 +29,7 @@ from phdesign.cli.common import (
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
 from phdesign.cli.messages import translated
-from phdesign.core.checks import EXPORT_FORMATS, REDUCTIONS, SAMPLERS
+from phdesign.core.checks import EXPORT_FORMATS, GAIN_DESIGNS, REDUCTIONS, SAMPLERS
 from phdesign.core.defaults import current
 from phdesign.core.errors import NumericError, ObserverError, OutputFileError, VerificationError
 
@@ -76,6 +76,29 @@ def _add_design_arguments(ex: argparse.ArgumentParser) -> None:
         "that are slower than the abscissa",
     )
     ex.add_argument(
+        "--design",
+        choices=GAIN_DESIGNS,
+        default=export.design,
+        help="the gain the observer runs: auto (default) makes the passive and the Kalman "
+        "design, verifies both on the initial states and keeps the lower worst F/F_c; passive "
+        "re-tunes the gain inside the dissipative averaged structure; kalman is the "
+        "steady-state Kalman predictor of the exact sampled model; given uses --gain as is",
+    )
+    ex.add_argument(
+        "--process-noise",
+        metavar="W,..",
+        default="1",
+        help="the Kalman design's noise model: intensity of white noise at each plant input "
+        "(one number, or one per input; default 1)",
+    )
+    ex.add_argument(
+        "--sensor-noise",
+        metavar="R,..",
+        default="1",
+        help="the Kalman design's noise model: variance of each sensor sample's noise (one "
+        "number, or one per sensor; default 1)",
+    )
+    ex.add_argument(
         "--tol",
         type=float,
         default=export.tol,
@@ -119,13 +142,26 @@ def _add_verification_arguments(ex: argparse.ArgumentParser) -> None:
         action="store_true",
         help="verify (implies --verify) and exit with status 3, writing nothing, when a "
         "check fails: the targets, the sampled against the continuous observer, the "
-        "verification plant's own resolution",
+        "verification plant's own resolution, the worst F/F_c over the initial states "
+        "against --max-ratio",
+    )
+    ex.add_argument(
+        "--max-ratio",
+        type=float,
+        default=export.max_ratio,
+        metavar="R",
+        help="the largest worst ratio F/F_c of the sampled to the continuous error floor over "
+        "the initial states that passes (default %(default)g): --strict fails above it, "
+        "--design auto does not take a Kalman design above it",
     )
     ex.add_argument(
         "--x0",
         metavar="EXPRS",
-        help="plant initial state of the order selection and verification runs (default "
-        "every x_i = (z-a)/(b-a) - 0.9)",
+        action="append",
+        help="plant initial state of the verification runs, repeatable: the states given are "
+        "the verification set, the first also the order selection's (default every "
+        "x_i = (z-a)/(b-a) - 0.9, then two smooth states per component that meet the "
+        "boundary conditions)",
     )
     ex.add_argument(
         "--t-end",
@@ -194,7 +230,23 @@ def _exported(args: argparse.Namespace, observer: Any) -> Any:
         t_end=args.t_end,
         plant_resolution=args.plant_resolution,
         points=None if args.at is None else split_items(args.at),
+        design=args.design,
+        process_noise=_numbers(args.process_noise, "--process-noise"),
+        sensor_noise=_numbers(args.sensor_noise, "--sensor-noise"),
+        max_ratio=args.max_ratio,
     )
+
+
+def _numbers(text: str, option: str) -> float | tuple[float, ...]:
+    """Read ``1`` or ``1,3`` (the noise model's intensities; their values are checked there)."""
+    items = split_items(text)
+    try:
+        values = tuple(float(item) for item in items)
+    except ValueError:
+        raise NumericError(
+            f"{option} must be a number or comma-separated numbers; found {text!r}"
+        ) from None
+    return values[0] if len(values) == 1 else values
 
 
 def add_sampling_arguments(parser: argparse.ArgumentParser) -> None:

@@ -26,6 +26,7 @@ from phdesign.core.errors import ArgumentError, NumericError, PhdesignError
 
 __all__ = [
     "EXPORT_FORMATS",
+    "GAIN_DESIGNS",
     "REDUCTIONS",
     "SAMPLERS",
     "choice",
@@ -45,6 +46,10 @@ SAMPLERS = ("average", "point")
 #: How an exported observer's order is reduced
 #: (:func:`phdesign.numeric.sampled.order.select_order`).
 REDUCTIONS = ("none", "modal", "balanced")
+
+#: The gain designs of an exported observer; the first is the default
+#: (:mod:`phdesign.numeric.sampled.gain_design`).
+GAIN_DESIGNS = ("auto", "passive", "kalman", "given")
 
 #: The formats an exported observer is written in (:func:`phdesign.codegen.write_observer`).
 EXPORT_FORMATS = ("json", "c", "npz", "statespace")

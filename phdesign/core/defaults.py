@@ -290,6 +290,13 @@ class ExportDefaults:
     plant_degree : int
         Galerkin degree of the verification plant: the paper's beam observer of degree 16
         (34 states) then meets a plant of 98 states.
+    design : str
+        ``"auto"``: the passive and the Kalman design, verified on the initial states, the
+        lower worst-case floor wins (:mod:`phdesign.numeric.sampled.gain_design`).
+    max_ratio : float
+        The largest worst ratio of the sampled to the continuous error floor over the
+        verification set that passes (``strict`` fails above it; a Kalman design above it
+        is not taken): the aliasing threshold, ten.
     """
 
     sampler: str = "average"
@@ -297,6 +304,8 @@ class ExportDefaults:
     output_tol: float = 1e-3
     t_end: float = 5.0
     plant_degree: int = 48
+    design: str = "auto"
+    max_ratio: float = 10.0
 
     def fill(
         self,

@@ -74,10 +74,14 @@ class ObserverExport:
         output_tol: float | None = None,
         verify: bool = False,
         strict: bool = False,
-        x0: str | Callable[[Any], Any] | None = None,
+        x0: str | Callable[[Any], Any] | Sequence[str | Callable[[Any], Any]] | None = None,
         t_end: float | None = None,
         plant_resolution: int | None = None,
         points: float | str | Sequence[float | str] | None = None,
+        design: str | None = None,
+        process_noise: float | Sequence[float] = 1.0,
+        sensor_noise: float | Sequence[float] = 1.0,
+        max_ratio: float | None = None,
         progress: Progress | None = None,
     ) -> SampledObserver:
         r"""Return the observer a controller runs: finite order, sampled every ``dt``.
@@ -113,13 +117,28 @@ class ObserverExport:
             Verify (``verify`` implied) and raise
             :class:`~phdesign.core.errors.VerificationError` naming each failed check
             (targets, sampled against continuous, the plant's resolution).
-        x0 : str or callable, optional
-            Plant initial state of those runs (``"x1: 0, x2: z - 0.9"``, or a function of z).
+        x0 : str, callable or a list of them, optional
+            Plant initial state of those runs (``"x1: 0, x2: z - 0.9"``, or a function of
+            z); a list is the whole verification set, its first state the order
+            selection's. Default: every component ``(z-a)/(b-a) - 0.9``, then two smooth
+            states per component that meet the boundary conditions.
         t_end : float
         plant_resolution : int, optional
             Galerkin degree of the verification plant.
         points : sequence of float or str, optional
             Point outputs: ``w(z)`` at numbers, named fields as ``"rotation(1)"`` (default b).
+        design : {"auto", "passive", "kalman", "given"}, optional
+            The gain the observer runs: the given gain re-tuned inside the dissipative
+            averaged structure (``passive``), the steady-state Kalman predictor of the exact
+            sampled model (``kalman``), both verified on the initial states and the lower
+            worst ratio of floors taken (``auto``, the default), or the given gain as is
+            (:mod:`phdesign.numeric.sampled.gain_design`). ``.design`` says which and why.
+        process_noise, sensor_noise : float or sequence of float
+            The Kalman design's noise model: intensity of white noise at each plant input,
+            variance of each sensor sample's noise.
+        max_ratio : float, optional
+            The largest worst ratio F/F_c over the initial states that passes verification
+            (10): ``strict`` fails above it, ``auto`` does not take a Kalman design above it.
         progress : callable, optional
             Called with one line of text at each stage (:mod:`phdesign.core.progress`).
 
@@ -137,9 +156,10 @@ class ObserverExport:
         >>> sampled.order, sampled.inputs, sampled.sampler
         (12, ('u1', 'u2', 'y2'), 'average')
         """
-        from phdesign.numeric.sampled.export import export_observer
+        from phdesign.numeric.sampled.export import KalmanNoise, export_observer
 
         C, L = self.numeric_gain("export")
+        states = self._initial_states(x0)
         return export_observer(
             self.plant.numeric,
             C,
@@ -152,10 +172,33 @@ class ObserverExport:
             output_tol=output_tol,
             verify=verify,
             strict=strict,
-            x0=self.plant.initial_state(x0, "x0"),
-            x0_text=x0 if isinstance(x0, str) else None,
+            x0=states,
             t_end=t_end,
             plant_resolution=plant_resolution,
             points=points,
             model_name=self.plant.model.name,
+            design=design,
+            noise=KalmanNoise(_intensity(process_noise), _intensity(sensor_noise)),
+            max_ratio=max_ratio,
         )
+
+    def _initial_states(self, x0: Any) -> Any:
+        """Return the verification set of ``x0`` (None: the export's default set)."""
+        from phdesign.numeric.sampled.state_set import InitialState
+
+        if x0 is None:
+            return None
+        given = list(x0) if isinstance(x0, (list, tuple)) else [x0]
+        if not given:
+            raise ObserverError("x0 must name at least one initial state; found an empty list")
+        return [
+            InitialState(
+                item if isinstance(item, str) else "x0", self.plant.initial_state(item, "x0")
+            )
+            for item in given
+        ]
+
+
+def _intensity(value: Any) -> Any:
+    """Return a number as is, a sequence as a tuple (the noise model checks the values)."""
+    return tuple(value) if isinstance(value, (list, tuple)) else value

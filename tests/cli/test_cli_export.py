@@ -78,7 +78,8 @@ def test_export_c_folder_and_force(capsys, tmp_path):
 
 
 def test_export_modal_reduction_from_the_command_line(capsys, tmp_path):
-    argv = ["export", *BEAM, "--dt", "1e-3", "--reduce", "modal", *PAPER_X0]
+    # the given gain as is (--design given): its poles are the modal observer's, sampled
+    argv = ["export", *BEAM, "--dt", "1e-3", "--reduce", "modal", *PAPER_X0, "--design", "given"]
     status, out, _ = run(capsys, *argv, "--format", "json", "-o", str(tmp_path / "m.json"))
     assert status == 0
     assert "reduction modal" in out

@@ -86,7 +86,7 @@ def test_export_with_verification_passes_the_initial_state_text(string):
 def test_point_sampled_update_is_the_held_continuous_observer(string):
     # [A B] = [I 0] expm([[A_o, B_o], [0, 0]] dt) (module docstring).  1e-12: two
     # evaluations of the exponential of a 15 x 15 matrix of norm < 1 in double precision.
-    sampled = string.export(dt=DT, order=12, sampler="point")
+    sampled = string.export(dt=DT, order=12, sampler="point", design="given")
     cont = sampled.continuous
     assert cont is not None
     n, m = cont.B.shape

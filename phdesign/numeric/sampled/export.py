@@ -34,26 +34,29 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from phdesign.core.checks import EXPORT_FORMATS, positive_number
+from phdesign.core.checks import positive_number
 from phdesign.core.defaults import current
 from phdesign.core.errors import ArgumentError, NumericError
 from phdesign.core.progress import report
-from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_initial_state, check_periods, check_sampling
 from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.points import point_outputs
 from phdesign.numeric.discretization.registry import discretize
+from phdesign.numeric.sampled.exported import FORMATS, SampledObserver
+from phdesign.numeric.sampled.gain_design import DESIGNS, GainDesign, design_gain
+from phdesign.numeric.sampled.kalman import KalmanNoise
 from phdesign.numeric.sampled.order import REDUCTIONS, select_order
 from phdesign.numeric.sampled.plant_resolution import verification_plant_degree
 from phdesign.numeric.sampled.samplers import ContinuousObserver, default_initial_state
 from phdesign.numeric.sampled.selection import OrderSelection
+from phdesign.numeric.sampled.state_runs import StateRuns
+from phdesign.numeric.sampled.state_set import InitialState, verification_states
 from phdesign.numeric.sampled.verification import (
     Verification,
     check_strict,
@@ -62,11 +65,13 @@ from phdesign.numeric.sampled.verification import (
     with_plant_gap,
     with_target_check,
 )
-from phdesign.numeric.signals import signal_lines
 from phdesign.numeric.threads import limited_threads
 
 __all__ = [
+    "DESIGNS",
     "FORMATS",
+    "POINT_SAMPLER_WARNING",
+    "KalmanNoise",
     "SampledObserver",
     "Verification",
     "displacement_points",
@@ -74,213 +79,13 @@ __all__ = [
     "verify_observer",
 ]
 
-#: Export formats of :meth:`SampledObserver.write`.
-FORMATS = EXPORT_FORMATS
-
-
-def _matrix(a: np.ndarray) -> list[list[float]]:
-    return [[float(x) for x in row] for row in np.atleast_2d(a)]
-
-
-@dataclass(frozen=True)
-class SampledObserver:
-    """A discrete-time observer ready for a controller (module docstring).
-
-    Attributes
-    ----------
-    model : str
-    dt : float
-        Sampling period in seconds.
-    sampler : {"average", "point"}
-    A, B, C, D : ndarray
-        ``x[k+1] = A x[k] + B v[k]``, ``out[k] = C x[k] + D v[k]``.
-    inputs, outputs : tuple of str
-        Names of v (plant inputs u1.., then the measured outputs) and of the outputs.
-    energy_matrix : ndarray
-        Q of the observer's energy ½ x̂ᵀ Q x̂.
-    selection : OrderSelection
-        How the order was chosen and what was dropped.
-    verification : Verification or None
-    continuous : ContinuousObserver
-        The continuous observer of the same design and order (``point`` steps it with
-        its input held; ``average`` runs its model as a sampled-data observer).
-    """
-
-    model: str
-    dt: float
-    sampler: str
-    A: np.ndarray = field(repr=False)
-    B: np.ndarray = field(repr=False)
-    C: np.ndarray = field(repr=False)
-    D: np.ndarray = field(repr=False)
-    inputs: tuple[str, ...]
-    outputs: tuple[str, ...]
-    energy_matrix: np.ndarray = field(repr=False)
-    selection: OrderSelection = field(repr=False)
-    verification: Verification | None = field(default=None, repr=False)
-    continuous: ContinuousObserver | None = field(default=None, repr=False, compare=False)
-
-    @property
-    def order(self) -> int:
-        """Number of states N."""
-        return int(self.A.shape[0])
-
-    @property
-    def x0(self) -> np.ndarray:
-        """The initial state: zeros."""
-        return np.zeros(self.order)
-
-    def descriptions(self) -> tuple[tuple[str, ...], tuple[str, ...]]:
-        """Return what each input and output is (``y3 = e1'(1)``), else their names."""
-        c = self.continuous
-        if c is None or not c.input_descriptions:
-            return self.inputs, self.outputs
-        return c.input_descriptions, c.output_descriptions
-
-    @property
-    def renumbering(self) -> str | None:
-        """How a ``[feedback]`` closure renumbered the ports (:mod:`phdesign.numeric.signals`)."""
-        from phdesign.numeric.signals import renumbering
-
-        return None if self.continuous is None else renumbering(self.continuous.discrete.model)
-
-    @property
-    def warnings(self) -> tuple[str, ...]:
-        """Warnings of the order selection and of the verification."""
-        extra = () if self.verification is None else self.verification.warnings
-        return self.selection.warnings + extra
-
-    def step(self, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """One step: returns ``(x[k+1], out[k])`` from ``x[k]`` and ``v[k]``."""
-        return self.A @ x + self.B @ v, self.C @ x + self.D @ v
-
-    def run(self, V: np.ndarray, x0: np.ndarray | None = None) -> np.ndarray:
-        """Return the outputs ``(nk, n_outputs)`` for inputs ``V`` of shape ``(nk, n_inputs)``."""
-        V = np.atleast_2d(np.asarray(V, dtype=float))
-        x = self.x0 if x0 is None else np.asarray(x0, dtype=float)
-        out = np.empty((V.shape[0], len(self.outputs)))
-        for k, v in enumerate(V):
-            x, out[k] = self.step(x, v)
-        return out
-
-    def signal_names(self) -> tuple[tuple[str, ...], tuple[str, ...]]:
-        """Return the inputs' and outputs' names as python-control takes them.
-
-        python-control refuses '.' in a signal name: ``w(0.5)`` is ``w(0p5)`` there
-        (:func:`~phdesign.numeric.statespace.control_signal_name`).
-        """
-        from phdesign.numeric.statespace import control_signal_name
-
-        return (
-            tuple(control_signal_name(name) for name in self.inputs),
-            tuple(control_signal_name(name) for name in self.outputs),
-        )
-
-    def statespace(self) -> Any:
-        """``control.StateSpace(A, B, C, D, dt)`` with the signal names (:meth:`signal_names`)."""
-        import control
-
-        inputs, outputs = self.signal_names()
-        return control.ss(
-            self.A,
-            self.B,
-            self.C,
-            self.D,
-            self.dt,
-            inputs=list(inputs),
-            outputs=list(outputs),
-            states=[f"xhat{i + 1}" for i in range(self.order)],
-            name="observer",
-        )
-
-    def to_dict(self) -> dict[str, Any]:
-        """Return the JSON export (strict JSON).
-
-        Keys: model, dt, sampler, order, A, B, C, D, inputs, outputs, x0, energy_matrix,
-        verification (null when not run) and order_selection; input_descriptions and
-        output_descriptions say what each signal is (:meth:`descriptions`), renumbering
-        how a ``[feedback]`` closure renumbered the ports (null without one).
-        """
-        inputs, outputs = self.descriptions()
-        return {
-            "model": self.model,
-            "dt": self.dt,
-            "sampler": self.sampler,
-            "order": self.order,
-            "A": _matrix(self.A),
-            "B": _matrix(self.B),
-            "C": _matrix(self.C),
-            "D": _matrix(self.D),
-            "inputs": list(self.inputs),
-            "outputs": list(self.outputs),
-            "x0": self.x0.tolist(),
-            "energy_matrix": _matrix(self.energy_matrix),
-            "verification": None if self.verification is None else self.verification.to_dict(),
-            "order_selection": self.selection.to_dict(),
-            "input_descriptions": list(inputs),
-            "output_descriptions": list(outputs),
-            "renumbering": self.renumbering,
-        }
-
-    def write(self, path: str, format: str = "json", force: bool = False) -> list[str]:
-        """Write the observer as ``format`` (:data:`FORMATS`) to ``path``; returns the files.
-
-        ``json``, ``npz`` and ``statespace`` (a Python module that rebuilds the
-        ``control.StateSpace``) write one file; ``c`` writes a folder holding
-        ``observer.h``, ``observer.c`` and the marker ``.phdesign-export``, all files or
-        none. ``force`` replaces a file, or a folder phdesign wrote and nothing else
-        (:mod:`phdesign.codegen.folder`).
-        """
-        from phdesign.codegen import write_observer
-
-        return write_observer(self, path, format, force=force)
-
-    def __repr__(self) -> str:
-        return (
-            f"SampledObserver(model={self.model!r}, order={self.order}, dt={self.dt:g}, "
-            f"sampler={self.sampler!r}, inputs={len(self.inputs)}, outputs={len(self.outputs)})"
-        )
-
-    def __str__(self) -> str:
-        how = "mean over each period" if self.sampler == "average" else "point samples"
-        sel, slow = self.selection, ""
-        if sel.spurious and sel.abscissa is not None and sel.spurious_max_real is not None:
-            slow = (
-                f" ({sel.spurious} unresolved poles slower than the abscissa {sel.abscissa:.3g}: "
-                f"max Re {sel.spurious_max_real:.3g}; `reduction='modal'` drops them)"
-            )
-        lines = [
-            f"observer for {self.model}: {self.order} states{slow}, dt = {self.dt:g} s, "
-            f"sampler {self.sampler} ({how})",
-            *signal_lines(*self.descriptions(), self.renumbering),
-            str(self.selection),
-        ]
-        if self.verification is not None:
-            lines.append(str(self.verification))
-        lines += [f"warning: {w}" for w in self.selection.warnings]
-        return "\n".join(lines)
-
-    def _repr_html_(self) -> str:
-        rows = [
-            ("model", self.model),
-            (
-                "order",
-                f"{self.order} (degree {self.selection.degree}, {self.selection.reduction})",
-            ),
-            ("dt, sampler", f"{self.dt:g} s, {self.sampler}"),
-            ("inputs", ", ".join(self.inputs)),
-            ("outputs", ", ".join(self.outputs)),
-        ]
-        if self.verification is not None:
-            v = self.verification
-            rows.append(("error floor", f"{v.floor:.3g} (continuous {v.continuous_floor:.3g})"))
-        return html_table((), rows)
-
-    def plot(self, ax: Any = None) -> Any:
-        """Draw the verification run (needs ``verify=True``); returns the axes."""
-        if self.verification is None:
-            raise NumericError("this observer was exported without verification: verify=True")
-        return self.verification.plot(ax)
+#: The export's warning for the point sampler, whether or not it verifies.
+POINT_SAMPLER_WARNING = (
+    "point samples alias: a boundary velocity is not a function of time at each instant for "
+    "the plant's unresolved content, so the observer's error floor grows with the plant's "
+    "resolution (the paper's beam at 1 ms: 6.4e-4 for 50 modes, 1.6e-2 for 1000); use "
+    "`sampler='average'` (an integrate-and-dump front end)"
+)
 
 
 def displacement_points(
@@ -313,14 +118,17 @@ def export_observer(
     output_tol: float | None = None,
     verify: bool = False,
     strict: bool = False,
-    x0: Callable[[np.ndarray], np.ndarray] | None = None,
+    x0: Callable[[np.ndarray], np.ndarray] | Sequence[InitialState] | None = None,
     x0_text: str | None = None,
     t_end: float | None = None,
     plant_resolution: int | None = None,
     points: float | str | Sequence[float | str] | None = None,
     model_name: str | None = None,
+    design: str | None = None,
+    noise: KalmanNoise | None = None,
+    max_ratio: float | None = None,
 ) -> SampledObserver:
-    """Design the observer a controller runs: order, sampled discretization, verification.
+    """Design the observer a controller runs: order, gain, sampled discretization, checks.
 
     Parameters
     ----------
@@ -330,8 +138,9 @@ def export_observer(
     dt : float
         Sampling period (> 0).
     sampler : {"average", "point"}, optional
-        The controller's front end (module docstring). ``average`` is the safe default.
-        This and the other defaults are the export's (:mod:`phdesign.core.defaults`).
+        The controller's front end (module docstring). ``average`` is the safe default;
+        ``point`` always warns (:data:`POINT_SAMPLER_WARNING`). This and the other
+        defaults are the export's (:mod:`phdesign.core.defaults`).
     order : int, optional
         Number of observer states; chosen from ``tol``/``output_tol`` when omitted.
     reduction : {"none", "modal", "balanced"}
@@ -339,18 +148,22 @@ def export_observer(
     tol, output_tol : float, optional
         Spectral and performance targets of the order selection (1e-6 and 1e-3).
     verify : bool
-        Run the exported observer against the verification plant.
+        Run the exported observer against the verification plant: the first initial state
+        over time (:class:`Verification`), every state of the set for the floors.
     strict : bool
         Run the verification (``verify`` implied) and raise
         :class:`~phdesign.core.errors.VerificationError` naming every failed check
-        (:func:`~phdesign.numeric.sampled.verification.failed_checks`).
-    x0 : callable, optional
-        Plant initial state ``x0(z) -> (m, n)`` of the performance and verification runs;
-        default every component ``(z - a)/(b - a) - 0.9``.
+        (:func:`~phdesign.numeric.sampled.verification.failed_checks`), among them a worst
+        ratio over the set above ``max_ratio``.
+    x0 : callable or sequence of InitialState, optional
+        Plant initial state ``x0(z) -> (m, n)`` of the order selection, or the whole
+        verification set (its first state then serves the order selection); default
+        every component ``(z - a)/(b - a) - 0.9`` followed by smooth states that meet the
+        boundary conditions (:mod:`phdesign.numeric.sampled.state_set`).
     x0_text : str, optional
-        How ``x0`` is described in reports.
+        How a callable ``x0`` is described in reports.
     t_end : float, optional
-        Length of those runs (5 s).
+        Length of those runs (5 s); the floors are taken over its last fifth.
     plant_resolution : int, optional
         Galerkin degree of the verification plant (default the table's
         ``export.plant_degree``, raised to twice the order: :mod:`phdesign.core.defaults`).
@@ -359,6 +172,12 @@ def export_observer(
         field; default (b,) for a model with a displacement, none otherwise.
     model_name : str, optional
         Name recorded in the export (default the model's).
+    design : {"auto", "passive", "kalman", "given"}, optional
+        The gain the observer runs (:mod:`phdesign.numeric.sampled.gain_design`).
+    noise : KalmanNoise, optional
+        The Kalman design's noise model (default unit intensities).
+    max_ratio : float, optional
+        The largest worst ratio F/F_c over the set a design may have to pass verification.
 
     Returns
     -------
@@ -369,49 +188,121 @@ def export_observer(
     >>> from phdesign.models import load_builtin
     >>> from phdesign.numeric.bridge import to_numeric
     >>> nm = to_numeric(load_builtin("wave"))
-    >>> obs = export_observer(nm, np.array([[0.0, 1.0]]), np.array([[0.5]]), dt=1e-2, order=12)
+    >>> obs = export_observer(nm, np.array([[0.0, 1.0]]), np.array([[0.5]]), dt=1e-2, order=12,
+    ...                       design="given")
     >>> obs.order, obs.inputs, obs.outputs
     (12, ('u1', 'u2', 'y2'), ('yhat1', 'yhat2'))
     """
-    sampler, tol, output_tol, t_end = current().export.fill(sampler, tol, output_tol, t_end)
+    d = current().export
+    sampler, tol, output_tol, t_end = d.fill(sampler, tol, output_tol, t_end)
+    design = d.design if design is None else design
+    max_ratio = d.max_ratio if max_ratio is None else max_ratio
     verify = _checked_flags(verify, strict)  # strict verifies
-    dt = _checked_request(nm, dt, sampler, reduction, t_end, verify, tol, output_tol, x0)
+    states = _states(nm, x0, x0_text)
+    dt = _checked_request(nm, dt, sampler, reduction, t_end, verify, tol, output_tol, states)
+    C, Lm = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (C_m, L))
+    _checked_design(design, noise, max_ratio, nm.n_ports, C.shape[0])
     plant = discretize(
         nm, "galerkin", verification_plant_degree(nm, order, plant_resolution, reduction)
     )
-    initial = default_initial_state(nm.size, nm.interval) if x0 is None else x0
-    text = x0_text or ("x_i = (z - a)/(b - a) - 0.9 for every component" if x0 is None else "x0")
-    e0 = plant.project(initial)
-    C, Lm = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (C_m, L))
+    e0 = plant.project(states[0].function)
     selection, continuous = select_order(
         nm, C, Lm, plant=plant, x0=e0, t_end=float(t_end), order=order, reduction=reduction,
         points=displacement_points(nm, points), tol=tol, output_tol=output_tol,
     )  # fmt: skip
-    discrete = continuous.sampled(dt, sampler)
+    gains = _designed(plant, continuous, C, states, design, dt, sampler, float(t_end), verify,
+                      noise or KalmanNoise(), float(max_ratio))  # fmt: skip
+    discrete = gains.selected.realization
     verification = None
     if verify:
         report("export: verification against the plant")
         verification = verify_observer(
             plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=float(t_end),
-            x0_text=text, realization=discrete,
+            x0_text=states[0].text, realization=discrete,
         )  # fmt: skip
     selection, verification = _plant_checks(
-        nm, plant, continuous, initial, float(t_end), text, selection, verification, strict
-    )
+        nm, plant, continuous, states[0], float(t_end), selection, verification,
+        _design_failures(gains, verify) if strict else None,
+    )  # fmt: skip
+    assert discrete is not None  # the chosen design was made (design_gain raises otherwise)
     return SampledObserver(
-        model=model_name or nm.name,
-        dt=dt,
-        sampler=sampler,
-        A=discrete.A,
-        B=discrete.B,
-        C=discrete.C,
-        D=discrete.D,
-        inputs=continuous.inputs,
-        outputs=continuous.outputs,
-        energy_matrix=continuous.energy_matrix,
-        selection=selection,
-        verification=verification,
-        continuous=continuous,
+        model=model_name or nm.name, dt=dt, sampler=sampler,
+        A=discrete.A, B=discrete.B, C=discrete.C, D=discrete.D,
+        inputs=continuous.inputs, outputs=continuous.outputs,
+        energy_matrix=continuous.energy_matrix, selection=selection,
+        verification=verification, continuous=continuous, design=gains,
+        notes=(POINT_SAMPLER_WARNING,) if sampler == "point" else (),
+    )  # fmt: skip
+
+
+def _states(nm: NumericModel, x0: Any, x0_text: str | None) -> tuple[InitialState, ...]:
+    """Return the verification set: the given states, else x0 and the smooth states."""
+    if isinstance(x0, (list, tuple)):
+        if not x0 or not all(isinstance(s, InitialState) for s in x0):
+            raise NumericError(
+                f"x0 must be a function of z or a non-empty sequence of InitialState; found {x0!r}"
+            )
+        return tuple(x0)
+    if x0 is None:
+        default = InitialState(
+            "x_i = (z - a)/(b - a) - 0.9 for every component",
+            default_initial_state(nm.size, nm.interval),
+        )
+        return verification_states(nm, (), default)
+    return (InitialState(x0_text or "x0", x0),)
+
+
+def _checked_design(design: Any, noise: Any, max_ratio: Any, inputs: int, sensors: int) -> None:
+    """Refuse an unknown design, a bad noise model (its intensities), a bound not > 0."""
+    if design not in DESIGNS:
+        raise NumericError(f"unknown design {design!r}; expected one of {DESIGNS}")
+    if noise is not None and not isinstance(noise, KalmanNoise):
+        raise NumericError(f"noise must be a KalmanNoise; found {type(noise).__name__}")
+    if noise is not None:
+        noise.matrices(inputs, sensors)
+    positive_number(max_ratio, "max_ratio")
+
+
+def _designed(
+    plant: DiscretePHS,
+    continuous: ContinuousObserver,
+    C: np.ndarray,
+    states: tuple[InitialState, ...],
+    design: str,
+    dt: float,
+    sampler: str,
+    t_end: float,
+    verify: bool,
+    noise: KalmanNoise,
+    max_ratio: float,
+) -> GainDesign:
+    """Run the set against the plant when a design or the verification needs it; design."""
+    runs = None
+    if verify or design in ("auto", "passive"):
+        report(f"export: the plant from {len(states)} initial states")
+        runs = StateRuns.run(
+            plant, continuous, C, states=states, dt=dt, sampler=sampler, t_end=t_end
+        )
+    report(f"export: gain design {design!r}")
+    return design_gain(
+        continuous, runs, design=design, dt=dt, sampler=sampler, noise_model=noise,
+        bound=max_ratio,
+    )  # fmt: skip
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
+def _design_failures(gains: GainDesign, verify: bool) -> tuple[str, ...]:
+    """Return the strict check of the set: the exported design's worst ratio over the bound."""
+    c = gains.selected
+    if not verify or c.floors is None or c.worst <= gains.bound:
+        return ()
+    return (
+        f"verification set: the {c.design} design's worst F/F_c over "
+        f"{_count(len(c.floors.states), 'initial state')} is {c.worst:.3g} "
+        f"(at most {gains.bound:g}x)",
     )
 
 
@@ -432,7 +323,7 @@ def _checked_request(
     verify: bool,
     tol: Any,
     output_tol: Any,
-    x0: Any,
+    states: tuple[InitialState, ...],
 ) -> float:
     """Refuse a bad request before any work; return the sampling period."""
     period = check_sampling(dt, sampler)
@@ -443,7 +334,8 @@ def _checked_request(
     check_periods(period, float(t_end), stepped=verify)
     positive_number(tol, "tol")
     positive_number(output_tol, "output_tol")
-    check_initial_state(x0, nm, "x0")
+    for state in states:
+        check_initial_state(state.function, nm, "x0")
     return period
 
 
@@ -451,29 +343,31 @@ def _plant_checks(
     nm: NumericModel,
     plant: DiscretePHS,
     continuous: ContinuousObserver,
-    initial: Callable[[np.ndarray], np.ndarray],
+    initial: InitialState,
     t_end: float,
-    text: str,
     selection: OrderSelection,
     verification: Verification | None,
-    strict: bool = False,
+    strict: tuple[str, ...] | None = None,
 ) -> tuple[OrderSelection, Verification | None]:
     """Check the verification and a missed target against a finer plant (its own resolution?).
 
     One finer plant serves both checks, on the verification's records when there are any.
-    ``strict`` raises when a check failed (:func:`check_strict`).
+    ``strict`` (the design's failed checks, None when not strict) raises when a check
+    failed (:func:`check_strict`).
     """
     missed = selection.floor > selection.output_tol  # is it the plant's own resolution?
     if verification is None and not missed:
+        if strict is not None:
+            check_strict(selection, verification, strict)
         return selection, verification
     report("export: does the verification plant resolve its own outputs?")
     samples = current().simulation.samples
     t = np.linspace(0.0, t_end, samples) if verification is None else verification.t
-    found = plant_gap(nm, plant, continuous, initial, t)
+    found = plant_gap(nm, plant, continuous, initial.function, t)
     if verification is not None:
         verification = with_plant_gap(verification, found, plant.resolution)
     if missed:
-        selection = with_target_check(selection, found, plant.resolution, text)
-    if strict:
-        check_strict(selection, verification)
+        selection = with_target_check(selection, found, plant.resolution, initial.text)
+    if strict is not None:
+        check_strict(selection, verification, strict)
     return selection, verification

@@ -247,11 +247,12 @@ class ObserverModel:
         """Return the continuous observer: the output injection closed at every instant."""
         return self._close(self.F, self.G, self.H, self.D)
 
-    def averaged(self, dt: float) -> Realization:
+    def averaged(self, dt: float, period: SampledPlant | None = None) -> Realization:
         r"""Return the exact sampled-data observer of the ``average`` sampler at period ``dt``.
 
-        One period of the model with its input held (:func:`sample_plant`), closed by the
-        correction that compares interval means (module docstring).
+        One period of the model with its input held (:func:`sample_plant`, or ``period``
+        when the caller has it: it does not depend on the gain), closed by the correction
+        that compares interval means (module docstring).
 
         Examples
         --------
@@ -264,7 +265,11 @@ class ObserverModel:
         >>> [round(float(model.averaged(dt).A[0, 0]), 12) for dt in (0.1, 1.0, 100.0)]
         [0.666666666667, -0.333333333333, -0.990049751244]
         """
-        s = sample_plant(self.F, self.G, self.H, self.D, dt, "average")
+        s = (
+            sample_plant(self.F, self.G, self.H, self.D, dt, "average")
+            if period is None
+            else period
+        )
         return self._close(s.Phi, s.Gamma, s.C_s, s.D_s)
 
     def _close(

@@ -36,6 +36,7 @@ from phdesign.numeric.sampled.samplers import ContinuousObserver
 __all__ = [
     "ALIASING_RATIO",
     "FLOOR_WINDOW",
+    "LoopMaps",
     "LoopRun",
     "aliasing_warning",
     "error_floor",
@@ -121,7 +122,7 @@ def run_loop(
     if n_steps < 1 or stride < 1:
         raise NumericError(f"a run needs n_steps >= 1 and stride >= 1; found {n_steps}, {stride}")
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
-    maps = _LoopMaps.of(plant, observer, C, dt, sampler, realization)
+    maps = LoopMaps.of(plant, observer, C, dt, sampler, realization)
     n, no, m = plant.dim, observer.order, plant.n_ports
     X0 = np.concatenate([x0, np.zeros(no) if xhat0 is None else xhat0])
     X, U = maps.records(X0, n_steps, stride, u, m)
@@ -144,7 +145,7 @@ def run_loop(
 
 
 @dataclass(frozen=True)
-class _LoopMaps:
+class LoopMaps:
     """One period of plant and observer together (:func:`run_loop`'s block matrices).
 
     ``step`` and ``drive`` advance X = (x; x̂) with the input held; ``C_s``, ``D_s`` give
@@ -167,7 +168,7 @@ class _LoopMaps:
         dt: float,
         sampler: str | None,
         realization: Realization | None = None,
-    ) -> _LoopMaps:
+    ) -> LoopMaps:
         """Return the period's maps: exact for the continuous or the sampled observer.
 
         ``realization``: the sampled observer's map, when already computed.

@@ -31,6 +31,7 @@ Plant and observer run together, continuous or sampled: :mod:`phdesign.numeric.s
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -39,7 +40,7 @@ import numpy as np
 from phdesign.core.errors import NumericError, check_shape
 from phdesign.numeric.checks import check_sampling
 from phdesign.numeric.discretization.functionals import Functional
-from phdesign.numeric.discretization.phs import DiscretePHS
+from phdesign.numeric.discretization.phs import DiscretePHS, feedback_matrix
 from phdesign.numeric.discretization.points import point_rows
 from phdesign.numeric.sampled.period_maps import (
     ObserverModel,
@@ -235,8 +236,32 @@ class ContinuousObserver:
             output_descriptions=self.output_descriptions,
         )
 
-    def sampled(self, dt: float, sampler: str) -> Realization:
+    def with_gain(self, L: np.ndarray) -> ContinuousObserver:
+        r"""Return this observer with the gain L instead (same model, sensors and outputs).
+
+        The model's closure :meth:`ObserverModel.continuous
+        <phdesign.numeric.sampled.period_maps.ObserverModel.continuous>` with L, the point
+        rows kept; refused as :func:`~phdesign.numeric.discretization.phs.feedback_matrix`
+        refuses a gain (shape, :math:`L + L^\top \succ 0`).
+        """
+        Lm = np.atleast_2d(np.asarray(L, dtype=float))
+        feedback_matrix(self.model.C_m, Lm, self.n_plant_inputs)
+        model = dataclasses.replace(self.model, L=Lm)
+        closed, m = model.continuous(), self.n_plant_inputs
+        return dataclasses.replace(
+            self,
+            A=closed.A,
+            B=closed.B,
+            C=np.vstack([closed.C, self.C[m:]]),
+            D=np.vstack([closed.D, self.D[m:]]),
+            model=model,
+        )
+
+    def sampled(self, dt: float, sampler: str, period: SampledPlant | None = None) -> Realization:
         r"""Return the discrete observer for ``sampler`` at period ``dt`` (module docstring).
+
+        ``period``: the model's own one-period map under the ``average`` sampler
+        (:func:`sample_plant` of ``model``), when the caller has it.
 
         ``"point"``: this observer with v held (:func:`hold_discretization`), outputs
         :math:`C\hat x_k + Dv_k`. ``"average"``: the exact sampled-data observer
@@ -248,7 +273,7 @@ class ContinuousObserver:
         if sampler == "point":
             A_d, B_d = hold_discretization(self.A, self.B, dt)
             return Realization(A_d, B_d, self.C.copy(), self.D.copy())
-        closed = self.model.averaged(dt)
+        closed = self.model.averaged(dt, period)
         m = self.n_plant_inputs
         extra = self.C[m:]
         return Realization(

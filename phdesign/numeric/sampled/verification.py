@@ -276,8 +276,10 @@ def with_target_check(
     return dataclasses.replace(selection, warnings=(*selection.warnings, warning))
 
 
-def failed_checks(selection: OrderSelection, verification: Verification | None) -> tuple[str, ...]:
-    """Return every failed check of an export: its targets, then its verification's.
+def failed_checks(
+    selection: OrderSelection, verification: Verification | None, extra: tuple[str, ...] = ()
+) -> tuple[str, ...]:
+    """Return every failed check of an export: its targets, its verification's, then ``extra``.
 
     The targets are the order selection's (rightmost eigenvalues to ``tol``, performance
     floor to ``output_tol`` of the peak, as its first line reports them); a verification
@@ -292,12 +294,17 @@ def failed_checks(selection: OrderSelection, verification: Verification | None) 
             f"performance floor {selection.output_tol:g} of the peak (reached "
             f"{selection.floor:.3g})"
         )
-    return tuple(out) + (() if verification is None else verification.failures())
+    return tuple(out) + (() if verification is None else verification.failures()) + extra
 
 
-def check_strict(selection: OrderSelection, verification: Verification | None) -> None:
-    """Raise :class:`~phdesign.core.errors.VerificationError` naming the failed checks."""
-    failed = failed_checks(selection, verification)
+def check_strict(
+    selection: OrderSelection, verification: Verification | None, extra: tuple[str, ...] = ()
+) -> None:
+    """Raise :class:`~phdesign.core.errors.VerificationError` naming the failed checks.
+
+    ``extra``: failed checks found elsewhere (the verification set's worst ratio).
+    """
+    failed = failed_checks(selection, verification, extra)
     if failed:
         raise VerificationError(
             "`strict=True`: the export failed its checks: " + "; ".join(failed)

@@ -112,7 +112,13 @@ def test_point_sampled_observer_is_the_continuous_one_with_held_input(rng):
     # sampler's observer is checked in tests/numeric/sampled/test_sampled_averaged.py)
     nm = to_numeric(load_builtin("wave"))
     obs = export_observer(
-        nm, np.array([[0.0, 1.0]]), np.array([[0.5]]), dt=0.02, sampler="point", order=12
+        nm,
+        np.array([[0.0, 1.0]]),
+        np.array([[0.5]]),
+        dt=0.02,
+        sampler="point",
+        order=12,
+        design="given",  # the given gain as is: the discretization under test
     )
     cont = obs.continuous
     V = rng.standard_normal((20, 3))
@@ -185,6 +191,8 @@ def test_json_export_has_the_contract_keys(beam_observer, tmp_path):
         "energy_matrix", "verification", "order_selection",
         # issue 28: what each slot is, and the [feedback] renumbering (keys added)
         "input_descriptions", "output_descriptions", "renumbering",
+        # issue 29: the gain design (which, why, the candidates' floors and noise)
+        "design",
     }  # fmt: skip
     assert data["model"] == "euler-bernoulli"
     assert data["sampler"] == "average"
