@@ -416,6 +416,34 @@ COMMAND_ROWS = [
         "argument --sampler: invalid choice: 'spline' (choose from 'average', 'point')",
         None,
     ),
+    # ---- issue 29: the gain design and its noise model, checked before any work
+    row(
+        f"{EXPORT} --dt 1e-3 --design lqr -o {{tmp}}/o.json",
+        "argument --design: invalid choice: 'lqr' (choose from 'auto', 'passive', 'kalman', "
+        "'given')",
+        None,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --process-noise 1,x -o {{tmp}}/o.json",
+        "--process-noise must be a number or comma-separated numbers; found '1,x'",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --sensor-noise 1,2,3 -o {{tmp}}/o.json",
+        r"sensor noise variance must be a positive number or 2 positive numbers \(one per "
+        r"channel\); found \(1.0, 2.0, 3.0\)",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --process-noise=-1 -o {{tmp}}/o.json",
+        "process noise intensity must be finite and positive; found -1.0",
+        NumericError,
+    ),
+    row(
+        f"{EXPORT} --dt 1e-3 --max-ratio 0 -o {{tmp}}/o.json",
+        "--max-ratio must be a finite positive number; found 0.0",
+        NumericError,
+    ),
     row(
         f"{EXPORT} --dt 1e-3 --order 60 --plant-resolution 48 -o {{tmp}}/o.json",
         "order 60 needs a verification plant of at least 120 states; the plant "

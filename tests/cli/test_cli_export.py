@@ -151,3 +151,47 @@ def test_the_default_export_says_in_its_first_line_that_it_keeps_slow_unresolved
     assert "slower than the abscissa -2.91: max Re -0.115; --reduce modal drops them)" in first
     status, out, _ = run(capsys, *argv, "-o", str(tmp_path / "m.json"), "--reduce", "modal")
     assert out.splitlines()[0].startswith("observer for euler-bernoulli: 15 states, dt")
+
+
+# ---- issue 29: gain designs, the verification set, the point sampler's warning
+
+
+def test_export_design_and_a_repeated_x0_from_the_command_line(capsys, tmp_path):
+    states = ["x1: 0, x2: z - 0.9", "x1: z**2, x2: 0"]
+    argv = ["export", *BEAM, "--dt", "1e-2", "--order", "34", "--design", "kalman", "--verify"]
+    argv += [item for s in states for item in ("--x0", s)]
+    status, out, err = run(capsys, *argv, "--format", "json", "-o", str(tmp_path / "o.json"))
+    assert (status, err) == (0, "")
+    assert "design: kalman (as requested)" in out
+    assert "error floor F over t = 4..5 s against the continuous observer's F_c" in out
+    assert f"F/F_c = 0.649: {states[0]}" in out  # test_gain_design.py: 0.65 on this state
+    data = json.loads((tmp_path / "o.json").read_text())
+    design = data["design"]
+    assert (design["requested"], design["chosen"]) == ("kalman", "kalman")
+    kalman = design["candidates"][-1]
+    assert [s["x0"] for s in kalman["floors"]["states"]] == states
+    assert kalman["noise_gain"] == pytest.approx(kalman["noise_variance"][0] ** 0.5)
+    assert design["noise_model"] == {"process": 1.0, "sensor": 1.0}
+
+
+def test_point_sampler_warns_without_verification(capsys, tmp_path):
+    argv = ["export", "wave", "--sensors", "2", "--gain", "1", "--dt", "1e-3", "--order", "12"]
+    status, out, err = run(
+        capsys, *argv, "--sampler", "point", "--design", "given", "--format", "json",
+        "-o", str(tmp_path / "o.json"),
+    )  # fmt: skip
+    assert status == 0
+    assert "warning: point samples alias" in out
+    assert "--sampler average" in out  # the library's words translated to the option
+
+
+def test_strict_fails_when_the_worst_ratio_over_the_states_exceeds_the_bound(capsys, tmp_path):
+    # the paper's gain at 10 ms: worst F/F_c over the default set 4.5 (test_gain_design.py's
+    # five states: 4.46); --max-ratio 2 fails it, exit 3, nothing written
+    path = tmp_path / "o.json"
+    argv = ["export", *BEAM, "--dt", "1e-2", "--order", "34", "--design", "given", "--strict"]
+    status, out, err = run(capsys, *argv, "--max-ratio", "2", "--format", "json", "-o", str(path))
+    assert (status, out) == (3, "")
+    assert "verification set: the given design's worst F/F_c over 5 initial states is" in err
+    assert "(at most 2x); nothing written" in err
+    assert not path.exists()

@@ -79,11 +79,16 @@ class Candidate:
         """Worst ratio over the set (inf when it was not run)."""
         return math.inf if self.floors is None else self.floors.worst
 
+    @property
+    def noise_gain(self) -> float:
+        """The noise gain: the root of the largest variance (the H2 norm from unit noise)."""
+        return math.inf if self.noise is None else math.sqrt(float(np.max(self.noise)))
+
     def noise_text(self) -> str:
-        """Return the noise price as printed: the largest variance over the performance outputs."""
+        """Return the noise price as printed: the largest variance, and its root (the gain)."""
         if self.noise is None:
             return "n/a"
-        return f"{float(np.max(self.noise)):.3g}"
+        return f"{float(np.max(self.noise)):.3g} (gain {self.noise_gain:.3g})"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary (strict JSON)."""
@@ -94,6 +99,7 @@ class Candidate:
             "floors": None if self.floors is None else self.floors.to_dict(),
             "worst_ratio": _number(self.worst),
             "noise_variance": noise,
+            "noise_gain": _number(self.noise_gain),
             "failure": self.failure,
         }
 

@@ -16,7 +16,8 @@ so its stationary covariance solves the discrete Lyapunov equation (scipy's
     \sigma_j^2 = c_j P c_j^\top + \tfrac{1}{\Delta t} d_j d_j^\top
 
 for each performance output j (rows :math:`c_j, d_j` of C and of the sensor columns of D).
-For a smooth performance functional (the beam's tip w(1)) and the averaged sampler this
+Its root :math:`\sigma_j` is the noise *gain* (the :math:`H_2` norm from unit sensor noise to
+the output's error, an amplitude; the reports print both). For a smooth performance functional (the beam's tip w(1)) and the averaged sampler this
 tends to the continuous observer's variance as :math:`\Delta t \to 0`
 (:func:`phdesign.numeric.noise.statistics.error_statistics` on the same observer's model).
 """

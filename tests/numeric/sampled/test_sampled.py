@@ -252,8 +252,20 @@ int main(void)
 """
 
 
-def test_every_export_gives_the_same_outputs_over_1000_steps(beam_observer, tmp_path, rng):
+@pytest.fixture(scope="module", params=["auto", "passive", "kalman", "given"])
+def designed_observer(request, beam_observer) -> SampledObserver:
+    """The beam observer of each gain design (issue 29): every format must carry each."""
+    if request.param == "auto":
+        return beam_observer
+    nm = to_numeric(load_builtin("euler-bernoulli"))
+    obs = export_observer(nm, BEAM_SENSORS, BEAM_GAIN, dt=1e-3, order=34, design=request.param)
+    assert obs.design is not None and obs.design.chosen == request.param
+    return obs
+
+
+def test_every_export_gives_the_same_outputs_over_1000_steps(designed_observer, tmp_path, rng):
     pytest.importorskip("jinja2", reason="the C and statespace exports need the codegen extra")
+    beam_observer = designed_observer
     V = rng.standard_normal((1000, len(beam_observer.inputs)))
     reference = beam_observer.run(V)
     scale = np.max(np.abs(reference))
