@@ -176,7 +176,7 @@ def test_export_design_and_a_repeated_x0_from_the_command_line(capsys, tmp_path)
 
 def test_point_sampler_warns_without_verification(capsys, tmp_path):
     argv = ["export", "wave", "--sensors", "2", "--gain", "1", "--dt", "1e-3", "--order", "12"]
-    status, out, err = run(
+    status, out, _ = run(
         capsys, *argv, "--sampler", "point", "--design", "given", "--format", "json",
         "-o", str(tmp_path / "o.json"),
     )  # fmt: skip

@@ -17,7 +17,8 @@ so its stationary covariance solves the discrete Lyapunov equation (scipy's
 
 for each performance output j (rows :math:`c_j, d_j` of C and of the sensor columns of D).
 Its root :math:`\sigma_j` is the noise *gain* (the :math:`H_2` norm from unit sensor noise to
-the output's error, an amplitude; the reports print both). For a smooth performance functional (the beam's tip w(1)) and the averaged sampler this
+the output's error, an amplitude; the reports print both). For a smooth performance functional
+(the beam's tip w(1)) and the averaged sampler this
 tends to the continuous observer's variance as :math:`\Delta t \to 0`
 (:func:`phdesign.numeric.noise.statistics.error_statistics` on the same observer's model).
 """

@@ -72,7 +72,8 @@ def test_auto_design_at_10_ms_meets_the_floor_targets_on_five_states(at_10ms):
     design = at_10ms.design
     chosen = design.selected
     ratios = chosen.floors.ratios
-    assert at_10ms.order == 34 and at_10ms.verification.plant_degree == 48
+    assert at_10ms.order == 34
+    assert at_10ms.verification.plant_degree == 48
     assert chosen.floors.window == (4.0, 5.0)
     assert np.all(ratios <= 1.5), f"{design.chosen}: F/F_c = {np.round(ratios, 3)}"
     assert chosen.floors.floors[0] <= 2.0e-5, chosen.floors.floors[0]
@@ -136,7 +137,8 @@ def test_auto_refuses_a_kalman_design_that_fails_verification(beam, five, at_10m
     timid = design_gain(
         at_10ms.continuous, runs, noise_model=KalmanNoise(process=1e-6), bound=10.0, **common
     )
-    assert timid.chosen == "passive" and timid.candidate("kalman").worst > 10
+    assert timid.chosen == "passive"
+    assert timid.candidate("kalman").worst > 10
     assert timid.candidate("kalman").failure is not None
 
 

@@ -259,7 +259,8 @@ def designed_observer(request, beam_observer) -> SampledObserver:
         return beam_observer
     nm = to_numeric(load_builtin("euler-bernoulli"))
     obs = export_observer(nm, BEAM_SENSORS, BEAM_GAIN, dt=1e-3, order=34, design=request.param)
-    assert obs.design is not None and obs.design.chosen == request.param
+    assert obs.design is not None
+    assert obs.design.chosen == request.param
     return obs
 
 
