@@ -213,18 +213,13 @@ def export_observer(
     gains = _designed(plant, continuous, C, states, design, dt, sampler, float(t_end), verify,
                       noise or KalmanNoise(), float(max_ratio))  # fmt: skip
     discrete = gains.selected.realization
-    verification = None
-    if verify:
-        report("export: verification against the plant")
-        verification = verify_observer(
-            plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=float(t_end),
-            x0_text=states[0].text, realization=discrete,
-        )  # fmt: skip
+    assert discrete is not None  # the chosen design was made (design_gain raises otherwise)
+    verification = _verified(plant, continuous, C, dt, sampler, e0, float(t_end), states[0],
+                             discrete) if verify else None  # fmt: skip
     selection, verification = _plant_checks(
         nm, plant, continuous, states[0], float(t_end), selection, verification,
         _design_failures(gains, verify) if strict else None,
     )  # fmt: skip
-    assert discrete is not None  # the chosen design was made (design_gain raises otherwise)
     return SampledObserver(
         model=model_name or nm.name, dt=dt, sampler=sampler,
         A=discrete.A, B=discrete.B, C=discrete.C, D=discrete.D,
@@ -232,6 +227,25 @@ def export_observer(
         energy_matrix=continuous.energy_matrix, selection=selection,
         verification=verification, continuous=continuous, design=gains,
         notes=(POINT_SAMPLER_WARNING,) if sampler == "point" else (),
+    )  # fmt: skip
+
+
+def _verified(
+    plant: DiscretePHS,
+    continuous: ContinuousObserver,
+    C: np.ndarray,
+    dt: float,
+    sampler: str,
+    e0: np.ndarray,
+    t_end: float,
+    state: InitialState,
+    realization: Any,
+) -> Verification:
+    """Run the exported observer from the first state over time (:func:`verify_observer`)."""
+    report("export: verification against the plant")
+    return verify_observer(
+        plant, continuous, C, dt=dt, sampler=sampler, x0=e0, t_end=t_end, x0_text=state.text,
+        realization=realization,
     )  # fmt: skip
 
 

@@ -143,6 +143,12 @@ class GainDesign:
         """The candidate the export runs."""
         return self.candidate(self.chosen)
 
+    def plot(self, ax: Any = None) -> Any:
+        """Draw F/F_c per initial state of each design; return the axes (:mod:`phdesign.plots`)."""
+        from phdesign.plots.gain_design import plot_gain_design
+
+        return plot_gain_design(self, ax)
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary."""
         return {

@@ -190,3 +190,12 @@ def test_default_states_meet_the_boundary_conditions(name):
                     v[trace_index(i + 1, k, side, nm.order, nm.size)] = series.deriv(k)(point)
         assert np.max(np.abs(e)) > 0.1
         assert np.max(np.abs(rows @ v)) <= 1e-10 * max(1.0, np.max(np.abs(v))), state.text
+
+
+@pytest.mark.slow
+def test_the_designs_plot_side_by_side(at_10ms):
+    pytest.importorskip("matplotlib")
+    ax = at_10ms.design.plot()
+    assert len(ax.patches) == 3 * 5  # given, passive, kalman on the five states
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert f"{at_10ms.design.chosen} (exported)" in " ".join(labels)
