@@ -233,7 +233,18 @@ ROWS = [
     # ------------------------------------------------------------------- export
     add(E6, "--param rho=2", "A"),
     swap(E6, "--sensors 2", "--cm [[0,3]]", "B"),
-    swap(E6, "--gain 0.5", "--gain 0.3", "A"),
+    # the gain as given reaches A; the designed gains start from it (issue 29)
+    swap(f"{E6} --design given", "--gain 0.5", "--gain 0.3", "A"),
+    add(E6, "--design passive", "design.chosen", equals("passive")),
+    add(f"{E6} --design kalman", "--process-noise 0.01", "A"),
+    add(f"{E6} --design kalman", "--sensor-noise 10", "A"),
+    add(E6, "--max-ratio 0.5", "design.bound", equals(0.5)),
+    add(
+        EV,
+        "--x0 x1:z --x0 x2:z",
+        "design.candidates.0.floors.states",
+        lambda b, v: len(b) == 5 and [s["x0"] for s in v] == ["x1:z", "x2:z"],
+    ),
     swap(E6, "--dt 0.01", "--dt 0.02", "dt", equals(0.02)),
     add(E6, "--sampler point", "A"),
     add(E, "--order 8", "order", equals(8)),

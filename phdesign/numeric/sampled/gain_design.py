@@ -204,7 +204,7 @@ def design_gain(
         made.append(
             _kalman(observer, runs, dt, sampler, noise_model, bound, strict=design == "kalman")
         )
-    chosen, reason = _choice(design, made, bound)
+    chosen, reason = _choice(design, made)
     return GainDesign(design, chosen, reason, tuple(made), noise_model, bound)
 
 
@@ -251,7 +251,7 @@ def _kalman(
     return Candidate(c.design, c.realization, c.gain, c.floors, c.noise, failure)
 
 
-def _choice(design: str, made: list[Candidate], bound: float) -> tuple[str, str]:
+def _choice(design: str, made: list[Candidate]) -> tuple[str, str]:
     """Return the chosen design and the reason, as the report says it."""
     if design != "auto":
         return design, "as requested"
