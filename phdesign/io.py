@@ -36,6 +36,13 @@ expression strings in ``z`` and the parameters, and omitted ``P_k`` are zero::
     Q = [["1/m"]]
     G = [[-1]]
     B = [[1]]                                  # optional: an external force w on the mass
+    [disturbances]                             # optional: dx/dt = ... + B(z) w
+    B = [[1], [0]]                             # n x q, in z and the parameters
+    [performance]                              # optional: the outputs a design is judged on
+    outputs = ["integral(e1)", "e1(1)", "w(1)"]
+
+``[ports]`` may also hold ``unknown = [2]``: external inputs that are disturbances
+(:mod:`phdesign.symbolic.disturbances`).
 
 Every model phdesign can read it can write, and ``read(write(model)) == model``.
 
@@ -61,6 +68,7 @@ from phdesign.core.checks import require_path
 from phdesign.core.errors import ExpressionError, ModelError, ModelFileError, PhdesignError
 from phdesign.core.limits import MAX_MODEL_FILE_BYTES, check_file_size
 from phdesign.symbolic.boundary_systems import boundary_system_to_dict
+from phdesign.symbolic.disturbances import SECTION_KEYS, file_sections, read_sections
 from phdesign.symbolic.expressions import exact_number, parse_scalar
 from phdesign.symbolic.fields import Displacement, Field, Term, field_from_table
 from phdesign.symbolic.model import BCPHS
@@ -92,6 +100,7 @@ _OPTIONAL = (
     "feedback",
     "units",
     "boundary_systems",
+    *SECTION_KEYS,
 )
 
 
@@ -148,6 +157,7 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
     outputs = _read_outputs(ports, source)  # checks that [ports] holds inputs
     feedback = _read_feedback(data, source)
     units = _table(data, "units", source) if "units" in data else None
+    disturbances, performance = read_sections(data, ports, source)
     return BCPHS.define(
         name=data["name"],
         description=data.get("description", ""),
@@ -164,6 +174,8 @@ def model_from_dict(data: Mapping[str, Any], source: str = "model file") -> BCPH
         units=units,
         fields=_read_fields(data, source),
         boundary_systems=data.get("boundary_systems"),
+        disturbances=disturbances,
+        performance=performance,
     )
 
 
@@ -204,11 +216,12 @@ def _read_P(matrices: Mapping[str, Any], source: str) -> dict[int, Any]:
 
 def _read_outputs(ports: Mapping[str, Any], source: str) -> Any:
     """Return the outputs of [ports]: trace expressions, or "conjugate" (also omitted)."""
-    bad_ports = sorted(set(ports) - {"inputs", "outputs"})
+    bad_ports = sorted(set(ports) - {"inputs", "outputs", "unknown"})
     if bad_ports or "inputs" not in ports:
         raise ModelFileError(
             f"{source}: [ports] must hold exactly inputs and outputs (outputs may be "
-            f'"conjugate" or omitted); found {", ".join(sorted(ports)) or "nothing"}'
+            f'"conjugate" or omitted), and optionally unknown; found '
+            f"{', '.join(sorted(ports)) or 'nothing'}"
         )
     outputs = ports.get("outputs", "conjugate")
     if isinstance(outputs, str) and outputs != "conjugate":
@@ -354,6 +367,11 @@ def model_to_dict(model: BCPHS) -> dict[str, Any]:
         data["boundary_systems"] = [
             boundary_system_to_dict(bs, rows) for bs in model.boundary_systems
         ]
+    if model.disturbances is not None and model.disturbances.unknown:
+        data["ports"]["unknown"] = list(model.disturbances.unknown)
+    data.update(
+        file_sections(model, lambda x: _toml_number(x) if x.is_number else format_expression(x))
+    )
     return data
 
 

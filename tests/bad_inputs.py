@@ -356,4 +356,55 @@ BAD_MODELS = [
         ModelError,
         r"boundary_systems must be a list of boundary systems",
     ),
+    # ---- issue 27: [disturbances], [ports] unknown, [performance]
+    (
+        {"disturbances": {"B": [[1], [0], [0]]}},
+        ModelError,
+        r"disturbances B matrix; expected \(2, q\) .* but found \(3, 1\)",
+    ),
+    ({"disturbances": {"B": [[1, 0], [0]]}}, ModelError, r"disturbances B row 2 has 1 entries"),
+    ({"disturbances": {"B": [["kk"], [0]]}}, ExpressionError, r"unknown symbol 'kk'"),
+    ({"disturbances": {"G": [[1], [0]]}}, ModelFileError, r"\[disturbances\] must hold exactly B"),
+    ({"ports__unknown": [5]}, ModelError, r"ports.unknown\[1\] = 5 is not an input"),
+    ({"ports__unknown": [2, 2]}, ModelError, r"ports.unknown\[2\] = 2 is repeated"),
+    (
+        {"performance": {"outputs": ["integral(e1*e2)"]}},
+        ExpressionError,
+        r"performance.outputs\[1\] 'integral\(e1\*e2\)'.*not linear in the efforts",
+    ),
+    (
+        {"performance": {"outputs": ["w(1)", "e1(1)*e2(0)"]}},
+        ExpressionError,
+        r"performance.outputs\[2\] 'e1\(1\)\*e2\(0\)'.*not linear in the efforts",
+    ),
+    (
+        {"performance": {"outputs": ["integral(e1(1))"]}},
+        ExpressionError,
+        r"performance.outputs\[1\].*integral\(\) of a trace: e1\(1\) is a boundary value",
+    ),
+    (
+        {"performance": {"outputs": ["integral(e1) + 1"]}},
+        ExpressionError,
+        r"performance.outputs\[1\].*not linear in the efforts: it has the term 1",
+    ),
+    (
+        {"performance": {"outputs": ["z*e1(1)"]}},
+        ExpressionError,
+        r"performance.outputs\[1\].*z is not allowed",
+    ),
+    (
+        {"performance": {"outputs": ["w(2)"]}},
+        ExpressionError,
+        r"performance.outputs\[1\]: w\(2\) is outside the interval \[0, 1\]",
+    ),
+    (
+        {"performance": {"outputs": ["integral(e3)"]}},
+        ExpressionError,
+        r"e3 in integral\(e3\) is out of range; expected components 1..2",
+    ),
+    (
+        {"performance": {"outputs": ["w(1)", "w(1)"]}},
+        ModelError,
+        r"performance outputs: w\(1\) given twice",
+    ),
 ]

@@ -174,7 +174,8 @@ def parse_matrix(
 ) -> sympy.ImmutableMatrix:
     """Read a matrix of numbers or expression strings (rows of a list) exactly.
 
-    It must be square unless ``square`` is false (a boundary system's input matrices).
+    It must be square unless ``square`` is false (a boundary system's input matrices,
+    the disturbances' ``B``, n x q).
     """
     if isinstance(value, sympy.MatrixBase):
         rows = value.tolist()
@@ -185,7 +186,10 @@ def parse_matrix(
     elif hasattr(value, "tolist"):  # numpy arrays, without importing numpy here
         rows = value.tolist()
     else:
-        raise ModelError(f"{name} must be a matrix given as a list of rows; found {value!r}")
+        raise ModelError(
+            f"{name} must be a {'square ' if square else ''}matrix given as a list of rows; "
+            f"found {value!r}"
+        )
     if not rows or not all(isinstance(r, list) for r in rows):
         raise ModelError(f"{name} must be a non-empty list of rows; found {value!r}")
     width = len(rows[0])

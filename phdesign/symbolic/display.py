@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 import sympy
 
 from phdesign.core.text import REPR_LIMIT, html_table, number_text, shorten
+from phdesign.symbolic.disturbances import disturbance_lines
 from phdesign.symbolic.feedback import external_numbering
 from phdesign.symbolic.printing import format_expression
 
@@ -101,6 +102,7 @@ def model_text(model: BCPHS) -> str:
     if model.feedback is not None:  # what --sensors, --u and the exports index
         lines.append(external_numbering(len(model.inputs), model.feedback))
     lines += boundary_text(model)
+    lines += disturbance_lines(model)
     lines += [f"check: {c}" for c in model.checks]
     return "\n".join(lines)
 

@@ -47,9 +47,11 @@ from phdesign.symbolic.definition import (
     parse_ports,
     parse_units,
 )
+from phdesign.symbolic.disturbances import Disturbances, disturbances_from_mapping
 from phdesign.symbolic.expressions import Z, exact_number, parameter_symbol
 from phdesign.symbolic.feedback import Feedback, external_indices, feedback_from_mapping
 from phdesign.symbolic.fields import Field
+from phdesign.symbolic.performance import PerformanceOutput, parse_performance
 from phdesign.symbolic.ports import Ports, derive_ports
 from phdesign.symbolic.system import PortedSystem
 from phdesign.symbolic.validation import validate
@@ -159,6 +161,12 @@ class BCPHS(PortedSystem):
         power-preserving interconnection (``[[boundary_systems]]``,
         :mod:`phdesign.symbolic.boundary_systems`); their external inputs follow the
         PDE's in :attr:`n_ports`.
+    disturbances : Disturbances or None
+        :math:`B(z) w` in the domain and the unknown external inputs
+        (:mod:`phdesign.symbolic.disturbances`); the energy identity gains
+        :math:`\int_a^b e^\top B w\, dz`.
+    performance : tuple of PerformanceOutput
+        The outputs a design is judged on (``[performance]``).
     checks : tuple of str
         How each condition was verified (exactly, or at the defaults on a grid).
     """
@@ -180,6 +188,8 @@ class BCPHS(PortedSystem):
     derived_outputs: bool = False
     fields: tuple[tuple[str, Field], ...] = ()
     boundary_systems: tuple[BoundarySystem, ...] = ()
+    disturbances: Disturbances | None = None
+    performance: tuple[PerformanceOutput, ...] = ()
     checks: tuple[str, ...] = field(default=(), compare=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -220,6 +230,8 @@ class BCPHS(PortedSystem):
         units: Mapping[str, str] | None = None,
         fields: Mapping[str, Field] | None = None,
         boundary_systems: Sequence[BoundarySystem | Mapping[str, Any]] | None = None,
+        disturbances: Disturbances | Mapping[str, Any] | Any = None,
+        performance: Sequence[str | PerformanceOutput] | None = None,
     ) -> BCPHS:
         r"""Build a model from numbers, strings and nested lists.
 
@@ -262,6 +274,11 @@ class BCPHS(PortedSystem):
             Boundary systems joined to some inputs (keys ``name``, ``ports``, ``J``,
             ``R``, ``Q``, ``G`` and optionally ``D``, ``B``, ``states``, ``inputs``,
             ``interconnection``: :mod:`phdesign.symbolic.boundary_systems`).
+        disturbances : Disturbances, {"B": [[...]], "unknown": [j]} or B, optional
+            :math:`B(z)`, ``n x q``, and the external inputs (1-based) the observer does
+            not know (:mod:`phdesign.symbolic.disturbances`).
+        performance : sequence of str, optional
+            Outputs such as ``"integral(e1)"``, ``"e1(1)"``, ``"w(1)"``.
         """
         if not isinstance(order, int) or isinstance(order, bool) or order < 1:
             raise ModelError(f"order must be an integer N >= 1; found {order!r}")
@@ -289,6 +306,17 @@ class BCPHS(PortedSystem):
             derived_outputs=derived,
             fields=_named_fields(fields),
             boundary_systems=boundary_systems_from_value(boundary_systems, names),
+            disturbances=None
+            if disturbances is None
+            else disturbances_from_mapping(disturbances, size, names),
+            performance=parse_performance(
+                performance,
+                endpoints,
+                order,
+                size,
+                names,
+                (("w",) if displacement is not None else ()) + tuple(fields or ()),
+            ),
         )
 
     # ------------------------------------------------------------------ views

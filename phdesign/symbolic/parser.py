@@ -18,7 +18,7 @@ Grammar (``**`` and ``^`` are both powers)::
     term  := unary (("*" | "/") unary)*
     unary := ("+" | "-") unary | power
     power := atom (("**" | "^") unary)?
-    atom  := NUMBER | TRACE | NAME | NAME "(" expr ")" | "(" expr ")"
+    atom  := NUMBER | TRACE | NAME | NAME "(" expr ")" | CALL | "(" expr ")"
 
 Examples
 --------
@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import sympy
@@ -132,6 +132,7 @@ class _Context:
     text: str
     resolve_name: Callable[[str, str], sympy.Expr]
     trace_factory: Callable[[Token], sympy.Expr] | None
+    calls: Mapping[str, Callable[[str], sympy.Expr]]
 
 
 class _Parser:
@@ -283,8 +284,23 @@ class _Parser:
             f"at position {token.position}"
         )
 
+    def call(self, name: str) -> sympy.Expr:
+        self.expect("(")  # the text between the parentheses goes to the caller's reader
+        start, depth = self.index, 1
+        while self.index < len(self.tokens) and depth:
+            text = self.tokens[self.index].text if self.tokens[self.index].kind == "op" else ""
+            depth += (text == "(") - (text == ")")
+            self.index += 1
+        if depth or self.index - 1 == start:  # not closed, or empty
+            raise ExpressionError(f"cannot read {self.context.text!r}: {name}(...) expected")
+        first, closing = self.tokens[start], self.tokens[self.index - 1]
+        return self.context.calls[name](self.context.text[first.position : closing.position])
+
     def name(self, token: Token) -> sympy.Expr:
         name = token.text
+        following = self.peek()
+        if name in self.context.calls and following is not None and following.text == "(":
+            return self.call(name)
         if name in FUNCTIONS:
             self.expect("(")
             argument = self.expr()
@@ -464,6 +480,7 @@ def parse(
     text: str,
     resolve_name: Callable[[str, str], sympy.Expr],
     trace_factory: Callable[[Token], sympy.Expr] | None = None,
+    calls: Mapping[str, Callable[[str], sympy.Expr]] | None = None,
 ) -> sympy.Expr:
     """Parse ``text`` by the grammar of the module docstring.
 
@@ -476,5 +493,8 @@ def parse(
         :class:`ExpressionError`; functions and constants are resolved here.
     trace_factory : callable, optional
         Turns a trace token into a symbol; without it, traces are refused.
+    calls : mapping {name: reader}, optional
+        A CALL ``name(...)`` (``integral(e1)``): ``reader(text between the parentheses)``
+        returns the symbol that stands for it.
     """
-    return _Parser(_Context(text, resolve_name, trace_factory)).parse()
+    return _Parser(_Context(text, resolve_name, trace_factory, calls or {})).parse()

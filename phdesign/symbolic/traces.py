@@ -23,7 +23,7 @@ Examples
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Literal
@@ -40,6 +40,7 @@ __all__ = [
     "linear_coefficients",
     "parse_trace_expression",
     "trace_of",
+    "trace_reader",
     "trace_symbol",
 ]
 
@@ -171,6 +172,24 @@ def parse_trace_expression(
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ExpressionError(f"{name} must be a positive integer; found {value!r}")
 
+    try:
+        expr = parse(text, name_resolver(parameters, False), trace_reader((a, b), order, size))
+    except ExpressionError as error:
+        raise ExpressionError(f"{what} {text!r}: {error}") from None
+    linear_coefficients(expr, what=f"{what} {text!r}")
+    return expr
+
+
+def trace_reader(
+    interval: tuple[sympy.Expr, sympy.Expr], order: int, size: int
+) -> Callable[[Token], sympy.Expr]:
+    """Return the parser's trace factory: a trace token as its symbol, checked.
+
+    The component must lie in 1..``size``, the derivative below ``order`` and the point
+    at an endpoint of ``interval`` (exact endpoints).
+    """
+    a, b = interval
+
     def make_trace(token: Token) -> sympy.Expr:
         component_text, primes, point = token.groups
         component, derivative = int(str(component_text)), len(str(primes))
@@ -186,12 +205,7 @@ def parse_trace_expression(
             )
         return trace_symbol(component, derivative, _side_of(str(point), a, b, token.text))
 
-    try:
-        expr = parse(text, name_resolver(parameters, False), make_trace)
-    except ExpressionError as error:
-        raise ExpressionError(f"{what} {text!r}: {error}") from None
-    linear_coefficients(expr, what=f"{what} {text!r}")
-    return expr
+    return make_trace
 
 
 _POINT_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?:/\d+)?\Z")

@@ -28,6 +28,7 @@ from phdesign.core.limits import check_model_dimensions, check_parameter_count
 from phdesign.symbolic.closing import closed_ports
 from phdesign.symbolic.conjugate import conjugate_outputs
 from phdesign.symbolic.definiteness import check_definite
+from phdesign.symbolic.disturbances import check_disturbances
 from phdesign.symbolic.expressions import Z, canonical, vanishes
 from phdesign.symbolic.feedback import check_feedback_indices
 from phdesign.symbolic.fields import check_fields
@@ -58,6 +59,7 @@ def validate(model: BCPHS) -> list[str]:
     checks += _check_all_ports(model, symbols, defaults)
     if model.feedback is not None:
         checks += check_feedback(model, symbols, defaults)
+    checks += check_disturbances(model)
     return checks
 
 
