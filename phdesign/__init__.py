@@ -62,6 +62,7 @@ _EXPORTS: dict[str, str] = {
     "tune": "phdesign.numeric.tuning.search",
     "TuneResult": "phdesign.numeric.tuning.search",
     "NoiseReport": "phdesign.numeric.noise.report",
+    "GainReport": "phdesign.numeric.noise.disturbance_report",
     "Tradeoff": "phdesign.numeric.noise.tradeoff",
     "SampledObserver": "phdesign.numeric.sampled.export",
     "Certificate": "phdesign.numeric.certified.certificate",
@@ -76,6 +77,7 @@ __all__ = [
     "Classification",
     "CoupledClassification",
     "Displacement",
+    "GainReport",
     "Loop",
     "NoiseReport",
     "Observer",
@@ -121,6 +123,7 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
     from phdesign.numeric.bridge import to_numeric
     from phdesign.numeric.certified.certificate import Certificate
     from phdesign.numeric.discretization.registry import discretize
+    from phdesign.numeric.noise.disturbance_report import GainReport
     from phdesign.numeric.noise.report import NoiseReport
     from phdesign.numeric.noise.tradeoff import Tradeoff
     from phdesign.numeric.sampled.export import SampledObserver

@@ -47,6 +47,7 @@ COMMAND_MODULES = {
     "tune": "phdesign.cli.numeric_commands",
     "noise": "phdesign.cli.noise_commands",
     "tradeoff": "phdesign.cli.noise_commands",
+    "gain": "phdesign.cli.gain_command",
     "export": "phdesign.cli.export_command",
     "certify": "phdesign.cli.certify_command",
     "check": "phdesign.cli.certify_command",

@@ -157,7 +157,7 @@ def _numbers(text: str, flag: str) -> list[float]:
     return values
 
 
-def _intensities(text: str | None, flag: str) -> list[float] | None:
+def intensities(text: str | None, flag: str) -> list[float] | None:
     """Return the numbers of a noise intensity option (the design checks count and signs)."""
     return None if text is None else _numbers(text, flag)
 
@@ -198,8 +198,8 @@ def _observer(args: argparse.Namespace, command: str) -> Any:
 def _noise_inputs(args: argparse.Namespace) -> dict[str, Any]:
     """Return the noise options as the design's arguments (intensities, performance)."""
     return {
-        "intensity": _intensities(args.intensity, "--intensity"),
-        "input_intensity": _intensities(args.input_noise, "--input-noise"),
+        "intensity": intensities(args.intensity, "--intensity"),
+        "input_intensity": intensities(args.input_noise, "--input-noise"),
         "performance": _performance(args),
     }
 
@@ -317,13 +317,13 @@ def noise_options(args: argparse.Namespace) -> dict[str, Any]:
     if args.noise_intensity is not None and sensors is None:
         raise ObserverError("--noise-intensity needs an observer: give --sensors or --cm")
     return {
-        "noise_intensity": _listed_intensities(args.noise_intensity, "--noise-intensity"),
-        "input_intensity": _listed_intensities(args.input_noise, "--input-noise"),
+        "noise_intensity": _listedintensities(args.noise_intensity, "--noise-intensity"),
+        "input_intensity": _listedintensities(args.input_noise, "--input-noise"),
         "seed": args.seed,
     }
 
 
-def _listed_intensities(text: str | None, flag: str) -> list[float] | None:
+def _listedintensities(text: str | None, flag: str) -> list[float] | None:
     """Return the numbers of an intensity option (the simulation options check them)."""
     return None if text is None else _numbers(text, flag)
 

@@ -32,6 +32,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     import numpy as np
     import sympy
 
+    from phdesign.numeric.noise.disturbance_report import GainReport
     from phdesign.numeric.noise.metrics import Metric
     from phdesign.numeric.noise.report import NoiseReport
     from phdesign.numeric.noise.tradeoff import Tradeoff
@@ -128,6 +129,39 @@ class ObserverNoise:
             max_resolution=max_resolution,
             tol=tol,
             metrics=metrics,
+        )
+
+    @reports_progress
+    def gain(
+        self,
+        *,
+        intensity: float | Sequence[float] | None = None,
+        performance: str | Sequence[str] | None = None,
+        max_resolution: int | None = None,
+        tol: float | None = None,
+        optimal: bool = False,
+        progress: Progress | None = None,
+    ) -> GainReport:
+        r"""Return the H∞ and H₂ norms from the disturbances and sensor noise to the error.
+
+        The observer knows u but not the disturbances (the model's ``[disturbances]``
+        :math:`B(z) w` and unknown inputs) nor the sensor noise ν of ``intensity``
+        (default 1; 0 leaves it out); the report gives the norms from all of them to the
+        estimation error of the ``[performance]`` outputs, split per source, each
+        converged or flagged (:meth:`phdesign.design.plant.Plant.gain`).  With
+        ``optimal``, the optimal full-order estimators of the same plant, disturbances
+        and noise are printed beside: the Kalman–Bucy H₂ error and the H∞-optimal level
+        γ* (:mod:`phdesign.numeric.noise.optimal`), the price of a boundary observer.
+        """
+        C, L = self.numeric_gain("gain")
+        return self.plant.gain(
+            C,
+            L,
+            intensity=intensity,
+            performance=[performance] if isinstance(performance, str) else performance,
+            max_resolution=max_resolution,
+            tol=tol,
+            optimal=optimal,
         )
 
     @reports_progress

@@ -19,6 +19,7 @@ naming the item.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
@@ -33,7 +34,16 @@ from phdesign.numeric.bridge import (
     trace_index,
 )
 
-__all__ = ["initial_state_function", "input_function", "input_samples", "trace_row"]
+__all__ = [
+    "Profile",
+    "disturbance_inputs",
+    "initial_state_function",
+    "input_function",
+    "input_samples",
+    "performance_terms",
+    "trace_expression_row",
+    "trace_row",
+]
 
 
 def _evaluate_at(expr: Any, variable: Any, t: float) -> Any:
@@ -78,15 +88,118 @@ def trace_row(text: str, nm: NumericModel, model: Any = None) -> np.ndarray:
     expr = traces.parse_trace_expression(
         text, interval, nm.order, nm.size, parameters=[str(s) for s in values]
     )
+    return trace_expression_row(expr, values, nm, f"trace expression {text!r}")
+
+
+def trace_expression_row(
+    expr: Any, values: Mapping[Any, Any], nm: NumericModel, what: str
+) -> np.ndarray:
+    """Return the row over ``v`` of a linear trace expression, its parameters substituted."""
+    from phdesign.symbolic import traces
+
     row = np.zeros(2 * nm.order * nm.size)  # the trace vector of the open plant
     for trace, coefficient in traces.linear_coefficients(expr).items():
         value = coefficient.subs(values)
         if value.free_symbols:
-            message = _free_symbols_message(f"trace expression {text!r}", value.free_symbols)
-            raise ParameterError(message)
+            raise ParameterError(_free_symbols_message(what, value.free_symbols))
         index = trace_index(trace.component, trace.derivative, trace.side, nm.order, nm.size)
         row[index] = float(value)
     return row
+
+
+def _substituted(model: Any, expr: Any, what: str) -> Any:
+    """``expr`` with the model's parameter values in: only z may stay free."""
+    from phdesign.symbolic.expressions import Z
+
+    value = expr.xreplace(_parameter_values(model, None))
+    if value.free_symbols - {Z}:
+        raise ParameterError(_free_symbols_message(what, value.free_symbols - {Z}))
+    return value
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A function of z read from exact entries: ``profile(z) -> (m, *shape)``.
+
+    ``key`` is the exact substituted entries (hashable): two profiles with equal keys are
+    the same function, so work built from one (a discretization's input matrix) serves
+    the other.
+    """
+
+    key: tuple[Any, ...]
+    shape: tuple[int, ...]
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        """Evaluate at the points ``z`` (the safe evaluator: no code generation)."""
+        from phdesign.symbolic.evaluation import evaluate
+
+        zz = np.atleast_1d(np.asarray(z, dtype=float))
+        vals = [np.broadcast_to(evaluate(e, zz), zz.shape) for e in self.key]
+        return np.stack(vals, axis=-1).reshape(zz.size, *self.shape)
+
+
+def _profile(model: Any, entries: list[Any], shape: tuple[int, ...], what: str) -> Profile:
+    """Return the entries, in z and with the parameters' values, as a :class:`Profile`."""
+    return Profile(tuple(_substituted(model, e, what) for e in entries), shape)
+
+
+def disturbance_inputs(model: Any, nm: NumericModel) -> tuple[Any, tuple[int, ...]]:
+    r"""Return :math:`B(z)` as ``f(z) -> (m, n, q)`` (None without one) and the unknown inputs.
+
+    The unknown inputs are 0-based indices into the external inputs (after the model's
+    ``[feedback]``), as the discretizations number their columns of B.
+    """
+    from phdesign.symbolic.feedback import external_indices
+
+    dist = getattr(model, "disturbances", None)
+    if dist is None:
+        return None, ()
+    kept = external_indices(len(model.inputs), model.feedback)
+    unknown = tuple(kept.index(j - 1) for j in dist.unknown)
+    if not dist.q:
+        return None, unknown
+    entries = [x for row in dist.B.tolist() for x in row]
+    return _profile(model, entries, (nm.size, dist.q), "disturbances B"), unknown
+
+
+def performance_terms(model: Any, nm: NumericModel, outputs: Any = None) -> list[Any]:
+    r"""Return each performance output as ``(name, weight, trace, points)`` with numbers.
+
+    ``weight(z) -> (m, n)`` weighs the states, :math:`\int (H c + d)^	op x\, dz` for
+    :math:`\int c^	op e + d^	op x` (None without an integral); ``trace`` is the row over
+    ``v`` (None without traces); ``points`` are ``(field, point, coefficient)`` floats.
+    ``outputs`` are text in the ``[performance]`` grammar (default: the model's outputs).
+    """
+    import sympy
+
+    from phdesign.symbolic.performance import parse_performance
+
+    items = model.performance
+    if outputs is not None:
+        fields = (("w",) if model.displacement is not None else ()) + tuple(
+            name for name, _ in model.fields
+        )
+        texts = [outputs] if isinstance(outputs, str) else outputs
+        items = parse_performance(
+            texts, model.interval, model.order, model.size, model.parameter_names, fields
+        )
+    out = []
+    H = model.H
+    for item in items:
+        what = f"performance output {item.text!r}"
+        weight = None
+        if item.has_integral:
+            c = H * sympy.Matrix(item.effort_weights) + sympy.Matrix(item.state_weights)
+            weight = _profile(model, list(c), (nm.size,), what)
+        trace = None
+        if item.traces != 0:
+            trace = trace_expression_row(item.traces, _parameter_values(model, None), nm, what)
+        points = tuple(
+            (field, float(point), float(_substituted(model, c, what)))
+            for field, point, c in item.points
+        )
+        out.append((item.text, weight, trace, points))
+    return out
 
 
 def initial_state_function(

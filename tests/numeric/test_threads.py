@@ -46,6 +46,15 @@ def wave_observer(resolution: int | None = 8) -> phd.Observer:
     return phd.Observer(phd.load("wave"), sensors=[2], gain=0.5, resolution=resolution)
 
 
+def tip_force_observer() -> phd.Observer:
+    """The string observed through its tip velocity, pushed by an unknown tip force."""
+    from phdesign.io import model_from_dict, model_to_dict
+
+    data = model_to_dict(phd.load("wave"))
+    data["ports"]["unknown"] = [2]
+    return phd.Observer(model_from_dict(data), sensors=[2], gain=0.5)
+
+
 def beam_loop() -> phd.Loop:
     beam = phd.Observer(phd.load("euler-bernoulli"), sensors=[3, 4], gain=[0.1, 1])
     return phd.Loop(beam, actuate=3)
@@ -74,6 +83,7 @@ ENTRY_POINTS = {
     ),
     "tune": lambda: wave_observer().tune(starts=1),
     "noise": lambda: wave_observer(None).noise(),
+    "gain": lambda: tip_force_observer().gain(performance="integral(e1)", intensity=0.1),
     "tradeoff": lambda: wave_observer(None).tradeoff(scales=[1.0], performance="x2: 1"),
     "export": lambda: wave_observer().export(dt=0.01, order=6),
     "export verified": lambda: wave_observer().export(dt=0.01, order=6, verify=True, t_end=0.5),

@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -45,10 +45,12 @@ __all__ = [
     "Functional",
     "default_performance",
     "displacement_at",
+    "disturbance_matrix",
     "field_names",
     "integral_functional",
     "parse_functional",
     "parse_functionals",
+    "performance_functional",
     "trace_functional",
 ]
 
@@ -67,7 +69,7 @@ class Functional:
     ----------
     name : str
         How reports name it: ``"w(1)"``, ``"e1(1)"``, ``"int(x2: sin(pi*z))"``.
-    kind : {"displacement", "trace", "integral"}
+    kind : {"displacement", "trace", "integral", "sum"}
     point : float or None
         The point of a displacement or named field.
     field_name : str
@@ -76,6 +78,8 @@ class Functional:
         The row over the trace vector v of a trace combination.
     weight : callable or None
         ``weight(z) -> (m, n)`` of an integral (weights on the state components).
+    parts : tuple of (Functional, float)
+        The terms of a sum (a ``[performance]`` output such as ``integral(e1) + e1(1)``).
     """
 
     name: str
@@ -86,6 +90,7 @@ class Functional:
     weight: Callable[[np.ndarray], np.ndarray] | None = field(
         default=None, compare=False, repr=False
     )
+    parts: tuple[tuple[Functional, float], ...] = field(default=(), compare=False, repr=False)
 
     def row(self, d: DiscretePHS) -> np.ndarray:
         """Return ``c`` with the functional equal to ``c @ ê`` on the discretization ``d``.
@@ -108,6 +113,8 @@ class Functional:
             return np.asarray(self.trace @ T, dtype=float)
         if self.kind == "integral" and self.weight is not None:
             return _integral_row(d, self.weight)
+        if self.kind == "sum":
+            return np.asarray(sum(c * f.row(d) for f, c in self.parts))
         raise NumericError(f"unknown kind of functional {self.kind!r}")  # pragma: no cover
 
 
@@ -241,17 +248,65 @@ def default_performance(nm: NumericModel) -> tuple[Functional, ...]:
     return (displacement_at(nm, "b"),)
 
 
+def performance_functional(
+    nm: NumericModel,
+    name: str,
+    weight: Callable[[np.ndarray], np.ndarray] | None,
+    trace: np.ndarray | None,
+    points: Sequence[tuple[str, float, float]],
+) -> Functional:
+    r"""Return a ``[performance]`` output: its integral, traces and fields at points, summed.
+
+    The pieces are those of :func:`phdesign.numeric.inputs.performance_terms`; one piece
+    with coefficient 1 is that functional itself, renamed.
+    """
+    parts: list[tuple[Functional, float]] = []
+    if weight is not None:
+        parts.append((Functional(name, "integral", weight=weight), 1.0))
+    if trace is not None:
+        parts.append((Functional(name, "trace", trace=trace), 1.0))
+    parts += [(displacement_at(nm, point, field), c) for field, point, c in points]
+    if len(parts) == 1 and parts[0][1] == 1.0:
+        return replace(parts[0][0], name=name)
+    return Functional(name, "sum", parts=tuple(parts))
+
+
+def disturbance_matrix(d: DiscretePHS, B: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    r"""Return :math:`B_d = \int_a^b \Psi(z)^\top B(z)\, dz`, ``(dim, q)``, by Gauss.
+
+    Testing :math:`\partial_t x = \dots + B w` with the effort basis (the Galerkin weak
+    form, :math:`E = \int \Psi^\top \mathcal H^{-1} \Psi`) gives
+    :math:`E \dot{\hat e} = \dots + B_d w`, and :math:`\hat e^\top B_d w = \int e_h^\top
+    B w\, dz` is the supplied power of the discrete energy balance.  A ``B`` with a
+    hashable ``key`` (a :class:`~phdesign.numeric.inputs.Profile`) is integrated once per
+    discretization and shared (read-only).
+    """
+
+    def build() -> np.ndarray:
+        z, wq = _gauss(d)
+        values = np.asarray(B(z), dtype=float)  # (nq, n, q)
+        out = np.asarray(np.einsum("q,qid,qij->dj", wq, d.effort_basis(z), values))
+        out.flags.writeable = False
+        return out
+
+    key = getattr(B, "key", None)
+    return np.asarray(build() if key is None else _ROWS.get(d, ("disturbance", key), build))
+
+
+def _gauss(d: DiscretePHS) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on the model's interval, enough for the basis."""
+    a, b = d.model.interval
+    t, wq = leg.leggauss(max(64, 2 * d.dim))
+    return 0.5 * (a + b) + 0.5 * (b - a) * t, 0.5 * (b - a) * wq
+
+
 def _integral_row(d: DiscretePHS, weight: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
     r"""Row of :math:`\int \sum_i w_i x_i \, dz` with :math:`x = \mathcal H^{-1} e`, by Gauss.
 
     The rule has enough points to be exact for a polynomial weight against the Galerkin
     efforts (degree p) when H is constant; for a smooth weight it converges spectrally.
     """
-    a, b = d.model.interval
-    nq = max(64, 2 * d.dim)
-    t, wq = leg.leggauss(nq)
-    z = 0.5 * (a + b) + 0.5 * (b - a) * t
-    wq = 0.5 * (b - a) * wq
+    z, wq = _gauss(d)
     W = np.asarray(weight(z), dtype=float).reshape(z.size, d.model.size)
     Hinv_W = np.linalg.solve(d.model.H_at(z), W[:, :, None])[:, :, 0]  # H symmetric
     basis = d.effort_basis(z)  # (nq, n, dim)

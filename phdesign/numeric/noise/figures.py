@@ -61,7 +61,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import MutableMapping, Sequence
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -75,7 +74,7 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_noise_intensity
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
-from phdesign.numeric.noise.gain import PeakSearch, gain_pair
+from phdesign.numeric.noise.gain import PeakSearch, banded_gain, gain_pair
 from phdesign.numeric.noise.metrics import ErrorEnergy, Metric, OutputVariance
 from phdesign.numeric.noise.report import GainEstimate, NoiseReport
 from phdesign.numeric.noise.settle import Estimate, settle
@@ -89,6 +88,7 @@ __all__ = [
     "check_intensity",
     "noise",
     "noise_intensities",
+    "refinement_plan",
     "sensor_rows",
 ]
 
@@ -146,6 +146,36 @@ def sensor_rows(C_m: Any, what: str) -> np.ndarray:
     if C.size == 0:
         raise ObserverError(f"{what}: sensors needed; give C_m with at least one row")
     return C
+
+
+def refinement_plan(
+    nm: NumericModel,
+    method: str,
+    resolution: int | None,
+    max_resolution: int | None,
+    tol: float | None,
+) -> tuple[int, int, float, float]:
+    """Return the first and largest resolution and the tolerances of a noise refinement.
+
+    ``(p, pmax, tol, rtol)``: the spectrum's resolutions within the noise budget, the
+    method's noise tolerance (unless ``tol``) and its drift tolerance.
+    """
+    row = current().discretization(method, nm.order)  # the noise's and spectrum's tolerances
+    tol = row.noise_tol if tol is None else positive_number(tol, "tol")
+    p0, pmax = default_resolutions(nm, method)
+    p = p0 if resolution is None else positive_int(resolution, "resolution")
+    limits.check_noise_resolution(nm, p, "resolution")
+    if max_resolution is None:
+        # the default refinement stops within the budget (a size-16 model: degree 61)
+        pmax = max(p, min(pmax, limits.MAX_NOISE_STATES // nm.size - 1))
+    else:
+        pmax = positive_int(max_resolution, "max_resolution")
+        limits.check_noise_resolution(nm, pmax, "max_resolution")
+        if pmax < p:
+            raise NumericError(
+                f"max_resolution must be at least the first resolution {p}; found {pmax}"
+            )
+    return p, pmax, tol, row.resolved_rtol
 
 
 @limited_threads
@@ -221,22 +251,7 @@ def noise(
     sigma, w_in = noise_intensities(nm, C.shape[0], intensity, input_intensity)
     functionals = parse_functionals(performance, nm, model)
     method = method_or_default(method)
-    row = current().discretization(method, nm.order)  # the noise's and spectrum's tolerances
-    tol = row.noise_tol if tol is None else positive_number(tol, "tol")
-    rtol = row.resolved_rtol
-    p0, pmax = default_resolutions(nm, method)
-    p = p0 if resolution is None else positive_int(resolution, "resolution")
-    limits.check_noise_resolution(nm, p, "resolution")
-    if max_resolution is None:
-        # the default refinement stops within the budget (a size-16 model: degree 61)
-        pmax = max(p, min(pmax, limits.MAX_NOISE_STATES // nm.size - 1))
-    else:
-        pmax = positive_int(max_resolution, "max_resolution")
-        limits.check_noise_resolution(nm, pmax, "max_resolution")
-        if pmax < p:
-            raise NumericError(
-                f"max_resolution must be at least the first resolution {p}; found {pmax}"
-            )
+    p, pmax, tol, rtol = refinement_plan(nm, method, resolution, max_resolution, tol)
     cache = discretizations if discretizations is not None else {}
 
     run = _Refinement(functionals, tuple(metrics), tol, discrete=discrete_sup)
@@ -309,35 +324,7 @@ class _Refinement:
         return self.estimates()[len(self.outputs)]
 
     def gain(self) -> GainEstimate:
-        res = self.resolutions
-        if not self.steady:
-            return GainEstimate.missing(res)
-        discrete, discrete_frequency = None, None
-        if self.sups:
-            discrete = settle("discrete sup", [v for v, _ in self.sups], res, self.tol)
-            discrete_frequency = self.sups[-1][1]
-        banded = [pr for pr in self.pairs if pr.get("band") is not None]
-        if not banded:
-            return GainEstimate.missing(res, discrete, discrete_frequency)
-        last = banded[-1]
-        estimate = settle(
-            "gamma",
-            [pr["fine"][0] for pr in banded],
-            [pr["resolution"] for pr in banded],
-            self.tol,
-            pair=(last["coarse"][0], last["fine"][0]),
-        )
-        if last["fine"][1] >= (1 - 1e-6) * last["band"] and estimate.converged:
-            # a peak at the band's edge is where the resolved frequencies end, not a maximum
-            estimate = replace(estimate, converged=False)
-        return GainEstimate(
-            estimate=estimate,
-            frequency=last["fine"][1],
-            frequencies=tuple(pr["fine"][1] for pr in banded),
-            band=last["band"],
-            discrete=discrete,
-            discrete_frequency=discrete_frequency,
-        )
+        return banded_gain(self.pairs, self.sups, self.resolutions, self.steady, self.tol)
 
     def done(self) -> bool:
         """Every figure converged or diverging (three resolutions at least), or no steady state."""

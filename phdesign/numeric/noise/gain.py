@@ -21,16 +21,26 @@ resolution belongs to share them (their grids share the resonances).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from phdesign.numeric.noise.report import GainEstimate
+from phdesign.numeric.noise.settle import settle
 from phdesign.numeric.noise.statistics import ErrorStatistics
 from phdesign.numeric.spectrum.drift import match_resolved
 
-__all__ = ["PeakSearch", "discrete_sup", "frequency_grid", "gain_pair", "peak_gain"]
+__all__ = [
+    "PeakSearch",
+    "banded_gain",
+    "discrete_sup",
+    "frequency_grid",
+    "gain_pair",
+    "peak_gain",
+]
 
 #: Grid maxima this far (relative) below the largest peak are not refined as its ties.
 _TIE_SCREEN = 1e-2
@@ -176,9 +186,12 @@ class PeakSearch:
             self._work = np.empty_like(self.stats.pencil.T)
         return self.stats.pencil.response_at(omega, self._work)
 
-    def banded(self, upper: float, ties: float) -> tuple[float, float]:
-        """Return the peak over ``|ω| <= upper``, from the resonances (no sweep)."""
-        return self._peak(upper, ties=ties, sweep=False)
+    def banded(self, upper: float, ties: float, refine: int = 3) -> tuple[float, float]:
+        """Return the peak over ``|ω| <= upper``, from the resonances (no sweep).
+
+        ``refine`` grid maxima are refined (the highest first).
+        """
+        return self._peak(upper, refine=refine, ties=ties, sweep=False)
 
     def discrete(self) -> tuple[float, float]:
         """Return the supremum over all frequencies: a sweep up to twice the top eigenvalue."""
@@ -211,6 +224,7 @@ def gain_pair(
     fine: ErrorStatistics | PeakSearch,
     rtol: float,
     tol: float,
+    refine: int = 3,
 ) -> dict[str, Any]:
     r"""Return the fine member's peak over the pair's resolved band, and its check.
 
@@ -223,7 +237,8 @@ def gain_pair(
     resonances just above).  Peaks within ``tol`` of the largest count as equal and the
     lowest-frequency one is taken (:func:`peak_gain`): the figure cannot tell them apart,
     and the first is the one both members resolve best.  Give each member's
-    :class:`PeakSearch` to share its refined peaks with its other pair.
+    :class:`PeakSearch` to share its refined peaks with its other pair; ``refine``
+    local maxima are refined in each band.
     """
     low = coarse if isinstance(coarse, PeakSearch) else PeakSearch(coarse)
     high = fine if isinstance(fine, PeakSearch) else PeakSearch(fine)
@@ -233,11 +248,56 @@ def gain_pair(
     band = _resolved_band(high.stats, low.stats, rtol)
     out["band"] = band
     if band is not None:
-        out["fine"] = high.banded(band, tol)
-        out["coarse"] = low.banded(band * low.stats.resolution / high.stats.resolution, tol)
+        out["fine"] = high.banded(band, tol, refine)
+        trimmed = band * low.stats.resolution / high.stats.resolution
+        out["coarse"] = low.banded(trimmed, tol, refine)
     return out
 
 
 def discrete_sup(stats: ErrorStatistics | PeakSearch) -> tuple[float, float]:
     """Supremum of the discretization's response over all frequencies (a diagnostic)."""
     return (stats if isinstance(stats, PeakSearch) else PeakSearch(stats)).discrete()
+
+
+def banded_gain(
+    pairs: Sequence[dict[str, Any]],
+    sups: Sequence[tuple[float, float]],
+    resolutions: Sequence[int],
+    steady: bool,
+    tol: float,
+    name: str = "gamma",
+) -> GainEstimate:
+    """Judge the banded peaks of every pair (:func:`gain_pair`) under refinement.
+
+    ``sups`` are the discretizations' own suprema ``(gain, frequency)`` per resolution
+    (empty: not computed).  A peak at the band's edge is never converged: it is where the
+    resolved frequencies end, not a maximum.
+    """
+    res = tuple(resolutions)
+    if not steady:
+        return GainEstimate.missing(res)
+    discrete, discrete_frequency = None, None
+    if sups:
+        discrete = settle("discrete sup", [v for v, _ in sups], res, tol)
+        discrete_frequency = sups[-1][1]
+    banded = [pr for pr in pairs if pr.get("band") is not None]
+    if not banded:
+        return GainEstimate.missing(res, discrete, discrete_frequency)
+    last = banded[-1]
+    estimate = settle(
+        name,
+        [pr["fine"][0] for pr in banded],
+        [pr["resolution"] for pr in banded],
+        tol,
+        pair=(last["coarse"][0], last["fine"][0]),
+    )
+    if last["fine"][1] >= (1 - 1e-6) * last["band"] and estimate.converged:
+        estimate = replace(estimate, converged=False)
+    return GainEstimate(
+        estimate=estimate,
+        frequency=last["fine"][1],
+        frequencies=tuple(pr["fine"][1] for pr in banded),
+        band=last["band"],
+        discrete=discrete,
+        discrete_frequency=discrete_frequency,
+    )

@@ -110,6 +110,22 @@ class TriangularPencil:
         P = P.real
         return np.asarray(0.5 * (P + P.T))
 
+    def channel_energies(self) -> np.ndarray | None:
+        r"""Return :math:`\|R (sS - T)^{-1} h_k\|_2^2` for each input channel :math:`h_k`.
+
+        The H₂ norms squared of the single channels, from the observability Gramian
+        :math:`T^* Y + Y T + R^* R = 0` (one triangular Sylvester solve):
+        :math:`h_k^* Y h_k`.  On the whitened path only (``None`` on the QZ path, and
+        without an output map).
+        """
+        if not self.whitened or self.energy_map is None:
+            return None
+        RR = self.energy_map.conj().T @ self.energy_map
+        Y, scale, info = sl.lapack.ztrsyl(self.T, self.T, -RR, trana="C")
+        if info < 0 or scale != 1.0:  # pragma: no cover - LAPACK guard
+            raise NumericError(f"the triangular Lyapunov solve failed (info {info})")
+        return np.asarray(np.maximum(np.einsum("ik,ij,jk->k", self.H.conj(), Y, self.H).real, 0))
+
     def response(self, omega: np.ndarray) -> np.ndarray:
         r"""Largest singular value of the energy-norm frequency response at each ``omega``.
 
@@ -124,7 +140,7 @@ class TriangularPencil:
         Y = _shifted_back_substitution(self.T, None if self.whitened else self.S, self.H, w)
         if self.energy_map is not None:
             Y = self.energy_map @ Y
-        top = _largest_gram_eigenvalues(Y.reshape(n, m, w.size))
+        top = _largest_gram_eigenvalues(Y.reshape(Y.shape[0], m, w.size))
         return np.asarray(np.sqrt(np.maximum(top, 0.0)))
 
     def response_at(self, omega: float, work: np.ndarray | None = None) -> float:
