@@ -38,6 +38,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     g.add_argument(
         "--noise",
         metavar="S2",
+        dest="intensity",
         help="sensor noise intensities sigma_i^2 of an observer, one per sensor or one for "
         "all (default 1; 0 leaves the noise out)",
     )
@@ -81,12 +82,12 @@ def _gain(args: argparse.Namespace) -> int:
         "tol": args.tol,
     }
     if observer is None:
-        if args.noise is not None:
+        if args.intensity is not None:
             raise ObserverError("--noise needs --sensors or --cm: it is the sensors' noise")
         if args.optimal:
             raise ObserverError("--optimal needs --sensors or --cm: it compares estimators")
         report = Plant(model, method=args.method, resolution=args.resolution).gain(**options)
     else:
-        noise = intensities(args.noise, "--noise")
+        noise = intensities(args.intensity, "--noise")
         report = observer.gain(intensity=noise, optimal=args.optimal, **options)
     return emit_result(args, report)

@@ -244,8 +244,8 @@ def disturbance_gain(
     )
     if not outputs:
         raise NumericError(
-            "the disturbance gain needs performance outputs: give performance=[...] or a "
-            "[performance] section in the model"
+            "the disturbance gain needs performance outputs: give `performance` (e.g. "
+            "'integral(e1)') or a [performance] section in the model"
         )
     if B is None and not unknown:
         raise NumericError(
