@@ -107,7 +107,7 @@ def test_notebooks_use_the_public_api(path: Path):
     )
 
 
-def test_there_are_eight_notebooks():
+def test_there_are_nine_notebooks():
     assert [p.stem for p in PATHS] == [
         "01_quickstart",
         "02_euler_bernoulli_paper",
@@ -117,6 +117,7 @@ def test_there_are_eight_notebooks():
         "06_implementation",
         "07_observer_based_control",
         "08_boundary_dynamics",
+        "09_disturbances",
     ]
 
 

@@ -119,11 +119,9 @@ def _substituted(model: Any, expr: Any, what: str) -> Any:
 
 @dataclass(frozen=True)
 class Profile:
-    """A function of z read from exact entries: ``profile(z) -> (m, *shape)``.
+    """``profile(z) -> (m, *shape)`` of exact entries; ``key`` (the entries) is hashable.
 
-    ``key`` is the exact substituted entries (hashable): two profiles with equal keys are
-    the same function, so work built from one (a discretization's input matrix) serves
-    the other.
+    Equal keys are the same function: work built from one (an input matrix) serves both.
     """
 
     key: tuple[Any, ...]
@@ -176,13 +174,10 @@ def performance_terms(model: Any, nm: NumericModel, outputs: Any = None) -> list
 
     items = model.performance
     if outputs is not None:
-        fields = (("w",) if model.displacement is not None else ()) + tuple(
-            name for name, _ in model.fields
-        )
+        fields = ["w"] * (model.displacement is not None) + [n for n, _ in model.fields]
         texts = [outputs] if isinstance(outputs, str) else outputs
-        items = parse_performance(
-            texts, model.interval, model.order, model.size, model.parameter_names, fields
-        )
+        shape = (model.interval, model.order, model.size, model.parameter_names, fields)
+        items = parse_performance(texts, *shape)
     out = []
     H = model.H
     for item in items:
