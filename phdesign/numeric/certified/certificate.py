@@ -210,13 +210,16 @@ def _outward(exact: tuple[Fraction, Fraction]) -> tuple[float, float]:
 
 
 def _rate(system: ExactClosedSystem) -> Any:
+    # the semidefinite program needs cvxpy, which the extra `certify` installs beside flint
     try:
-        from phdesign.numeric.certified.rate import prove_decay_rate
+        import cvxpy  # noqa: F401
     except ImportError:
         raise CertificateError(
-            "the decay-rate proof is not available: phdesign.numeric.certified.rate is not "
-            "part of this installation yet; certify without `rate=True`"
+            "the decay-rate proof needs cvxpy (with Clarabel or SCS): "
+            "pip install 'phdesign[certify]', or certify without `rate=True`"
         ) from None
+    from phdesign.numeric.certified.rate import prove_decay_rate
+
     return prove_decay_rate(system)
 
 
