@@ -22,7 +22,7 @@ Four designs (``design=``), all of the export's form :math:`(A, B, C, D)`:
 Why a design at all: no sampled-data observer of the PDE has a uniform rate above d/2 (the
 period map's essential spectrum lies on :math:`|z| = e^{-d\Delta t/2}`, and a correction
 through a few sampled channels is a finite-rank change), but the floor that matters, the
-error after a few seconds, depends much on the gain (DESIGN.md, "The sampled limit").
+error after a few seconds, depends much on the gain (docs/sampled.rst, "The sampled limit").
 Each candidate carries its noise price (:mod:`phdesign.numeric.sampled.noise_price`).
 """
 

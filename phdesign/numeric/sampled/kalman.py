@@ -35,7 +35,7 @@ working precision or, where it solves, the design 5–100x worse on the fine pla
 predictor here treats them as independent.
 
 Nothing proves this design: its error system is not dissipative in the model's energy,
-and it is fragile across orders (DESIGN.md, "The sampled limit"), so the export verifies
+and it is fragile across orders (docs/sampled.rst, "The sampled limit"), so the export verifies
 it against the fine plant on every initial state of the set before ``design="auto"``
 takes it (:mod:`phdesign.numeric.sampled.gain_design`).
 """

@@ -1,7 +1,7 @@
 r"""The initial states a sampled observer is verified on: the export's x0 and smooth states.
 
 One initial state and one window is no specification: the ratio of a sampled observer's
-error floor to the continuous one's depends on both (DESIGN.md, "The sampled limit"). The
+error floor to the continuous one's depends on both (docs/sampled.rst, "The sampled limit"). The
 default verification set is the export's own initial state followed by
 :func:`boundary_states`: for each state component i, a few polynomial efforts
 
