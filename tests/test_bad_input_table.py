@@ -86,6 +86,21 @@ GRADED = tomli_w.dumps(
     }
 )
 
+#: PIETOOLS' damped-tip string under a uniform force w1, ∫ e1 judged (issue 27)
+DAMPED_TIP = tomli_w.dumps(
+    {
+        "name": "damped-tip wave",
+        "interval": [0, 1],
+        "order": 1,
+        "parameters": {"k": 0.5},
+        "matrices": {"P1": [[0, 1], [1, 0]], "H": [[1, 0], [0, 1]]},
+        "ports": {"inputs": ["e1(0)", "e2(1)"], "outputs": "conjugate"},
+        "feedback": {"inputs": [2], "gain": [["k"]]},
+        "disturbances": {"B": [[1], [0]]},
+        "performance": {"outputs": ["integral(e1)"]},
+    }
+)
+
 BEAM_SENSORS = "classify euler-bernoulli --sensors"
 BEAM_GAIN = "classify euler-bernoulli --sensors 3,4 --gain"
 SIM = "simulate wave --sensors 2"
@@ -1103,6 +1118,35 @@ COMMAND_ROWS = [
     ),
     row("check {tmp}/missing.json", "cannot read the proof file", OutputFileError),
     row("check {tmp}/bad.json", "is not JSON", OutputFileError, **{"bad.json": "{not json"}),
+    # ---- issue 27, the remainder: disturbances in simulate, tune and sweep
+    row(
+        "simulate wave --w w1:1",
+        "--w: model 'wave' has no disturbance channel",
+        ParameterError,
+    ),
+    row(
+        "simulate {tmp}/dtw.toml --w w2:sin(3*t)",
+        "--w: unknown disturbance 'w2'; the model's disturbances are w1",
+        ParameterError,
+        **{"dtw.toml": DAMPED_TIP},
+    ),
+    row(
+        "simulate {tmp}/dtw.toml --disturbance-noise 1,2",
+        "--disturbance-noise: expected 1 values",
+        NumericError,
+        **{"dtw.toml": DAMPED_TIP},
+    ),
+    row(
+        "simulate wave --disturbance-noise 1",
+        "--disturbance-noise: model 'wave' has no disturbance channel",
+        ParameterError,
+    ),
+    row(
+        "simulate {tmp}/dtw.toml --disturbance-noise -1",
+        "--disturbance-noise: intensities must be finite and non-negative",
+        NumericError,
+        **{"dtw.toml": DAMPED_TIP},
+    ),
 ]
 
 

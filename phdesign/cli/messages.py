@@ -35,6 +35,7 @@ ALIASES = {
     "parameters": "param",
     "C_m": "cm",
     "input_intensity": "input_noise",
+    "disturbance_intensity": "disturbance_noise",
     "points": "at",
 }
 

@@ -289,12 +289,19 @@ def add_stochastic_arguments(parser: argparse.ArgumentParser) -> None:
         help="white noise on the plant inputs, of these intensities (one per input or one "
         "for all)",
     )
+    parser.add_argument(
+        "--disturbance-noise",
+        metavar="W",
+        help="white noise on the disturbance channels w1..wq of the model's [disturbances], "
+        "of these intensities (one per channel or one for all); the observer does not know it",
+    )
     parser.add_argument("--seed", type=int, help="seed of the noise (with the noise options)")
 
 
 def noise_options(args: argparse.Namespace) -> dict[str, Any]:
     """Return the simulation options of the noise flags (empty without them), checked here."""
-    noisy = args.noise_intensity is not None or args.input_noise is not None
+    flags = (args.noise_intensity, args.input_noise, args.disturbance_noise)
+    noisy = any(value is not None for value in flags)
     if not noisy:
         if args.seed is not None:
             raise NumericError("--seed needs --noise-intensity or --input-noise")
@@ -319,6 +326,7 @@ def noise_options(args: argparse.Namespace) -> dict[str, Any]:
     return {
         "noise_intensity": _listedintensities(args.noise_intensity, "--noise-intensity"),
         "input_intensity": _listedintensities(args.input_noise, "--input-noise"),
+        "disturbance_intensity": _listedintensities(args.disturbance_noise, "--disturbance-noise"),
         "seed": args.seed,
     }
 

@@ -145,6 +145,12 @@ def _add_simulate(subparsers: argparse._SubParsersAction) -> None:
         "--u", metavar="EXPRS", help="plant inputs in t, e.g. 'u2: sin(2*t)'; default zero"
     )
     sim.add_argument(
+        "--w",
+        metavar="EXPRS",
+        help="disturbances in t on the model's [disturbances] B, which the observer does not "
+        "know, e.g. 'w1: sin(3*t)'; default zero",
+    )
+    sim.add_argument(
         "--tol",
         type=float,
         default=run.tol,
@@ -249,9 +255,9 @@ def _simulate(args: argparse.Namespace) -> int:
     with run_outputs(args) as commit:
         with np.errstate(all="ignore"):  # an overflow is refused below, with one line
             if observer is not None:
-                res = observer.simulate(x0, xhat0=xhat0, u=u, options=options)
+                res = observer.simulate(x0, xhat0=xhat0, u=u, w=args.w, options=options)
             else:
-                res = plant.simulate(x0, u=u, options=options)
+                res = plant.simulate(x0, u=u, w=args.w, options=options)
         check_finite_series(res)
         commit(simulation_text(args, model.name, res), res)
     for warning in (*_notices(args, observer), *res.warnings):
@@ -262,7 +268,10 @@ def _simulate(args: argparse.Namespace) -> int:
 def _notices(args: argparse.Namespace, observer: Any) -> list[str]:
     """Return what a run left to its defaults that the user may not have meant."""
     notices = []
-    driven = any(getattr(args, name, None) for name in ("u", "noise_intensity", "input_noise"))
+    driven = any(
+        getattr(args, name, None)
+        for name in ("u", "w", "noise_intensity", "input_noise", "disturbance_noise")
+    )
     if args.x0 is None and not driven:  # at rest and undriven: every series is zero
         notices.append(
             "no --x0 given: the plant starts at rest (x0 = 0), so without an input every "

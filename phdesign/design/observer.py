@@ -249,6 +249,7 @@ class Observer(ObserverNoise, ObserverExport, ObserverCertify):
         *,
         xhat0: str | Callable[[Any], Any] | None = None,
         u: str | Callable[[float], Any] | None = None,
+        w: str | Callable[[float], Any] | None = None,
         options: SimulationOptions | None = None,
         progress: Progress | None = None,
         **settings: Any,
@@ -264,6 +265,10 @@ class Observer(ObserverNoise, ObserverExport, ObserverCertify):
             ``u`` every series is zero.
         u : str or callable, optional
             Plant inputs: text such as ``"u2: sin(2*t)"`` or a function ``u(t)``.
+        w : str or callable, optional
+            Disturbances on the model's ``[disturbances]`` B, which the observer does not
+            know: text such as ``"w1: sin(3*t)"`` (the grammar of ``u``) or a function
+            ``w(t) -> (q,)``; white disturbances are ``disturbance_intensity=...``.
         options : SimulationOptions, optional
             How to run (:class:`~phdesign.numeric.time.options.SimulationOptions`: the
             grid, the stepping, a sampled observer, noise); the discretization is the plant's.
@@ -283,7 +288,7 @@ class Observer(ObserverNoise, ObserverExport, ObserverCertify):
         """
         C, L = self.numeric_gain("simulate")
         opts = self.plant.simulation_options(options, **settings)
-        return self.plant.run(C, L, x0, xhat0=xhat0, u=u, options=opts, labels=self.labels())
+        return self.plant.run(C, L, x0, xhat0=xhat0, u=u, w=w, options=opts, labels=self.labels())
 
     def abscissas(
         self, gains: Iterable[Any], *, resolution: int | tuple[int, int] | None = None

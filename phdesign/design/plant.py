@@ -242,17 +242,20 @@ class Plant:
         x0: str | Callable[[Any], Any] | None = None,
         *,
         u: str | Callable[[float], Any] | None = None,
+        w: str | Callable[[float], Any] | None = None,
         options: SimulationOptions | None = None,
         progress: Progress | None = None,
         **settings: Any,
     ) -> SimulationResult:
         """Simulate the plant alone from ``x0`` (text or a function of z; zero by default).
 
-        ``u``, ``options``, ``progress`` and ``settings`` as for :meth:`phdesign.Observer.simulate`
-        (``t_end=2``, ``scheme="midpoint"``, ``input_intensity=0.1`` ...); the noise on
-        the inputs is the only kind of run a plant without sensors has besides the plain one.
+        ``u``, ``w``, ``options``, ``progress`` and ``settings`` as for
+        :meth:`phdesign.Observer.simulate` (``t_end=2``, ``scheme="midpoint"``,
+        ``input_intensity=0.1``, ``disturbance_intensity=0.5`` ...); the noise is the only
+        kind of run a plant without sensors has besides the plain one.
         """
-        return self.run(None, None, x0, u=u, options=self.simulation_options(options, **settings))
+        opts = self.simulation_options(options, **settings)
+        return self.run(None, None, x0, u=u, w=w, options=opts)
 
     def simulation_options(
         self, options: SimulationOptions | None = None, **settings: Any
@@ -278,6 +281,7 @@ class Plant:
         *,
         xhat0: str | Callable[[Any], Any] | None = None,
         u: str | Callable[[float], Any] | None = None,
+        w: str | Callable[[float], Any] | None = None,
         options: SimulationOptions | None = None,
         labels: Mapping[str, str] | None = None,
     ) -> SimulationResult:
@@ -290,17 +294,22 @@ class Plant:
         sampled or lower-order observer, :func:`~phdesign.numeric.time.stochastic.simulate_noisy`
         for noise, else :func:`~phdesign.numeric.time.simulation.simulate`.  ``labels`` name
         the design in the result (presentation only: the plots' titles and the JSON).
+        ``w`` drives the model's ``[disturbances]`` B, as does ``disturbance_intensity``
+        (white) of the options: the observer knows neither.
 
         Raises
         ------
         ObserverError
             A sampled or lower-order observer asked for without sensors.
+        ParameterError
+            ``w`` on a model without disturbances, or a channel it does not have.
         """
         opts = self.simulation_options(options)
         inputs = {
             "x0": self.initial_state(x0, "x0"),
             "xhat0": self.initial_state(xhat0, "xhat0"),
             "u": self.input_signal(u),
+            **self._disturbance_inputs(w, opts),
         }
         if opts.kind == "sampled":
             from phdesign.numeric.sampled.simulation import simulate_sampled
@@ -319,6 +328,28 @@ class Plant:
 
             result = simulate(self.numeric, C_m, L, options=opts, **inputs)
         return self.labelled(result, **(labels or {}))
+
+    def _disturbance_inputs(self, w: Any, opts: SimulationOptions) -> dict[str, Any]:
+        """Return the simulator's ``w`` and ``disturbance`` B(z) (none: no disturbance)."""
+        from phdesign.numeric.disturbance_inputs import disturbance_inputs, disturbance_signal
+
+        text = _text_or_function(w, "w", "'w1: sin(3*t)'", "t")
+        signal = w if text is None else disturbance_signal(text, self.numeric, self.design_model)
+        if signal is None and opts.disturbance_intensity is None:
+            return {}
+        B = disturbance_inputs(self.design_model, self.numeric)[0]
+        if B is None:
+            raise ParameterError(
+                f"{'`w`' if signal is not None else 'disturbance_intensity'}: model "
+                f"{self.model.name!r} has no disturbance channel: add a [disturbances] "
+                "section with B (n x q)"
+            )
+        if opts.kind == "sampled":
+            raise ObserverError(
+                "a disturbance `w` runs with the continuous observer; dt, sampler and "
+                "observer_resolution ask for a sampled one: give one or the other"
+            )
+        return {"w": signal, "disturbance": B}
 
     def input_signal(self, u: str | Callable[[float], Any] | None) -> Any:
         """Return plant inputs as a function of t (text ``"u2: sin(2*t)"`` is parsed)."""

@@ -36,11 +36,12 @@ from phdesign.numeric.bridge import (
 
 __all__ = [
     "Profile",
-    "disturbance_inputs",
+    "Signals",
+    "exact_profile",
     "initial_state_function",
     "input_function",
     "input_samples",
-    "performance_terms",
+    "substituted",
     "trace_expression_row",
     "trace_row",
 ]
@@ -107,7 +108,7 @@ def trace_expression_row(
     return row
 
 
-def _substituted(model: Any, expr: Any, what: str) -> Any:
+def substituted(model: Any, expr: Any, what: str) -> Any:
     """``expr`` with the model's parameter values in: only z may stay free."""
     from phdesign.symbolic.expressions import Z
 
@@ -136,65 +137,9 @@ class Profile:
         return np.stack(vals, axis=-1).reshape(zz.size, *self.shape)
 
 
-def _profile(model: Any, entries: list[Any], shape: tuple[int, ...], what: str) -> Profile:
+def exact_profile(model: Any, entries: list[Any], shape: tuple[int, ...], what: str) -> Profile:
     """Return the entries, in z and with the parameters' values, as a :class:`Profile`."""
-    return Profile(tuple(_substituted(model, e, what) for e in entries), shape)
-
-
-def disturbance_inputs(model: Any, nm: NumericModel) -> tuple[Any, tuple[int, ...]]:
-    r"""Return :math:`B(z)` as ``f(z) -> (m, n, q)`` (None without one) and the unknown inputs.
-
-    The unknown inputs are 0-based indices into the external inputs (after the model's
-    ``[feedback]``), as the discretizations number their columns of B.
-    """
-    from phdesign.symbolic.feedback import external_indices
-
-    dist = getattr(model, "disturbances", None)
-    if dist is None:
-        return None, ()
-    kept = external_indices(len(model.inputs), model.feedback)
-    unknown = tuple(kept.index(j - 1) for j in dist.unknown)
-    if not dist.q:
-        return None, unknown
-    entries = [x for row in dist.B.tolist() for x in row]
-    return _profile(model, entries, (nm.size, dist.q), "disturbances B"), unknown
-
-
-def performance_terms(model: Any, nm: NumericModel, outputs: Any = None) -> list[Any]:
-    r"""Return each performance output as ``(name, weight, trace, points)`` with numbers.
-
-    ``weight(z) -> (m, n)`` weighs the states, :math:`\int (H c + d)^	op x\, dz` for
-    :math:`\int c^	op e + d^	op x` (None without an integral); ``trace`` is the row over
-    ``v`` (None without traces); ``points`` are ``(field, point, coefficient)`` floats.
-    ``outputs`` are text in the ``[performance]`` grammar (default: the model's outputs).
-    """
-    import sympy
-
-    from phdesign.symbolic.performance import parse_performance
-
-    items = model.performance
-    if outputs is not None:
-        fields = ["w"] * (model.displacement is not None) + [n for n, _ in model.fields]
-        texts = [outputs] if isinstance(outputs, str) else outputs
-        shape = (model.interval, model.order, model.size, model.parameter_names, fields)
-        items = parse_performance(texts, *shape)
-    out = []
-    H = model.H
-    for item in items:
-        what = f"performance output {item.text!r}"
-        weight = None
-        if item.has_integral:
-            c = H * sympy.Matrix(item.effort_weights) + sympy.Matrix(item.state_weights)
-            weight = _profile(model, list(c), (nm.size,), what)
-        trace = None
-        if item.traces != 0:
-            trace = trace_expression_row(item.traces, _parameter_values(model, None), nm, what)
-        points = tuple(
-            (field, float(point), float(_substituted(model, c, what)))
-            for field, point, c in item.points
-        )
-        out.append((item.text, weight, trace, points))
-    return out
+    return Profile(tuple(substituted(model, e, what) for e in entries), shape)
 
 
 def initial_state_function(
@@ -358,11 +303,22 @@ def _parse_z_expression(
     return expr
 
 
+@dataclass(frozen=True)
+class Signals:
+    """The signals of t a text names: ``argument`` (``u``), a ``noun`` and their ``names``."""
+
+    argument: str
+    noun: str
+    names: tuple[str, ...]
+
+
 def input_function(
     text: str | None,
     nm: NumericModel,
     parameters: Mapping[str, Any] | None = None,
     model: Any = None,
+    *,
+    channels: Signals | None = None,
 ) -> Callable[[float], np.ndarray] | None:
     """Parse plant inputs ``'u2: sin(2*t), u1: 0.1'`` into ``u(t) -> (n_ports,)``.
 
@@ -370,6 +326,8 @@ def input_function(
     model's external inputs and the expression a formula in the time ``t`` and the
     model's parameters, read by the symbolic layer's safe parser (never evaluated as
     Python).  Inputs not named are zero; ``None`` or empty text gives ``None`` (no input).
+    ``channels`` reads other signals of t the same way (the disturbances ``w1..wq``:
+    :func:`phdesign.numeric.disturbance_inputs.disturbance_signal`).
 
     Raises
     ------
@@ -393,7 +351,9 @@ def input_function(
 
     from phdesign.symbolic.parser import check_text, parse
 
-    check_text(text, "`u`")
+    kind = channels or Signals("u", "input", tuple(f"u{i + 1}" for i in range(nm.n_ports)))
+    arg = f"`{kind.argument}`"
+    check_text(text, arg)
     by_name = {
         name: _exact_value(value)
         for name, value in _substituted_values(nm, model, parameters).items()
@@ -408,38 +368,45 @@ def input_function(
         known = ", ".join(["t", *sorted(by_name)])
         raise ExpressionError(f"unknown symbol {name!r} in {expression!r}; expected {known}")
 
-    m = nm.n_ports
-    names = {f"u{i + 1}": i for i in range(m)}
+    names = {name: i for i, name in enumerate(kind.names)}
     funcs: dict[int, Callable[[float], Any]] = {}
     for part in _split_top_level(text):
         if ":" not in part:
             raise ParameterError(
-                f"`u` item {part.strip()!r}: expected 'u<i>: expression in t', e.g. 'u1: sin(2*t)'"
+                f"{arg} item {part.strip()!r}: expected '{kind.argument}<i>: expression in t', "
+                f"e.g. '{kind.argument}1: sin(2*t)'"
             )
         key, body = (x.strip() for x in part.split(":", 1))
         if key not in names:
-            expected = ", ".join(names) if names else "none (every input is closed)"
-            raise ParameterError(f"`u`: unknown input {key!r}; the model's inputs are {expected}")
+            expected = ", ".join(names) if names else f"none (every {kind.noun} is closed)"
+            raise ParameterError(
+                f"{arg}: unknown {kind.noun} {key!r}; the model's {kind.noun}s are {expected}"
+            )
         if names[key] in funcs:
-            raise ParameterError(f"`u`: input {key!r} given twice")
+            raise ParameterError(f"{arg}: {kind.noun} {key!r} given twice")
         try:
             expr = parse(body, resolve)
         except ExpressionError as error:
-            raise ExpressionError(f"`u` {key}: {error}") from None
+            raise ExpressionError(f"{arg} {key}: {error}") from None
         funcs[names[key]] = partial(_evaluate_at, expr, time)
 
-    def u(t: float) -> np.ndarray:
-        out = np.zeros(m)
-        for i, f in funcs.items():
-            try:
-                out[i] = float(f(float(t)))
-            except (ArithmeticError, ValueError, TypeError):
-                out[i] = np.nan
-            if not np.isfinite(out[i]):
-                raise NumericError(f"`u`: input u{i + 1} is not finite at t = {t:g}")
-        return out
+    return partial(_signal_values, funcs, kind)
 
-    return u
+
+def _signal_values(
+    funcs: Mapping[int, Callable[[float], Any]], kind: Signals, t: float
+) -> np.ndarray:
+    """Return the signals of :func:`input_function` at ``t`` (those not named are zero)."""
+    out = np.zeros(len(kind.names))
+    for i, f in funcs.items():
+        try:
+            out[i] = float(f(float(t)))
+        except (ArithmeticError, ValueError, TypeError):
+            out[i] = np.nan
+        if not np.isfinite(out[i]):
+            name = kind.names[i]
+            raise NumericError(f"`{kind.argument}`: {kind.noun} {name} is not finite at t = {t:g}")
+    return out
 
 
 def input_samples(

@@ -20,8 +20,8 @@ checked by :mod:`~phdesign.sweep.fields`),
 :mod:`~phdesign.sweep.execute` (running them), :mod:`~phdesign.sweep.store` (Zarr),
 :mod:`~phdesign.sweep.export` (CSV, NetCDF), :mod:`~phdesign.sweep.summary` (the printed
 result; its pictures are drawn by :mod:`phdesign.plots.sweep`); the jobs'
-evaluators live in :mod:`~phdesign.sweep.spectrum_job` and
-:mod:`~phdesign.sweep.classify_job`.
+evaluators live in :mod:`~phdesign.sweep.spectrum_job`,
+:mod:`~phdesign.sweep.classify_job` and :mod:`~phdesign.sweep.gain_job`.
 
 Examples
 --------
@@ -90,11 +90,14 @@ def sweep(
     ----------
     model : BCPHS or str
         The model, or a built-in name / TOML path.
-    job : {"spectrum", "classify"}
+    job : {"spectrum", "classify", "gain"}
         ``spectrum``: ``spectral_abscissa``, ``converged``, ``digits``, ``n_resolved``,
         ``unbounded_below``, ``ill_conditioned`` of the error system
         :math:`\tilde u = -C_m^\top L C_m \tilde y` (of the plant, u = 0, without
-        sensors); ``classify``: ``verdict``, ``kappa`` (κ* of the best variant), ``best``.
+        sensors); ``classify``: ``verdict``, ``kappa`` (κ* of the best variant), ``best``;
+        ``gain``: ``hinf``, ``hinf_converged``, ``hinf_frequency``, ``h2``,
+        ``h2_converged``, ``h2_diverges``, ``steady_state`` from the model's
+        ``[disturbances]`` to its ``[performance]`` outputs (:mod:`~phdesign.sweep.gain_job`).
     sensors : str or sequence of int, optional
         Measured outputs (1-based), the same at every point: ``[3, 4]`` or ``"3,4"``.
     sensor_sets : str or sequence, optional
@@ -109,7 +112,8 @@ def sweep(
     parameters : mapping, optional
         Fixed parameter values (as ``--param``).
     options : mapping, optional
-        Job options: ``method``, ``resolution``, ``max_resolution``, ``tol`` (spectrum).
+        Job options: ``method``, ``resolution``, ``max_resolution``, ``tol`` (spectrum and
+        gain), ``intensity`` (gain: the sensor noise).
     output : path, optional
         ``map.zarr`` (written chunk by chunk, resumable), ``map.csv`` or ``map.nc``
         (written at the end); nothing is written without it.

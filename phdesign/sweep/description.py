@@ -331,7 +331,7 @@ def describe(
     model : BCPHS
         The model, fixed parameter values already applied (``model.with_parameters``).
     job : str
-        ``"spectrum"`` or ``"classify"`` (see :data:`phdesign.sweep.jobs.JOBS`).
+        ``"spectrum"``, ``"classify"`` or ``"gain"`` (see :data:`phdesign.sweep.jobs.JOBS`).
     sensors : str or sequence of int, optional
         The measured outputs (1-based), the same at every point: ``[3, 4]`` or ``"3,4"``.
     sensor_sets : str or sequence of sequences of int, optional

@@ -26,7 +26,7 @@ Adding a job is one entry in :data:`JOBS`, e.g. for noise figures::
 Examples
 --------
 >>> sorted(JOBS)
-['classify', 'spectrum']
+['classify', 'gain', 'spectrum']
 >>> [f.name for f in JOBS["classify"].figures]
 ['verdict', 'kappa', 'best']
 """
@@ -220,6 +220,13 @@ _METHOD = Option(
     "method", "choice", _default_method, "discretization (default: the table's)", _method_names
 )
 
+#: The discretization and its refinement, options of the numeric jobs
+_REFINEMENT = (
+    _METHOD,
+    Option("resolution", "int", None, "first resolution of the refinement pairs"),
+    Option("max_resolution", "int", None, "largest resolution"),
+)
+
 JOBS: dict[str, Job] = {
     "spectrum": Job(
         name="spectrum",
@@ -233,15 +240,37 @@ JOBS: dict[str, Job] = {
             Figure("ill_conditioned", "bool", "the rightmost eigenvalue is near a coalescence"),
         ),
         options=(
-            _METHOD,
-            Option("resolution", "int", None, "first resolution of the refinement pairs"),
-            Option("max_resolution", "int", None, "largest resolution"),
+            *_REFINEMENT,
             Option("tol", "float", None, "required agreement of α (times max(1, |α|))"),
         ),
         prepare="phdesign.sweep.spectrum_job:prepare",
         needs_sensors=False,
         points_per_chunk=32,
         settings_per_chunk=4,
+        check="phdesign.sweep.spectrum_job:check_options",
+    ),
+    "gain": Job(
+        name="gain",
+        summary="H∞ and H₂ norms from the disturbances to the performance outputs (their "
+        "estimation error with sensors)",
+        figures=(
+            Figure("hinf", "float64", "H∞ norm (L²-gain), NaN unless converged"),
+            Figure("hinf_converged", "bool", "the H∞ norm agrees to tol under refinement"),
+            Figure("hinf_frequency", "float64", "frequency of the H∞ peak", "rad/s"),
+            Figure("h2", "float64", "H₂ norm, NaN unless converged"),
+            Figure("h2_converged", "bool", "the H₂ norm agrees to tol under refinement"),
+            Figure("h2_diverges", "bool", "the H₂ norm grows with the resolution (infinite)"),
+            Figure("steady_state", "bool", "the system is exponentially stable"),
+        ),
+        options=(
+            *_REFINEMENT,
+            Option("tol", "float", None, "relative agreement of a converged norm"),
+            Option("intensity", "float", None, "sensor noise intensity σ² (default 1)"),
+        ),
+        prepare="phdesign.sweep.gain_job:prepare",
+        needs_sensors=False,
+        points_per_chunk=8,
+        settings_per_chunk=2,
         check="phdesign.sweep.spectrum_job:check_options",
     ),
     "classify": Job(

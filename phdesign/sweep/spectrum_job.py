@@ -30,7 +30,14 @@ from phdesign.numeric.spectrum.converged import spectrum
 from phdesign.numeric.spectrum.refinement import Discretizations
 from phdesign.numeric.spectrum.report import SpectrumReport
 
-__all__ = ["ChunkSpectrum", "abscissa_evaluator", "check_options", "figures_of_report", "prepare"]
+__all__ = [
+    "ChunkSpectrum",
+    "abscissa_evaluator",
+    "check_options",
+    "figures_of_report",
+    "prepare",
+    "sensor_rows",
+]
 
 
 def figures_of_report(report: SpectrumReport) -> dict[str, Any]:
@@ -136,8 +143,13 @@ def prepare(
 ) -> Callable[[tuple[float, ...] | None], dict[str, Any]]:
     """Prepare the job's evaluator (see :mod:`phdesign.sweep.jobs`)."""
     nm = to_numeric(model)
-    C_m = None
-    if sensors is not None:
-        C_m = np.zeros((len(sensors), nm.n_ports))
-        C_m[np.arange(len(sensors)), np.asarray(sensors) - 1] = 1.0
-    return abscissa_evaluator(nm, C_m, options)
+    return abscissa_evaluator(nm, sensor_rows(sensors, nm.n_ports), options)
+
+
+def sensor_rows(sensors: tuple[int, ...] | None, ports: int) -> np.ndarray | None:
+    """Return C_m of the unit rows that pick the (1-based) ``sensors`` (None: no sensors)."""
+    if sensors is None:
+        return None
+    C_m = np.zeros((len(sensors), ports))
+    C_m[np.arange(len(sensors)), np.asarray(sensors) - 1] = 1.0
+    return C_m

@@ -39,7 +39,7 @@ def test_the_sweep_options_are_added_when_sweep_is_used():
     sweep = next(a for a in parser._actions if a.dest == "command").choices["sweep"]
     help_text = sweep.format_help()
     assert "--max-resolution N" in help_text  # an option of the spectrum job
-    assert "--job {classify,spectrum}" in help_text
+    assert "--job {classify,gain,spectrum}" in help_text
     args = parser.parse_args(["sweep", "wave", "-o", "m.csv", "--tol", "-1e-3"])
     assert (args.job, args.option_tol) == ("spectrum", -1e-3)  # a negative value is taken
 

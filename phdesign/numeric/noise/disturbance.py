@@ -62,7 +62,7 @@ from phdesign.numeric.discretization.functionals import (
     performance_functional,
 )
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize
-from phdesign.numeric.inputs import disturbance_inputs, performance_terms
+from phdesign.numeric.disturbance_inputs import disturbance_inputs, performance_terms
 from phdesign.numeric.noise.disturbance_report import GainReport, SourceFigures
 from phdesign.numeric.noise.figures import check_intensity, refinement_plan
 from phdesign.numeric.noise.gain import PeakSearch, banded_gain, gain_pair

@@ -46,7 +46,7 @@ __all__ = ["KINDS", "NOISY_SCHEME", "SAMPLED_SCHEME", "SimulationOptions"]
 #: The options that ask for a sampled (or lower-order) observer.
 SAMPLING = ("dt", "sampler", "observer_resolution")
 #: The options that ask for a noisy run.
-NOISE = ("noise_intensity", "input_intensity", "seed")
+NOISE = ("noise_intensity", "input_intensity", "disturbance_intensity", "seed")
 #: Why a noisy run refuses another scheme than ``"expm"``.
 NOISY_SCHEME = (
     "a noisy simulation steps exactly (Van Loan sampling of the noise); the {scheme!r} "
@@ -106,6 +106,10 @@ class SimulationOptions:
         Sensor noise intensities :math:`\sigma_i^2` (one per sensor or one for all).
     input_intensity : float or sequence of float, optional
         White noise on the plant inputs (one per input or one for all).
+    disturbance_intensity : float or sequence of float, optional
+        White noise on the disturbance channels ``w1..wq`` of the model's
+        ``[disturbances]`` B (one per channel or one for all), which the observer does not
+        know.
     seed : int, optional
         Seed of the noise (needs a noise intensity).
     at : sequence of str or float, optional
@@ -136,6 +140,7 @@ class SimulationOptions:
     observer_resolution: int | None
     noise_intensity: tuple[float, ...] | None
     input_intensity: tuple[float, ...] | None
+    disturbance_intensity: tuple[float, ...] | None
     seed: int | None
     at: tuple[str | float, ...] | None
 
@@ -156,6 +161,7 @@ class SimulationOptions:
         input_intensity: float | Sequence[float] | None = None,
         seed: int | None = None,
         at: str | float | Sequence[str | float] | None = None,
+        disturbance_intensity: float | Sequence[float] | None = None,
     ) -> None:
         table = current()  # None: the table's default, in force when the options are made
         t_end, samples, scheme, _ = table.simulation.fill(t_end, samples, scheme)
@@ -182,7 +188,7 @@ class SimulationOptions:
             )
         self._set("check_resolution", check_resolution)
         self._check_sampling(dt, sampler, observer_resolution)
-        self._check_noise(noise_intensity, input_intensity, seed)
+        self._check_noise(noise_intensity, input_intensity, disturbance_intensity, seed)
         self._set("at", None if at is None else _point_items(at))
 
     def _set(self, name: str, value: Any) -> None:
@@ -199,22 +205,28 @@ class SimulationOptions:
         if sampled and self.scheme != "expm":
             raise NumericError(SAMPLED_SCHEME.format(scheme=self.scheme))
 
-    def _check_noise(self, noise_intensity: Any, input_intensity: Any, seed: Any) -> None:
-        for name, value in (
+    def _check_noise(
+        self, noise_intensity: Any, input_intensity: Any, disturbance_intensity: Any, seed: Any
+    ) -> None:
+        intensities = (
             ("noise_intensity", noise_intensity),
             ("input_intensity", input_intensity),
-        ):
+            ("disturbance_intensity", disturbance_intensity),
+        )
+        for name, value in intensities:
             # their number is checked against the model's channels, by the simulator
             count = (np.size(value) if np.ndim(value) else 1) if value is not None else 0
             checked = (
                 None if value is None else tuple(check_intensity(value, count, name).tolist())
             )
             self._set(name, checked)
-        noisy = noise_intensity is not None or input_intensity is not None
+        noisy = any(value is not None for _, value in intensities)
         if seed is not None:
             seed = positive_int(seed, "seed", minimum=0)  # not numpy's traceback
             if not noisy:
-                raise NumericError("seed needs noise_intensity or input_intensity")
+                raise NumericError(
+                    "seed needs noise_intensity or input_intensity (or disturbance_intensity)"
+                )
         self._set("seed", seed)
         if not noisy:
             return
@@ -274,7 +286,13 @@ class SimulationOptions:
 
     def deterministic(self) -> SimulationOptions:
         """Return the same options without the noise (the noise-free part of a noisy run)."""
-        return replace(self, noise_intensity=None, input_intensity=None, seed=None)
+        return replace(
+            self,
+            noise_intensity=None,
+            input_intensity=None,
+            disturbance_intensity=None,
+            seed=None,
+        )
 
     def discretized(
         self, method: str | None, resolution: int | None, owner: str = "Plant"

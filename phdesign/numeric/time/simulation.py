@@ -13,9 +13,13 @@ coupled system is block triangular,
     E \dot{\hat e} = (J - R)\hat e + B u, \qquad
     E \dot{\tilde e} = (J - R - B G B^\top)\tilde e, \qquad G = (I + K D)^{-1} K,
 
-so the error system is stepped on its own and :math:`\tilde H = \tfrac12 \tilde e^\top E
-\tilde e` is computed from :math:`\tilde e` itself: no cancellation of plant minus
-observer (that difference loses all relative accuracy once :math:`\tilde H` is
+and a disturbance :math:`B_d w(t)` of the model's ``[disturbances]``
+(:func:`~phdesign.numeric.discretization.functionals.disturbance_matrix`), which the
+observer does not know, drives both rows: :math:`E \dot{\hat e} = \dots + B_d w` and
+:math:`E \dot{\tilde e} = \dots + B_d w`.  So the error system is stepped on its own
+and :math:`\tilde H = \tfrac12 \tilde e^\top E \tilde e` is computed from
+:math:`\tilde e` itself: no cancellation of plant minus observer (that difference loses
+all relative accuracy once :math:`\tilde H` is
 :math:`10^{-11}` of :math:`\tilde H(0)`).  The observer is :math:`\hat e - \tilde e`
 and :math:`\hat y = y - \tilde y`, :math:`\tilde y = (I - D G) B^\top \tilde e`.
 Time stepping (:mod:`phdesign.numeric.time.stepping`): exact (``"expm"``, default) or implicit
@@ -45,11 +49,11 @@ from typing import Any
 
 import numpy as np
 
-from phdesign.core.errors import NumericError
+from phdesign.core.errors import ArgumentError, NumericError
 from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_simulate_arguments
-from phdesign.numeric.discretization.functionals import Functional
+from phdesign.numeric.discretization.functionals import Functional, disturbance_matrix
 from phdesign.numeric.discretization.phs import ClosedLoop
 from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
@@ -148,6 +152,8 @@ def simulate(
     u: Callable[[float], np.ndarray] | None = None,
     options: SimulationOptions | None = None,
     discrete: DiscretePHS | None = None,
+    w: Callable[[float], np.ndarray] | None = None,
+    disturbance: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> SimulationResult:
     """Simulate the plant, and the continuous observer when sensors are given.
 
@@ -169,6 +175,11 @@ def simulate(
         ``simulate_noisy`` run them.
     discrete : DiscretePHS, optional
         A ready discretization (overrides ``options.method``/``options.resolution``).
+    w : callable, optional
+        Disturbance ``w(t) -> (q,)``, sampled like ``u``; the observer does not know it.
+    disturbance : callable, optional
+        :math:`B(z)`, ``f(z) -> (m, n, q)`` (:func:`phdesign.numeric.disturbance_inputs.
+        disturbance_inputs`); needed with ``w``.
 
     Returns
     -------
@@ -191,15 +202,48 @@ def simulate(
     d = discrete if discrete is not None else discretize(nm, opts.method, opts.resolution)
     step = _Stepper.of(opts)
     U = None if u is None else input_samples(u, step.t, nm.n_ports)
+    forcing = _Disturbance.of(w, disturbance, step.t)
     start = x0 or _zero(nm)
     report(f"simulate: the plant, resolution {d.resolution}")
-    plant = step(d.E, d.J - d.R, d.B, d.project(start), U)
+    B, V = forcing.joined(d, d.B, U)
+    plant = step(d.E, d.J - d.R, B, d.project(start), V)
     error = None
     if C_m is not None and L is not None:
         K = feedback_matrix(C_m, L, nm.n_ports)
         e0 = _difference(start, xhat0 or _zero(nm))
-        error = _error_run(nm, d, K, e0, step, opts.check_resolution)
-    return _result(nm, _Run(d, opts, step.t, U, plant, error, at))
+        error = _error_run(nm, d, K, e0, step, opts.check_resolution, forcing)
+    return _result(nm, _Run(d, opts, step.t, U, plant, error, at, forcing.W))
+
+
+@dataclass(frozen=True)
+class _Disturbance:
+    """The disturbance :math:`B(z)` and its samples ``W`` on the output grid (or none)."""
+
+    B: Callable[[np.ndarray], np.ndarray] | None = None
+    W: np.ndarray | None = None
+
+    @classmethod
+    def of(cls, w: Any, B: Any, t: np.ndarray) -> _Disturbance:
+        """Sample ``w`` on ``t`` (``B`` is needed with it)."""
+        if w is None:
+            return cls()
+        if B is None:
+            raise NumericError("w needs the disturbance matrix B(z) of the model's [disturbances]")
+        if not callable(w):
+            raise ArgumentError(
+                f"w must be a function of t returning the disturbances; found {w!r}"
+            )
+        q = np.asarray(B(np.zeros(1))).shape[-1]
+        return cls(B, input_samples(w, t, q, "w"))
+
+    def joined(
+        self, d: DiscretePHS, B: np.ndarray, U: np.ndarray | None
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """Return the input matrix ``[B, B_d]`` and samples ``[U, W]`` (unchanged without w)."""
+        if self.B is None or self.W is None:
+            return B, U
+        inputs = np.zeros((self.W.shape[0], B.shape[1])) if U is None else U
+        return np.hstack([B, disturbance_matrix(d, self.B)]), np.hstack([inputs, self.W])
 
 
 def _zero(nm: NumericModel) -> InitialState:
@@ -246,16 +290,19 @@ def _error_run(
     e0: InitialState,
     step: _Stepper,
     check_resolution: bool,
+    forcing: _Disturbance,
 ) -> _ErrorRun:
     """Step the error system (module docstring), and again at ⌈1.5 p⌉ to find its floor."""
     loop = d.close(K)
     report("simulate: the error system")
-    error = step(d.E, loop.A, np.zeros((d.dim, 0)), d.project(e0), None)
+    Bw, W = forcing.joined(d, np.zeros((d.dim, 0)), None)
+    error = step(d.E, loop.A, Bw, d.project(e0), W)
     if not check_resolution:
         return _ErrorRun(loop, error)
     fine = discretize(nm, d.method, math.ceil(1.5 * d.resolution))
     report(f"simulate: the error system at resolution {fine.resolution}, to check the first")
-    finer = step(fine.E, fine.close(K).A, np.zeros((fine.dim, 0)), fine.project(e0), None)
+    Bf, Wf = forcing.joined(fine, np.zeros((fine.dim, 0)), None)
+    finer = step(fine.E, fine.close(K).A, Bf, fine.project(e0), Wf)
     floor, until = _resolution_check(step.t, d.hamiltonian(error.X), fine.hamiltonian(finer.X))
     if floor is None or until is None:
         return _ErrorRun(loop, error)
@@ -274,6 +321,7 @@ class _Run:
     plant: Trajectory
     error: _ErrorRun | None
     at: tuple[Functional, ...] = ()
+    W: np.ndarray | None = None
 
     @property
     def trajectories(self) -> dict[str, Trajectory]:
@@ -332,9 +380,9 @@ def _audits(run: _Run) -> dict[str, float]:
     audits: dict[str, float] = {}
     if run.options.scheme != "expm":
         return audits
-    if run.U is None:  # the plant is autonomous only without input
+    if run.U is None and run.W is None:  # the plant is autonomous only without input
         audits["plant"] = energy_balance_residual(d.E, d.J - d.R, run.plant.X, run.t)
-    if error is not None:
+    if error is not None and run.W is None:
         audits["error system"] = energy_balance_residual(
             d.E, error.loop.A, error.trajectory.X, run.t
         )

@@ -13,8 +13,12 @@ the plant input carries :math:`w` (intensity :math:`\Sigma_w`), the observer rec
     N_2 = \begin{bmatrix} 0 & B \Sigma_w^{1/2} \\
     B M C_m^\top L \Sigma_\nu^{1/2} & B G D \Sigma_w^{1/2} \end{bmatrix},
 
-n unit white noise.  (The difference of the two rows is the error system's noise input
-:math:`B M [-C_m^\top L \Sigma_\nu^{1/2}, \Sigma_w^{1/2}]`, since :math:`I - GD = M`.)
+n unit white noise; white disturbances :math:`B_d \Sigma_d^{1/2} n_d` of the model's
+``[disturbances]`` enter the plant's row only (the observer does not know them), so the
+error's variance is :math:`\operatorname{tr}(C_p P C_p^\top)`, P the Lyapunov covariance of
+:mod:`phdesign.numeric.noise.disturbance`.  (The difference of the two rows is the error
+system's noise input :math:`B M [-C_m^\top L \Sigma_\nu^{1/2}, \Sigma_w^{1/2}]`, since
+:math:`I - GD = M`.)
 
 The sampled system is exact (Van Loan 1978): over a step Δt,
 :math:`X_{k+1} = \Phi X_k + \Gamma u + \eta_k` with :math:`\Phi = e^{F \Delta t}`,
@@ -50,11 +54,11 @@ import scipy.linalg as sl
 from phdesign.core.errors import NumericError, ObserverError
 from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
-from phdesign.numeric.discretization.functionals import Functional
+from phdesign.numeric.discretization.functionals import Functional, disturbance_matrix
 from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
 from phdesign.numeric.inputs import input_samples
-from phdesign.numeric.noise.figures import noise_intensities
+from phdesign.numeric.noise.figures import check_intensity, noise_intensities
 from phdesign.numeric.threads import limited_threads
 from phdesign.numeric.time.options import NOISY_SCHEME, SimulationOptions
 from phdesign.numeric.time.result import SimulationResult
@@ -70,10 +74,12 @@ def noisy_coupled_system(
     L: np.ndarray | None,
     intensity: np.ndarray | None,
     input_intensity: np.ndarray | None,
+    disturbance: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Return ``(E2, A2, B2, N2)`` of plant and observer driven by unit white noise.
+    r"""Return ``(E2, A2, B2, N2)`` of plant and observer driven by unit white noise.
 
     Without sensors (``C_m`` None) only the plant, driven by the input noise.
+    ``disturbance`` is :math:`B_d \Sigma_d^{1/2}`, the white disturbances' columns (last).
     """
     q = 0 if C_m is None else np.atleast_2d(C_m).shape[0]
     K = None if C_m is None or L is None else feedback_matrix(C_m, L, d.n_ports)
@@ -81,15 +87,16 @@ def noisy_coupled_system(
     sigma = np.zeros(q) if intensity is None else np.asarray(intensity, dtype=float)
     w_in = np.zeros(d.n_ports) if input_intensity is None else np.asarray(input_intensity, float)
     plant_w = d.B @ np.diag(np.sqrt(w_in))
+    plant_d = np.zeros((d.dim, 0)) if disturbance is None else disturbance
     if K is None or C_m is None or L is None:
-        return E2, A2, B2, plant_w
+        return E2, A2, B2, np.hstack([plant_w, plant_d])
     loop = d.close(K)  # B M = loop.B, G = M K = loop.gain
     C = np.atleast_2d(np.asarray(C_m, dtype=float))
     Lm = np.atleast_2d(np.asarray(L, dtype=float))
     observer_nu = loop.B @ C.T @ Lm @ np.diag(np.sqrt(sigma))
     observer_w = d.B @ loop.gain @ d.D @ np.diag(np.sqrt(w_in))
-    top = np.hstack([np.zeros_like(observer_nu), plant_w])
-    bottom = np.hstack([observer_nu, observer_w])
+    top = np.hstack([np.zeros_like(observer_nu), plant_w, plant_d])
+    bottom = np.hstack([observer_nu, observer_w, np.zeros_like(plant_d)])
     return E2, A2, B2, np.vstack([top, bottom])
 
 
@@ -143,18 +150,22 @@ def simulate_noisy(
     u: Callable[[float], np.ndarray] | None = None,
     options: SimulationOptions | None = None,
     discrete: DiscretePHS | None = None,
+    w: Callable[[float], np.ndarray] | None = None,
+    disturbance: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> SimulationResult:
-    """One sample path of plant and observer with sensor and input noise.
+    """One sample path of plant and observer with sensor, input and disturbance noise.
 
     Parameters
     ----------
-    nm, C_m, L, x0, xhat0, u, discrete
+    nm, C_m, L, x0, xhat0, u, discrete, w, disturbance
         As for :func:`phdesign.numeric.time.simulation.simulate`.
     options : SimulationOptions, optional
         As for ``simulate`` (``at`` too: point outputs of the noisy plant and observer), with
         the noise: ``noise_intensity`` (sensor intensities
         σᵢ², one per sensor or one for all; needs sensors), ``input_intensity`` (plant
-        input intensities, one per input or one for all) and ``seed`` (the same seed gives
+        input intensities, one per input or one for all), ``disturbance_intensity`` (white
+        noise on the channels of ``disturbance``, one per channel or one for all; needs
+        ``disturbance``) and ``seed`` (the same seed gives
         the same path).  The stepping is exact (``scheme="expm"``): implicit midpoint does
         not apply to a noisy run.
 
@@ -172,17 +183,34 @@ def simulate_noisy(
         raise ObserverError("sensor noise needs an observer: give the sensors C_m and gain L")
     q = 0 if C_m is None else np.atleast_2d(C_m).shape[0]
     sigma, w_in = noise_intensities(nm, q, opts.noise_intensity, opts.input_intensity, default=0.0)
+    white = _white_disturbance(opts, disturbance)
     at = point_outputs(nm, opts.at, "at")  # an unknown field is refused before any work
     d = discrete if discrete is not None else discretize(nm, opts.method, opts.resolution)
-    base = simulate(nm, C_m, L, x0=x0, xhat0=xhat0, u=u, options=opts.deterministic(), discrete=d)
+    base = simulate(
+        nm,
+        C_m,
+        L,
+        x0=x0,
+        xhat0=xhat0,
+        u=u,
+        options=opts.deterministic(),
+        discrete=d,
+        w=w,
+        disturbance=disturbance,
+    )
     report("simulate: the noise's sample path")
-    extra = _noise_paths(d, C_m, L, sigma, w_in, base.t, opts.seed)
+    columns = None
+    if white is not None and disturbance is not None:
+        columns = disturbance_matrix(d, disturbance) @ np.diag(np.sqrt(white))
+    extra = _noise_paths(d, C_m, L, sigma, w_in, base.t, opts.seed, columns)
     U = None if u is None else input_samples(u, base.t, d.n_ports)
     described = []
     if opts.noise_intensity is not None:
         described.append(f"sensor intensity {', '.join(f'{s:g}' for s in sigma)}")
     if w_in is not None:
         described.append(f"input intensity {', '.join(f'{s:g}' for s in w_in)}")
+    if white is not None:
+        described.append(f"disturbance intensity {', '.join(f'{s:g}' for s in white)}")
     info = {
         **base.info,
         "scheme": "expm (exact; Van Loan sampled noise)",
@@ -190,6 +218,19 @@ def simulate_noisy(
         "seed": -1 if opts.seed is None else int(opts.seed),
     }
     return replace(base, info=info, **_noisy_series(d, C_m, L, base, extra, U, at))
+
+
+def _white_disturbance(opts: SimulationOptions, disturbance: Any) -> np.ndarray | None:
+    """Return the white disturbances' intensities, one per channel of B (None: none)."""
+    if opts.disturbance_intensity is None:
+        return None
+    if disturbance is None:
+        raise NumericError(
+            "disturbance_intensity needs the disturbance matrix B(z) of the model's "
+            "[disturbances]: the model has none"
+        )
+    q = np.asarray(disturbance(np.zeros(1))).shape[-1]
+    return check_intensity(opts.disturbance_intensity, q, "disturbance_intensity")
 
 
 def _noise_paths(
@@ -200,9 +241,10 @@ def _noise_paths(
     w_in: np.ndarray | None,
     t: np.ndarray,
     seed: int | None,
+    disturbance: np.ndarray | None = None,
 ) -> np.ndarray:
     """Return one path of the response to the noise from zero, sampled exactly on ``t``."""
-    E2, A2, _, N2 = noisy_coupled_system(d, C_m, L, sigma, w_in)
+    E2, A2, _, N2 = noisy_coupled_system(d, C_m, L, sigma, w_in, disturbance)
     if not (N2.shape[1] and t.size > 1):
         return np.zeros((t.size, E2.shape[0]))
     sampler = sampled_noise(E2, A2, N2, float(t[1] - t[0]))
