@@ -27,6 +27,7 @@ _EXPORTS: dict[str, str] = {
     # models
     "BCPHS": "phdesign.symbolic.model",
     "Displacement": "phdesign.symbolic.definition",
+    "CoupledInitialState": "phdesign.numeric.boundary_start",
     "BoundarySystem": "phdesign.symbolic.boundary_systems",
     "load": "phdesign.models",
     "load_builtin": "phdesign.models",
@@ -76,6 +77,7 @@ __all__ = [
     "Certificate",
     "Classification",
     "CoupledClassification",
+    "CoupledInitialState",
     "Displacement",
     "GainReport",
     "Loop",
@@ -120,6 +122,7 @@ if TYPE_CHECKING:  # pragma: no cover - static imports for type checkers and IDE
     from phdesign.design.plant import Plant
     from phdesign.io import model_from_toml, model_to_toml, read_model, write_model
     from phdesign.models import builtin_names, load, load_builtin
+    from phdesign.numeric.boundary_start import CoupledInitialState
     from phdesign.numeric.bridge import to_numeric
     from phdesign.numeric.certified.certificate import Certificate
     from phdesign.numeric.discretization.registry import discretize

@@ -104,6 +104,7 @@ DAMPED_TIP = tomli_w.dumps(
 BEAM_SENSORS = "classify euler-bernoulli --sensors"
 BEAM_GAIN = "classify euler-bernoulli --sensors 3,4 --gain"
 SIM = "simulate wave --sensors 2"
+TIP = "simulate string-tip-mass --sensors 2"
 NOISE = "noise euler-bernoulli --sensors 3,4 --gain 0.1,1"
 TRADE = "tradeoff euler-bernoulli --sensors 3,4"
 TUNE_BEAM = "tune euler-bernoulli --sensors 3,4"
@@ -271,6 +272,20 @@ COMMAND_ROWS = [
     row(f"{SIM} --x0 x1:q*z", "unknown symbol 'q'", ExpressionError),
     row(f"{SIM} --x0 x1:(z", "expected ')'", ExpressionError),
     row(f"{SIM} --x0 x1:e1(0)", "trace 'e1(0)' is not allowed here", ExpressionError),
+    # issue 26: a coupled model's boundary states in --x0 / --xhat0
+    row(
+        f"{TIP} --x0 mass.x1:z",
+        "boundary state 'mass.x1' is one number, not a function of z",
+        ParameterError,
+    ),
+    row(
+        f"{TIP} --x0 mass.x2:1",
+        "unknown component 'mass.x2'; expected one of .*mass.x1",
+        ParameterError,
+    ),
+    row(f"{TIP} --x0 mass.x1:1,mass.x1:2", "boundary state 'mass.x1' given twice", ParameterError),
+    row(f"{TIP} --xhat0 mass.x1:q", "unknown symbol 'q'", ExpressionError),
+    row(f"{SIM} --x0 mass.x1:1", "unknown component 'mass.x1'", ParameterError),
     row(f"{SIM} --t-end -1", "--t-end", NumericError),
     row(f"{SIM} --t-end 0", "--t-end", NumericError),
     row(f"{SIM} --t-end nan", "--t-end", NumericError),

@@ -8,7 +8,9 @@ Initial states (``--x0``, ``--xhat0``) are comma-separated ``name: expression`` 
 a state name of the model (``x1``, ``x2``, ... always work, as do the model's own state
 names) or an effort ``e1``, ``e2``, ... (then x = H⁻¹ e), and an expression in ``z`` and
 the model's parameters, e.g. ``--x0 'x1: 0, x2: z - 0.9'`` or ``--x0 'e1: sin(pi*z)'``.
-Components not mentioned are zero.  Expressions go through the symbolic layer's safe
+Components not mentioned are zero.  A coupled model's boundary states are named by their
+labels or ``<name>.x<i>``, with a number or an expression in the parameters:
+``--x0 'x1: sin(pi*z), mass momentum: 0.5'``.  Expressions go through the symbolic layer's safe
 parser: user text is never evaluated.
 """
 
@@ -117,8 +119,9 @@ def _add_simulate(subparsers: argparse._SubParsersAction) -> None:
     sim.add_argument(
         "--x0",
         metavar="EXPRS",
-        help="plant initial state, e.g. 'x1: 0, x2: z - 0.9'; default zero (then every "
-        "series is zero: a warning says so)",
+        help="plant initial state, e.g. 'x1: 0, x2: z - 0.9' (a boundary system's states by "
+        "name, e.g. 'mass momentum: 0.5'); default zero (then every series is zero: a "
+        "warning says so)",
     )
     sim.add_argument("--xhat0", metavar="EXPRS", help="observer initial state; default zero")
     run = table.simulation

@@ -32,6 +32,7 @@ __all__ = [
     "number_text",
     "sensors_text",
     "shorten",
+    "split_top_level",
     "text_table",
 ]
 
@@ -245,3 +246,22 @@ def did_you_mean(name: object, choices: Iterable[str]) -> str:
 
     close = difflib.get_close_matches(str(name), list(choices), n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def split_top_level(text: str) -> list[str]:
+    """Split on commas that are not inside parentheses or brackets."""
+    parts: list[str] = []
+    cur: list[str] = []
+    depth = 0
+    for ch in text:
+        if ch in "([":
+            depth += 1
+        elif ch in ")]":
+            depth -= 1
+        if ch == "," and depth == 0:
+            parts.append("".join(cur))
+            cur = []
+        else:
+            cur.append(ch)
+    parts.append("".join(cur))
+    return [p for p in parts if p.strip()]

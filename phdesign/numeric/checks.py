@@ -197,6 +197,13 @@ def check_initial_state(x0: Any, nm: Any, name: str) -> None:
             f"{name} must be finite on [{a:g}, {b:g}]; found {values[i, j]} in component "
             f"{j + 1} at z = {z[i]:g}"
         )
+    boundary = getattr(x0, "boundary", None)
+    expected_states = sum(b.size for b in nm.boundary)
+    if boundary is not None and np.shape(boundary) != (expected_states,):
+        raise NumericError(
+            f"{name}.boundary must hold the {expected_states} boundary states of "
+            f"{nm.name!r}; found shape {np.shape(boundary)}"
+        )
 
 
 def _shapes(value: Any) -> str:

@@ -26,7 +26,13 @@ from typing import Any
 import numpy as np
 
 from phdesign.core.errors import ExpressionError, NumericError, ParameterError, PhdesignError
-from phdesign.core.text import did_you_mean
+from phdesign.core.text import did_you_mean, split_top_level
+from phdesign.numeric.boundary_start import (
+    boundary_items,
+    boundary_names,
+    constants,
+    with_boundary_states,
+)
 from phdesign.numeric.bridge import (
     NumericModel,
     _free_symbols_message,
@@ -155,12 +161,15 @@ def initial_state_function(
     model (``x1``, ...) or ``e<i>`` for the effort ``(H x)_i``; an expression is a
     formula in ``z`` and the model's parameters (``sin(pi*z)``, ``z - 0.9``).  Components
     not mentioned are zero.  Expressions are parsed with the symbolic layer's safe parser
-    (no ``eval`` of user text).  Efforts and states cannot be mixed.
+    (no ``eval`` of user text).  Efforts and states cannot be mixed.  A coupled model's
+    boundary states are named as :mod:`phdesign.numeric.boundary_start` says
+    (``mass momentum: 0.5``; numbers or parameters, no ``z``).
 
     Returns
     -------
     callable
-        ``f(z) -> (m, n)``, the state x at the points z.
+        ``f(z) -> (m, n)``, the state x at the points z (a
+        :class:`~phdesign.numeric.boundary_start.CoupledInitialState` with boundary states).
 
     Examples
     --------
@@ -188,7 +197,8 @@ def initial_state_function(
     efforts = {f"e{i + 1}": i for i in range(n)}
     exprs: dict[int, Any] = {}
     kind: str | None = None
-    for part in _split_top_level(text):
+    parts, boundary = boundary_items(split_top_level(text), nm)
+    for part in parts:
         if ":" not in part:
             raise ParameterError(
                 f"{what} item {part.strip()!r}: expected 'name: expression', "
@@ -201,6 +211,7 @@ def initial_state_function(
             this, idx = "e", efforts[key]
         else:
             known = ", ".join([*nm.state_names, *(f"x{i + 1}" for i in range(n)), *efforts])
+            known += "".join(f", {name}" for name in boundary_names(nm.boundary))
             raise ParameterError(f"{what}: unknown component {key!r}; expected one of {known}")
         if kind is not None and this != kind:
             raise ParameterError(f"{what}: give either state components or efforts, not both")
@@ -221,26 +232,8 @@ def initial_state_function(
             out = np.linalg.solve(nm.H_at(zz), out[:, :, None])[:, :, 0]
         return out
 
-    return x0
-
-
-def _split_top_level(text: str) -> list[str]:
-    """Split on commas that are not inside parentheses or brackets."""
-    parts: list[str] = []
-    cur: list[str] = []
-    depth = 0
-    for ch in text:
-        if ch in "([":
-            depth += 1
-        elif ch in ")]":
-            depth -= 1
-        if ch == "," and depth == 0:
-            parts.append("".join(cur))
-            cur = []
-        else:
-            cur.append(ch)
-    parts.append("".join(cur))
-    return [p for p in parts if p.strip()]
+    parse = partial(_parse_z_expression, nm=nm, model=model, parameters=parameters)
+    return with_boundary_states(x0, constants(boundary, parse, what), nm, what)
 
 
 def _exact_value(value: Any) -> Any:
@@ -370,7 +363,7 @@ def input_function(
 
     names = {name: i for i, name in enumerate(kind.names)}
     funcs: dict[int, Callable[[float], Any]] = {}
-    for part in _split_top_level(text):
+    for part in split_top_level(text):
         if ":" not in part:
             raise ParameterError(
                 f"{arg} item {part.strip()!r}: expected '{kind.argument}<i>: expression in t', "

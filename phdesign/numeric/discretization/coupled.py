@@ -24,7 +24,8 @@ The off-diagonal block is skew, so the result is again a
 is built) whose energy :math:`\tfrac12\hat e^\top E\hat e + \sum H_c` obeys
 :math:`\dot H = -\hat e^\top R\hat e - e_c^\top R_c e_c + u_r^\top y_r + w^\top z_c` to
 round-off.  The appended coordinates are zero in every field basis (they are no part of
-the PDE's state) and in a projected initial state (the boundary systems start at rest);
+the PDE's state); a projected initial state appends :math:`e_c(0) = Q_c x_c(0)` of a
+:class:`~phdesign.numeric.boundary_start.CoupledInitialState` (at rest otherwise);
 ``info["boundary_states"]`` says where they are (``(first index, count)``) and
 ``info["boundary_labels"]`` what they are.
 """
@@ -38,6 +39,8 @@ from typing import Any
 import numpy as np
 from scipy.linalg import block_diag
 
+from phdesign.numeric.boundary import NumericBoundary
+from phdesign.numeric.boundary_start import boundary_efforts
 from phdesign.numeric.discretization.feedback import close_ports
 from phdesign.numeric.discretization.phs import DiscretePHS
 
@@ -89,7 +92,7 @@ def _append(d: DiscretePHS, static: DiscretePHS) -> DiscretePHS:
         B=B,
         D=D,
         effort_basis=_padded(static.effort_basis, extra),
-        project=_projected(static.project, extra),
+        project=_projected(static.project, nm.boundary),
         displacement_basis=None
         if static.displacement_basis is None
         else _padded(static.displacement_basis, extra),
@@ -112,10 +115,11 @@ def _padded(
 
 
 def _projected(
-    project: Callable[[Callable[[np.ndarray], np.ndarray]], np.ndarray], extra: int
+    project: Callable[[Callable[[np.ndarray], np.ndarray]], np.ndarray],
+    boundaries: tuple[NumericBoundary, ...],
 ) -> Callable[[Callable[[np.ndarray], np.ndarray]], np.ndarray]:
     def projected(x0: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-        return np.concatenate([np.asarray(project(x0)), np.zeros(extra)])
+        return np.concatenate([np.asarray(project(x0)), boundary_efforts(boundaries, x0)])
 
     return projected
 

@@ -51,6 +51,7 @@ import numpy as np
 
 from phdesign.core.errors import ArgumentError, NumericError
 from phdesign.core.progress import report
+from phdesign.numeric.boundary_start import difference
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_simulate_arguments
 from phdesign.numeric.discretization.functionals import Functional, disturbance_matrix
@@ -210,7 +211,7 @@ def simulate(
     error = None
     if C_m is not None and L is not None:
         K = feedback_matrix(C_m, L, nm.n_ports)
-        e0 = _difference(start, xhat0 or _zero(nm))
+        e0 = difference(start, xhat0 or _zero(nm))
         error = _error_run(nm, d, K, e0, step, opts.check_resolution, forcing)
     return _result(nm, _Run(d, opts, step.t, U, plant, error, at, forcing.W))
 
@@ -426,12 +427,3 @@ def _info(run: _Run, audits: dict[str, float]) -> dict[str, Any]:
             info[f"midpoint_substeps_{key}"] = traj.substeps
             info[f"midpoint_error_estimate_{key}"] = traj.error_estimate
     return info
-
-
-def _difference(f: InitialState, g: InitialState) -> InitialState:
-    """Return the initial estimation error x0 - xhat0 (the projection is linear)."""
-
-    def diff(z: np.ndarray) -> np.ndarray:
-        return np.asarray(np.asarray(f(z), dtype=float) - np.asarray(g(z), dtype=float))
-
-    return diff
