@@ -24,7 +24,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["plot_simulation"]
+__all__ = ["plot_boundary_states", "plot_simulation"]
 
 
 def plot_simulation(
@@ -41,8 +41,10 @@ def plot_simulation(
     :math:`w - \hat w` (of :math:`w` without an observer), the end tip replaced by the
     point outputs (:func:`plot_at`) when the run has ``at``; otherwise the outputs
     :math:`y` and :math:`\hat y` (:func:`plot_outputs`) and the output error
-    :math:`|y - \hat y|` on a log scale.  A loop's run (its ``u``) adds a bottom row: the
-    control input :math:`u_a(t) = -K \hat y_a(t)` of each actuated input.
+    :math:`|y - \hat y|` on a log scale.  A loop's run (its ``u``) adds a row: the
+    control input :math:`u_a(t) = -K \hat y_a(t)` of each actuated input; a model with
+    boundary systems adds a row: their states :math:`x_c(t)` beside the observer's
+    estimates :math:`\hat x_c(t)` (:func:`plot_boundary_states`).
 
     Parameters
     ----------
@@ -66,18 +68,27 @@ def plot_simulation(
     """
     has_w = getattr(result, "w", None) is not None
     has_at = getattr(result, "at_values", None) is not None
-    has_u = getattr(result, "u", None) is not None
+    wide = [
+        draw
+        for draw, present in (
+            (_plot_control_input, getattr(result, "u", None) is not None),
+            (plot_boundary_states, getattr(result, "x_c", None) is not None),
+        )
+        if present
+    ]
     if title is None:
         title = getattr(result, "title", None)
-    rows, height = (3, 10.5) if has_u else (2, 7.5)
-    frame = drawing(path, force=force, title=title, nrows=rows, ncols=2, figsize=(11, height))
+    rows = 2 + len(wide)
+    frame = drawing(
+        path, force=force, title=title, nrows=rows, ncols=2, figsize=(11, 7.5 + 3.0 * len(wide))
+    )
     with frame as (fig, axes):
         plot_hamiltonians(result, axes[0])
-        if has_u:
-            grid = axes[2, 0].get_gridspec()
-            axes[2, 0].remove()
-            axes[2, 1].remove()
-            _plot_control_input(result, fig.add_subplot(grid[2, :]))
+        for row, draw in enumerate(wide, start=2):
+            grid = axes[row, 0].get_gridspec()
+            axes[row, 0].remove()
+            axes[row, 1].remove()
+            draw(result, fig.add_subplot(grid[row, :]))
         measured = _measured_outputs(result)
         if has_at:
             plot_at(result, axes[1, 0])
@@ -112,6 +123,31 @@ def _plot_control_input(result: Any, ax: Axes) -> None:
         xlabel=unit_label(result, "time t", "t"),
         ylabel="control input u",
         title="control input u(t)",
+    )
+    ax.grid(True, alpha=0.3)
+    legend_in_view(ax, fontsize="small")
+
+
+def plot_boundary_states(result: Any, ax: Axes) -> None:
+    r"""Draw the boundary systems' states :math:`x_c(t)` (solid) and estimates (dashed).
+
+    The states are the model's own (a mass's momentum, a winding's flux), as
+    ``result.x_c`` and ``result.x_c_hat`` hold them, one colour per state.
+    """
+    t = require(result, "t", "no time grid")
+    x_c = require(result, "x_c", "no boundary states (the model has no boundary systems)")
+    x_c_hat = getattr(result, "x_c_hat", None)
+    for k, label in enumerate(result.boundary_labels):
+        color = DESIGN_COLORS[k % len(DESIGN_COLORS)]
+        ax.plot(t, x_c[:, k], color=color, label=literal(label))
+        if x_c_hat is not None:
+            ax.plot(t, x_c_hat[:, k], color=color, ls="--", label=literal(f"{label}, estimate"))
+    ax.set(
+        xlabel=unit_label(result, "time t", "t"),
+        ylabel="boundary state x_c",
+        title="boundary systems: states and estimates"
+        if x_c_hat is not None
+        else "boundary systems: states",
     )
     ax.grid(True, alpha=0.3)
     legend_in_view(ax, fontsize="small")

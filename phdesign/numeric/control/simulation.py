@@ -32,6 +32,7 @@ from phdesign.core.progress import report
 from phdesign.core.text import html_table
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.control.assembly import LoopSystem, NumericLoop, assemble
+from phdesign.numeric.discretization.coupled import boundary_series
 from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import discretize
@@ -284,4 +285,5 @@ def _result(
         warnings=warnings,
         units=dict(nm.units),
         **point_series(at, d, eh, eh - err),
+        **boundary_series(d, eh, eh - err),
     )

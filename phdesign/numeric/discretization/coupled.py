@@ -44,7 +44,7 @@ from phdesign.numeric.boundary_start import boundary_efforts
 from phdesign.numeric.discretization.feedback import close_ports
 from phdesign.numeric.discretization.phs import DiscretePHS
 
-__all__ = ["close_and_couple"]
+__all__ = ["boundary_series", "close_and_couple"]
 
 
 def close_and_couple(d: DiscretePHS) -> DiscretePHS:
@@ -131,3 +131,34 @@ def _fields(
         return _padded(field_basis(spec), extra)
 
     return fields
+
+
+def boundary_series(
+    d: DiscretePHS,
+    states: np.ndarray,
+    states_hat: np.ndarray | None = None,
+    d_hat: DiscretePHS | None = None,
+) -> dict[str, Any]:
+    r"""Return the boundary states of a run, as the fields of a simulation result.
+
+    ``x_c`` = :math:`x_c(t) = E_c e_c(t)` (the model's own states: a mass's momentum) from
+    the states X ``(nt, dim)`` on ``d``, ``x_c_hat`` likewise for the observer's on
+    ``d_hat`` (default ``d``; None when the observer's coordinates are not a
+    discretization's, as a reduced observer's), and ``boundary_labels``.  Empty for a
+    model without boundary systems: the result's defaults stand.
+    """
+    if "boundary_states" not in d.info:
+        return {}
+
+    def series(disc: DiscretePHS, X: np.ndarray | None) -> np.ndarray | None:
+        if X is None or "boundary_states" not in disc.info or X.shape[1] != disc.dim:
+            return None
+        first, count = disc.info["boundary_states"]
+        block = slice(first, first + count)
+        return np.asarray(X[:, block] @ disc.E[block, block].T)
+
+    return {
+        "boundary_labels": tuple(d.info["boundary_labels"]),
+        "x_c": series(d, states),
+        "x_c_hat": series(d if d_hat is None else d_hat, states_hat),
+    }

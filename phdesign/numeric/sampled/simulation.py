@@ -26,6 +26,7 @@ from phdesign.core.errors import NumericError
 from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_periods
+from phdesign.numeric.discretization.coupled import boundary_series
 from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.points import point_outputs, point_series
@@ -199,4 +200,5 @@ def _result(
         },
         warnings=warnings,
         **point_series(at, plant, run.x, run.xhat, d_obs),
+        **boundary_series(plant, run.x, run.xhat, d_obs),
     )

@@ -88,6 +88,10 @@ class SimulationResult(SimulationDisplay):
         (:mod:`phdesign.numeric.discretization.points`).
     at_values, at_values_hat : ndarray (nt, len(at)) or None
         Their values on the plant and their estimates by the observer.
+    boundary_labels : tuple of str
+        A coupled model's boundary states (:mod:`phdesign.numeric.discretization.coupled`).
+    x_c, x_c_hat : ndarray (nt, len(boundary_labels)) or None
+        Their values :math:`x_c(t)` on the plant and the observer's estimates.
     """
 
     t: np.ndarray
@@ -112,6 +116,9 @@ class SimulationResult(SimulationDisplay):
     at: tuple[str, ...] = ()
     at_values: np.ndarray | None = None
     at_values_hat: np.ndarray | None = None
+    boundary_labels: tuple[str, ...] = ()
+    x_c: np.ndarray | None = None
+    x_c_hat: np.ndarray | None = None
 
     def at_columns(self) -> list[tuple[str, np.ndarray]]:
         """Return ``(name, series)`` of each point output, then of each estimate.
@@ -123,6 +130,16 @@ class SimulationResult(SimulationDisplay):
         cols = [(name, self.at_values[:, k]) for k, name in enumerate(self.at)]
         if self.at_values_hat is not None:
             cols += [(_hat(name), self.at_values_hat[:, k]) for k, name in enumerate(self.at)]
+        return cols
+
+    def boundary_columns(self) -> list[tuple[str, np.ndarray]]:
+        """Return ``(label, series)`` of each boundary state, then of each estimate (``_hat``)."""
+        if self.x_c is None:
+            return []
+        cols = [(label, self.x_c[:, k]) for k, label in enumerate(self.boundary_labels)]
+        if self.x_c_hat is not None:
+            hats = enumerate(self.boundary_labels)
+            cols += [(f"{label}_hat", self.x_c_hat[:, k]) for k, label in hats]
         return cols
 
     def to_dict(self) -> dict[str, Any]:
@@ -147,6 +164,8 @@ class SimulationResult(SimulationDisplay):
         if self.at:
             out["at"] = list(self.at)
             out["at_values"] = {name: _finite_list(v) for name, v in self.at_columns()}
+        if self.x_c is not None:
+            out["boundary_states"] = {n: _finite_list(v) for n, v in self.boundary_columns()}
         out.update(
             {
                 k: _json_safe(v)
@@ -165,7 +184,8 @@ class SimulationResult(SimulationDisplay):
     def to_csv(self) -> str:
         """CSV: t, H, H_hat, H_err, y_i, y_hat_i, the tip displacement w(b), ŵ(b), then ``at``.
 
-        The point outputs ``at`` follow as ``rotation(1)``, then ``rotation_hat(1)``.
+        The point outputs ``at`` follow as ``rotation(1)``, then ``rotation_hat(1)``, and
+        the boundary states as ``mass momentum``, then ``mass momentum_hat``.
         """
         cols: list[tuple[str, np.ndarray]] = [("t", self.t), ("H", self.H)]
         if self.H_hat is not None and self.H_err is not None:
@@ -179,7 +199,7 @@ class SimulationResult(SimulationDisplay):
             cols.append(("w_tip", self.w[:, -1]))
             if self.w_hat is not None:
                 cols.append(("w_hat_tip", self.w_hat[:, -1]))
-        cols += self.at_columns()
+        cols += self.at_columns() + self.boundary_columns()
         buf = io.StringIO()
         writer = csv.writer(buf, lineterminator="\n")
         writer.writerow([c[0] for c in cols])

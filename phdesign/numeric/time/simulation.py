@@ -54,6 +54,7 @@ from phdesign.core.progress import report
 from phdesign.numeric.boundary_start import difference
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_simulate_arguments
+from phdesign.numeric.discretization.coupled import boundary_series
 from phdesign.numeric.discretization.functionals import Functional, disturbance_matrix
 from phdesign.numeric.discretization.phs import ClosedLoop
 from phdesign.numeric.discretization.points import point_outputs, point_series
@@ -372,6 +373,7 @@ def _result(nm: NumericModel, run: _Run) -> SimulationResult:
         resolved_until=None if error is None else error.until,
         units=dict(nm.units),
         **point_series(run.at, d, eh, eo),
+        **boundary_series(d, eh, eo),
     )
 
 

@@ -54,6 +54,7 @@ import scipy.linalg as sl
 from phdesign.core.errors import NumericError, ObserverError
 from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
+from phdesign.numeric.discretization.coupled import boundary_series
 from phdesign.numeric.discretization.functionals import Functional, disturbance_matrix
 from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
@@ -282,4 +283,5 @@ def _noisy_series(
         changes["w"] = eh @ Wd.T
         if "states_hat" in changes:
             changes["w_hat"] = changes["states_hat"] @ Wd.T
-    return {**changes, **point_series(at, d, eh, changes.get("states_hat"))}
+    hat = changes.get("states_hat")
+    return {**changes, **point_series(at, d, eh, hat), **boundary_series(d, eh, hat)}
