@@ -52,7 +52,6 @@ from typing import TYPE_CHECKING, Any
 
 import sympy
 
-from phdesign.core.errors import ObserverError
 from phdesign.core.text import html_table, matrix_text, sensors_text
 from phdesign.symbolic.boundary_systems import coupling
 from phdesign.symbolic.closing import close_inputs
@@ -141,7 +140,7 @@ class CoupledClassification:
             "order": self.model.order,
             "size": self.model.size,
             "sensors": [[float(x) for x in row] for row in self.C_m.tolist()],
-            "gain": [[float(x) for x in row] for row in self.L.tolist()],
+            "gain": [[_entry(x) for x in row] for row in self.L.tolist()],
             "partitioned": False,
             "boundary_systems": [bs.name for bs in self.model.boundary_systems],
             "results": [r.to_dict() for r in self.results],
@@ -193,25 +192,29 @@ class CoupledClassification:
 def classify_coupled(
     model: BCPHS, C_m: Any, L: Any, method: str, static: StaticClassifier
 ) -> CoupledClassification:
-    """Classify the observer ``(C_m, L)`` of the coupled ``model`` (module docstring).
+    r"""Classify the observer ``(C_m, L)`` of the coupled ``model`` (module docstring).
 
     ``static`` classifies the static part (the PDE with :math:`u_p = -K y_p`) by the
     propositions.
 
+    Symbolic gains (``"symbolic"``: positive :math:`l_i`) are classified as the
+    propositions classify them: the asymptotic test does not involve L (on an
+    imaginary-axis eigenvector :math:`\tilde y_m^\top \operatorname{sym}(L)\tilde y_m = 0`
+    gives :math:`C_m \tilde y_{ext} = 0` for every :math:`L + L^\top \succ 0`), and the
+    exponential theorem's static part is Proposition 3.2 with the symbolic gain, whose
+    range of gains the reason states.
+
     Raises
     ------
     ObserverError
-        Bad sensors or gain, or a symbolic gain (the coupled verdict needs numbers).
+        Bad sensors or gain.
     """
     C, Lm = sensors_and_gain(C_m, L, model.n_ports)
-    if (C.free_symbols | Lm.free_symbols) - {s for s, _ in model.parameters}:
-        raise ObserverError(
-            "gain: a model with boundary systems is classified at numeric gains; found "
-            f"symbols in L = {matrix_text(Lm)}"
-        )
     defaults = model.parameter_defaults
     C, Lm = (sympy.Matrix(M).xreplace(defaults) for M in (C, Lm))
     asymptotic = _asymptotic(model, C, Lm)
+    if Lm.free_symbols and asymptotic.holds:  # its conditions do not involve L
+        asymptotic = replace(asymptotic, reason=f"{asymptotic.reason} (for all positive gains)")
     exponential = _exponential(model, C, Lm, method, static)
     if exponential.holds and not asymptotic.holds:  # a hypothesis kept for safety: no iR mode
         exponential = replace(
@@ -422,6 +425,7 @@ def _exponential(
             "Proposition 3.2 fails for the static part u_p = -K y_p (the dissipation inequality)"
         )
     best = max(holding, key=lambda r: r.kappa_float or 0.0)
+    conditions = f"; {best.conditions}" if best.conditions else ""
     return TheoremResult(
         "RLMZ",
         EXPONENTIAL,
@@ -429,7 +433,7 @@ def _exponential(
         True,
         True,
         f"boundary systems strictly input passive and Hurwitz; the static part satisfies "
-        f"Proposition 3.2 variant {best.variant} (κ* = {best.kappa_text})",
+        f"Proposition 3.2 variant {best.variant} (κ* = {best.kappa_text}{conditions})",
         kappa=best.kappa_float,
     )
 
@@ -457,3 +461,8 @@ def _free_traces(model: BCPHS, N: sympy.Matrix) -> str:
 def _end(model: BCPHS, end: str) -> str:
     a, b = model.interval
     return str(a if end == "a" else b)
+
+
+def _entry(x: sympy.Expr) -> float | str:
+    """Return a gain entry for the JSON: a float, or the expression as text (symbolic)."""
+    return str(x) if x.free_symbols else float(x)

@@ -68,6 +68,7 @@ from phdesign.symbolic.search_kappa import (
     subset_kappas,
 )
 from phdesign.symbolic.search_result import Candidate, SensorSearch, SubsetResult
+from phdesign.symbolic.sensors import gain_symbols
 from phdesign.symbolic.system import require_model
 
 __all__ = ["candidates", "search_sensors"]
@@ -190,15 +191,12 @@ def _coupled_search(model: BCPHS, gains: tuple[sympy.Expr, ...] | None) -> Senso
     """Classify every subset of a coupled model's outputs (the boundary systems' too).
 
     Each subset is classified by :func:`~phdesign.symbolic.coupled_classify.classify_coupled`
-    with the diagonal gains it measures (numbers: the theorems' hypotheses are checked at
-    them).
+    with the diagonal gains it measures: numbers, or (``gains`` None) the positive symbols
+    ``l_j`` of the outputs j it measures.
     """
-    if gains is None:
-        raise ObserverError(
-            "gain: the sensor search of a model with boundary systems needs numeric gains; "
-            "found 'symbolic'"
-        )
     nn = model.n_ports
+    symbolic = gains is None
+    gains = gain_symbols(nn) if gains is None else gains
     total = 2**nn - 1
     verdict_code = [VERDICTS.index("inconclusive")] * (total + 1)
     results = []
@@ -223,7 +221,7 @@ def _coupled_search(model: BCPHS, gains: tuple[sympy.Expr, ...] | None) -> Senso
         model=model.name,
         order=model.order,
         size=model.size,
-        gains=tuple(number_text(g) for g in gains),
+        gains=tuple("symbolic" if symbolic else number_text(g) for g in gains),
         candidates=(),
         subsets=tuple(results),
         minimal=_minimal_sets(verdict_code, VERDICTS, nn),

@@ -7,7 +7,6 @@ import json
 import pytest
 
 from phdesign.cli import main
-from phdesign.core.errors import ObserverError
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.spectrum.converged import spectrum
@@ -125,6 +124,24 @@ def test_classify_json_keeps_the_contract(capsys):
     assert data["results"][1]["holds"] is True
 
 
-def test_symbolic_gains_are_refused_for_coupled_models():
-    with pytest.raises(ObserverError, match="classified at numeric gains"):
-        classify(load_builtin("string-tip-mass"), sensor_matrix([2], 2), "symbolic")
+def test_symbolic_gains_on_coupled_models():
+    # The asymptotic test does not involve L (sym(L) > 0 only turns y~_m^T sym(L) y~_m = 0
+    # into C_m y~ = 0), so the tip-mass string is asymptotic for every positive l1, as at
+    # the numeric gains below; never exponential.
+    tip = load_builtin("string-tip-mass")
+    symbolic = classify(tip, sensor_matrix([2], 2), "symbolic")
+    assert symbolic.verdict == "asymptotic"
+    assert symbolic.results[1].reason.endswith("(for all positive gains)")
+    assert symbolic.to_dict()["gain"] == [["l1"]]
+    for l1 in (0.3, 3):
+        assert classify(tip, sensor_matrix([2], 2), [l1]).verdict == "asymptotic"
+    found = search_sensors(tip, gain="symbolic")
+    assert found.minimal == {"exponential": (), "asymptotic": ((1,), (2,)), "inconclusive": ()}
+    assert "depends on L" not in str(found)  # the asymptotic theorem has no κ*
+    # The Maxwell end with the sensor y1 = -e2(0): the static part has the injection
+    # e1(0) = l1 e2(0), so -u~^T y~ >= l1 e2(0)^2 and ||e~(0)||^2 = (1 + l1^2) e2(0)^2:
+    # Proposition 3.2 variant 1 with kappa* = l1/(l1^2 + 1) for every l1 > 0 (by hand)
+    result = classify(string_with_maxwell_end(d=1), sensor_matrix([1], 1), "symbolic")
+    assert result.verdict == "exponential"
+    assert result.best.name == "RLMZ"
+    assert "variant 1 (κ* = l1/(l1**2 + 1); holds for all positive l1)" in result.best.reason
