@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 import sympy
 
 from phdesign.core.text import REPR_LIMIT, html_table, number_text, shorten
+from phdesign.symbolic.coupled_ports import coupled_ports_dict, coupled_ports_text
 from phdesign.symbolic.disturbances import disturbance_lines
 from phdesign.symbolic.feedback import external_numbering
 from phdesign.symbolic.printing import format_expression
@@ -160,6 +161,7 @@ def ports_dict(ports: Ports) -> dict[str, Any]:
         "W_C": rows(ports.W_C),
         "identities": {key: float(value) for key, value in ports.identities.items()},
         "feedback": None if closed is None else closed.to_dict(),
+        **({} if m is None else coupled_ports_dict(m)),
     }
 
 
@@ -179,6 +181,8 @@ def ports_text(ports: Ports) -> str:
     closed = _closed(ports)
     if closed is not None:  # the plant's own dampers close some of the ports
         lines.append(str(closed))
+    if ports.model is not None:
+        lines += coupled_ports_text(ports.model)
     return "\n".join(lines)
 
 

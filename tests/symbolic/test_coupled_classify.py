@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import pytest
+from string_models import string_with_maxwell_end
 
 from phdesign.cli import main
 from phdesign.models import load_builtin
@@ -12,36 +13,8 @@ from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.spectrum.converged import spectrum
 from phdesign.symbolic.classify import classify
 from phdesign.symbolic.coupled_classify import ASYMPTOTIC, EXPONENTIAL
-from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import sensor_matrix
 from phdesign.symbolic.search import search_sensors
-
-
-def string_with_maxwell_end(d=1):
-    """A string whose end z = 1 (a force port) carries a spring k in series with a damper r
-    and a parallel damper d: x_c = spring elongation, x_c' = -r k x_c + u_c (u_c = the end's
-    velocity), y_c = k x_c + d u_c the force; e2(1) = -y_c. Strictly input passive (d > 0)."""
-    return BCPHS.define(
-        name="string with a Maxwell end",
-        interval=(0, 1),
-        order=1,
-        P={1: [[0, 1], [1, 0]]},
-        H=[[1, 0], [0, 1]],
-        inputs=["e1(0)", "e2(1)"],
-        outputs=["-e2(0)", "e1(1)"],
-        parameters={"d": d},
-        boundary_systems=[
-            {
-                "name": "end",
-                "ports": [2],
-                "J": [[0]],
-                "R": [[1]],
-                "Q": [[2]],
-                "G": [[1]],
-                "D": [["d"]],
-            }
-        ],
-    )
 
 
 @pytest.mark.parametrize("sensors", [[], [1], [2], [1, 2]])
