@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import phdesign as phd
 
@@ -57,10 +58,9 @@ def test_observer_based_control_through_the_motor():
     )
 
 
+@pytest.mark.slow  # three converged spectra and three classifications: ~30 s under load
 def test_sweeps_over_the_mass():
     # every tip mass: no exponential decay (spectrum) and asymptotic by the ABLV test
-    import pytest
-
     pytest.importorskip("xarray", reason="install the sweep extra")
     model = phd.load("string-tip-mass")
     common = {"sensors": [2], "grid": {"l1": "1"}, "param_grid": {"m": "0.5:2:3"}}
