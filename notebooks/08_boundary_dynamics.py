@@ -29,6 +29,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import phdesign as phd
+from phdesign.plots import plot_boundary_states
 
 string = phd.load("string-tip-mass")
 print(string)
@@ -73,6 +74,24 @@ ax.set_ylabel("−Re λ")
 ax.set_title("string with a tip mass: the error's real parts approach 0")
 ax.legend()
 plt.show()
+
+# %% [markdown]
+# ## The mass's own state: where it starts, how it is estimated
+#
+# A boundary system's states start where the initial state names them (`mass momentum: 1`:
+# the mass moves, the string is at rest), the observer's estimates where its own initial
+# state says; `phdesign ports` lists the coupled system's external ports (here the force
+# at the clamp $y_1$ and the mass's velocity $y_2$). Measured at the clamp, the observer
+# recovers the mass's momentum, and the run's figure shows it beside its estimate.
+
+# %%
+print("\n".join(str(string.ports).splitlines()[-3:]))
+obs = phd.Observer(string, sensors=[1], gain=1)
+run = obs.simulate(x0="mass momentum: 1", xhat0="mass momentum: -0.5", t_end=10, samples=201)
+assert run.x_c[0, 0] == 1.0
+assert run.x_c_hat[0, 0] == -0.5
+assert abs(run.x_c[-1, 0] - run.x_c_hat[-1, 0]) < 1e-3 * abs(run.x_c[0, 0] - run.x_c_hat[0, 0])
+plot_boundary_states(run)
 
 # %% [markdown]
 # ## A flexible arm with a payload

@@ -286,6 +286,12 @@ COMMAND_ROWS = [
     row(f"{TIP} --x0 mass.x1:1,mass.x1:2", "boundary state 'mass.x1' given twice", ParameterError),
     row(f"{TIP} --xhat0 mass.x1:q", "unknown symbol 'q'", ExpressionError),
     row(f"{SIM} --x0 mass.x1:1", "unknown component 'mass.x1'", ParameterError),
+    row(
+        "export string-motor --sensors 2 --gain 1 --dt 0.01 --order 42 --format json "
+        "--output {tmp}/o.json",
+        r"order 42 is not a Galerkin order of this model: n \(p \+ 1\) \+ 1 with its n = 2",
+        NumericError,
+    ),
     row(f"{SIM} --t-end -1", "--t-end", NumericError),
     row(f"{SIM} --t-end 0", "--t-end", NumericError),
     row(f"{SIM} --t-end nan", "--t-end", NumericError),

@@ -63,7 +63,7 @@ from phdesign.plots.deflection import (
     plot_tip_error,
 )
 from phdesign.plots.energy import plot_error_energy, plot_hamiltonians
-from phdesign.plots.simulation import plot_simulation
+from phdesign.plots.simulation import plot_boundary_states, plot_simulation
 from phdesign.plots.spectra import plot_abscissa_sweep, plot_gain_map, plot_spectrum
 
 __all__ = [
@@ -73,6 +73,7 @@ __all__ = [
     "literal",
     "new_figure",
     "plot_abscissa_sweep",
+    "plot_boundary_states",
     "plot_deflection",
     "plot_deflection_panels",
     "plot_error_energy",

@@ -10,6 +10,7 @@ import numpy as np
 
 from phdesign.plots._figures import (
     DESIGN_COLORS,
+    axes_or_new,
     drawing,
     legend_in_view,
     literal,
@@ -128,15 +129,20 @@ def _plot_control_input(result: Any, ax: Axes) -> None:
     legend_in_view(ax, fontsize="small")
 
 
-def plot_boundary_states(result: Any, ax: Axes) -> None:
+def plot_boundary_states(result: Any, ax: Axes | None = None) -> Figure:
     r"""Draw the boundary systems' states :math:`x_c(t)` (solid) and estimates (dashed).
 
     The states are the model's own (a mass's momentum, a winding's flux), as
     ``result.x_c`` and ``result.x_c_hat`` hold them, one colour per state.
+
+    Returns
+    -------
+    Figure
     """
     t = require(result, "t", "no time grid")
     x_c = require(result, "x_c", "no boundary states (the model has no boundary systems)")
     x_c_hat = getattr(result, "x_c_hat", None)
+    fig, ax = axes_or_new(ax, figsize=(6, 3.5))
     for k, label in enumerate(result.boundary_labels):
         color = DESIGN_COLORS[k % len(DESIGN_COLORS)]
         ax.plot(t, x_c[:, k], color=color, label=literal(label))
@@ -151,6 +157,7 @@ def plot_boundary_states(result: Any, ax: Axes) -> None:
     )
     ax.grid(True, alpha=0.3)
     legend_in_view(ax, fontsize="small")
+    return fig
 
 
 def _measured_outputs(result: Any) -> list[int] | None:

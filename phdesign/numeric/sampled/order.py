@@ -66,11 +66,26 @@ from phdesign.numeric.spectrum.converged import eigen, spectrum
 __all__ = [
     "REDUCTIONS",
     "check_order",
+    "galerkin_offset",
     "select_order",
 ]
 
 #: Records of the continuous run that measures a candidate's performance floor.
 FLOOR_RECORDS = 500
+
+
+def galerkin_offset(nm: NumericModel) -> int:
+    """Return the states a Galerkin observer has beyond ``n (p + 1)`` at every degree p.
+
+    A coupled model's boundary systems add their states, and a port they join as a
+    velocity removes the trace it imposes (:mod:`phdesign.numeric.discretization.coupled`):
+    the string with a tip mass has ``2 (p + 1)`` states (``2 p + 1`` of the field, the
+    mass's one), the motor-driven string ``2 (p + 1) + 1``.  Zero for most models.
+    """
+    if not nm.boundary:
+        return 0
+    lowest = nm.order + 1
+    return discretize(nm, "galerkin", lowest).dim - nm.size * (lowest + 1)
 
 
 def check_order(
@@ -81,13 +96,15 @@ def check_order(
     reduction: str = "balanced",
     size: int = 1,
     smallest: int = 1,
+    offset: int = 0,
 ) -> int | None:
     """Return ``order`` as an int (or None) after checking it against the request.
 
     The verification plant must have at least twice the observer's states, so that the
     verification is against a model the observer cannot reproduce. Without a balanced
     truncation the order is that of a Galerkin observer, a multiple of the model's
-    ``size`` efforts and at least ``smallest``; a modal reduction fixes its own order.
+    ``size`` efforts plus ``offset`` (:func:`galerkin_offset`) and at least ``smallest``; a
+    modal reduction fixes its own order.
 
     Examples
     --------
@@ -113,10 +130,11 @@ def check_order(
             "an explicit order cannot be combined with the modal reduction: the converged "
             "modes fix its order; use `reduction='none'` or `reduction='balanced'`"
         )
-    if reduction == "none" and (order % size or order < smallest):
+    if reduction == "none" and ((order - offset) % size or order < smallest):
+        shift = f" + {offset}" if offset > 0 else f" - {-offset}" if offset else ""
         raise NumericError(
-            f"order {order} is not a Galerkin order of this model: n (p + 1) with its n = "
-            f"{size} efforts and degree p >= N + 1 (at least {smallest}); use "
+            f"order {order} is not a Galerkin order of this model: n (p + 1){shift} with its "
+            f"n = {size} efforts and degree p >= N + 1 (at least {smallest}); use "
             "`reduction='balanced'` for any order"
         )
     return int(order)
@@ -179,15 +197,21 @@ def select_order(
     for name, value in (("tol", tol), ("output_tol", output_tol)):
         if not (math.isfinite(value) and value > 0):
             raise NumericError(f"{name} must be a finite positive number; found {value!r}")
-    n, N = nm.size, nm.order
+    n, N, offset = nm.size, nm.order, galerkin_offset(nm)
     order = check_order(
-        order, plant.dim, plant.resolution, reduction=reduction, size=n, smallest=n * (N + 2)
+        order,
+        plant.dim,
+        plant.resolution,
+        reduction=reduction,
+        size=n,
+        smallest=n * (N + 2) + offset,
+        offset=offset,
     )
     targets = _Targets.of(nm, C_m, L, plant, t_end, output_tol, count, reduction == "modal")
     trial = _Trial(nm, C_m, L, plant, x0, points, reduction, tol, output_tol, targets)
     candidates: list[Candidate] = []
     if order is not None:
-        degree = max(N + 1, -(-order // n) - 1)  # balanced: truncated from this degree
+        degree = max(N + 1, -(-(order - offset) // n) - 1)  # balanced: truncated from it
         found = _Found(degree, *trial.build(degree))
     else:
         found = _smallest_degree(trial, candidates)

@@ -42,7 +42,7 @@ from phdesign.core.errors import NumericError
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.phs import DiscretePHS
 from phdesign.numeric.discretization.registry import discretize
-from phdesign.numeric.sampled.order import check_order
+from phdesign.numeric.sampled.order import check_order, galerkin_offset
 from phdesign.numeric.sampled.runs import FLOOR_WINDOW, plant_targets
 from phdesign.numeric.sampled.samplers import ContinuousObserver
 from phdesign.numeric.spectrum.converged import default_resolutions
@@ -66,19 +66,23 @@ def verification_plant_degree(
     Checks the whole request first (:func:`phdesign.numeric.sampled.order.check_order`), so that a
     command refuses it before any computation.
     """
-    degree = _plant_degree(nm, order, plant_resolution)
+    offset = galerkin_offset(nm)
+    degree = _plant_degree(nm, order, plant_resolution, offset)
     check_order(
         order,
-        nm.size * (degree + 1),
+        nm.size * (degree + 1) + offset,
         degree,
         reduction=reduction,
         size=nm.size,
-        smallest=nm.size * (nm.order + 2),
+        smallest=nm.size * (nm.order + 2) + offset,
+        offset=offset,
     )
     return degree
 
 
-def _plant_degree(nm: NumericModel, order: int | None, plant_resolution: int | None) -> int:
+def _plant_degree(
+    nm: NumericModel, order: int | None, plant_resolution: int | None, offset: int = 0
+) -> int:
     if plant_resolution is not None:
         if isinstance(plant_resolution, bool) or not isinstance(plant_resolution, int):
             raise NumericError(f"plant_resolution must be an integer; found {plant_resolution!r}")
@@ -90,12 +94,12 @@ def _plant_degree(nm: NumericModel, order: int | None, plant_resolution: int | N
         return plant_resolution
     if order is None or isinstance(order, bool) or not isinstance(order, int) or order < 1:
         return current().export.plant_degree
-    needed = -(-2 * order // nm.size) - 1
+    needed = -(-(2 * order - offset) // nm.size) - 1
     largest = default_resolutions(nm, "galerkin")[1]
     if needed > largest:
         raise NumericError(
             f"order {order} needs a verification plant of at least {2 * order} states; the "
-            f"largest for this model has {nm.size * (largest + 1)} (Galerkin degree "
+            f"largest for this model has {nm.size * (largest + 1) + offset} (Galerkin degree "
             f"{largest}): lower the order"
         )
     return max(current().export.plant_degree, needed)
