@@ -20,6 +20,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 from phdesign.proofcheck.contour import (
+    centered_over,
     count_zeros,
     delta_over,
     overlapping,
@@ -46,8 +47,15 @@ def check_band(data: Delta, section: dict, claim: list | None, failures: list[st
     vertices = [(right, Fraction(0)), (right, omega), (left, omega), (left, Fraction(0))]
     segments = read_segments(section["path"])
     evaluate = delta_over(data)
+    tighter = centered_over(data)
     count = count_zeros(
-        evaluate, segments, vertices, symmetric=True, failures=failures, what="band"
+        evaluate,
+        segments,
+        vertices,
+        symmetric=True,
+        failures=failures,
+        what="band",
+        tighter=tighter,
     )
     if count is None:
         return
@@ -56,7 +64,7 @@ def check_band(data: Delta, section: dict, claim: list | None, failures: list[st
             f"band: the rectangle holds {count} zeros, the proof says {section['count']}"
         )
         return
-    squares = _squares(evaluate, section["enclosures"], left, right, omega, failures)
+    squares = _squares((evaluate, tighter), section["enclosures"], left, right, omega, failures)
     if squares is None:
         return
     enclosed = sum(m * (1 if sym else 2) for *_, m, sym in squares)
@@ -66,8 +74,14 @@ def check_band(data: Delta, section: dict, claim: list | None, failures: list[st
     _check_claim(squares, left, claim, failures, data.conservative)
 
 
-def _squares(evaluate, enclosures: list, left, right, omega, failures: list[str]) -> list | None:
-    """Verify the squares: each count, its place in the rectangle, no overlap."""
+def _squares(
+    evaluators: tuple, enclosures: list, left, right, omega, failures: list[str]
+) -> list | None:
+    """Verify the squares: each count, its place in the rectangle, no overlap.
+
+    ``evaluators``: the direct enclosure and the mean-value one tried where it fails.
+    """
+    evaluate, tighter = evaluators
     squares = []
     for index, square in enumerate(enclosures):
         what = f"band: square {index + 1}"
@@ -79,6 +93,7 @@ def _squares(evaluate, enclosures: list, left, right, omega, failures: list[str]
             failures=failures,
             what=what,
             prec=SQUARE_PRECISION,
+            tighter=tighter,
         )
         if found is None:
             return None

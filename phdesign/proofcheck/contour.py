@@ -22,10 +22,11 @@ from itertools import pairwise
 from mpmath.libmp import fzero, mpf_gt, mpf_lt
 
 from phdesign.proofcheck.exact import number
-from phdesign.proofcheck.intervals import PRECISION, box, delta
+from phdesign.proofcheck.intervals import PRECISION, box, centered_delta, delta
 
 __all__ = [
     "SPLITS",
+    "centered_over",
     "count_zeros",
     "delta_over",
     "overlapping",
@@ -67,18 +68,34 @@ def delta_over(data):
     return evaluate
 
 
-def _labels(evaluate, p: Point, q: Point, hint: int, depth: int, prec: int) -> list[int] | None:
-    value = evaluate(p, q, prec)
-    for label in (hint, *(x for x in range(4) if x != hint)):
-        if _holds(value, label):
-            return [label]
+def centered_over(data):
+    """Return the mean-value evaluator (:func:`.intervals.centered_delta`), for count_zeros."""
+
+    def evaluate(p: Point, q: Point, prec: int) -> tuple:
+        return centered_delta(data, p, q, prec)
+
+    return evaluate
+
+
+def _label(value: tuple, hint: int) -> int | None:
+    return next((x for x in (hint, *range(4)) if _holds(value, x)), None)
+
+
+def _labels(
+    evaluate, tighter, p: Point, q: Point, hint: int, depth: int, prec: int
+) -> list[int] | None:
+    label = _label(evaluate(p, q, prec), hint)
+    if label is None and tighter is not None:
+        label = _label(tighter(p, q, prec), hint)
+    if label is not None:
+        return [label]
     if depth == 0:
         return None
     m = ((p[0] + q[0]) / 2, (p[1] + q[1]) / 2)
-    first = _labels(evaluate, p, m, hint, depth - 1, prec)
+    first = _labels(evaluate, tighter, p, m, hint, depth - 1, prec)
     if first is None:
         return None
-    second = _labels(evaluate, m, q, hint, depth - 1, prec)
+    second = _labels(evaluate, tighter, m, q, hint, depth - 1, prec)
     return None if second is None else first + second
 
 
@@ -124,10 +141,13 @@ def count_zeros(
     failures: list[str],
     what: str,
     prec: int = PRECISION,
+    tighter=None,
 ) -> int | None:
     """Verify the path and its labels; return the number of zeros inside, or None.
 
-    ``evaluate(p, q, prec)`` encloses the function over the box of the segment p -> q.
+    ``evaluate(p, q, prec)`` encloses the function over the box of the segment p -> q;
+    ``tighter`` (same signature, e.g. :func:`centered_over`), if given, is tried on a
+    segment that ``evaluate`` does not separate from 0, before the segment is halved.
     """
     problem = _on_path(segments, vertices)
     if problem:
@@ -135,7 +155,7 @@ def count_zeros(
         return None
     labels: list[int] = []
     for p, q, hint in segments:
-        found = _labels(evaluate, p, q, hint, SPLITS, prec)
+        found = _labels(evaluate, tighter, p, q, hint, SPLITS, prec)
         if found is None:
             failures.append(
                 f"{what}: Δ is not separated from 0 on the segment {_text(p)} -> {_text(q)}"
@@ -164,7 +184,14 @@ def count_zeros(
 
 
 def square_count(
-    evaluate, square: dict, *, symmetric: bool, failures: list[str], what: str, prec: int
+    evaluate,
+    square: dict,
+    *,
+    symmetric: bool,
+    failures: list[str],
+    what: str,
+    prec: int,
+    tighter=None,
 ) -> tuple[Fraction, Fraction, Fraction, int] | None:
     """Verify a square of the proof (``center``, ``radius``, ``count``, ``path``).
 
@@ -190,6 +217,7 @@ def square_count(
         failures=failures,
         what=what,
         prec=prec,
+        tighter=tighter,
     )
     if found is None:
         return None

@@ -42,6 +42,9 @@ CLUSTER = 1e-6  # estimates whose real parts agree to this form the rightmost cl
 GRID = 2**20  # the left edge is a multiple of 2^-20
 PRECISION = 96  # bits, for the long contour
 ENCLOSURE_PRECISION = 160  # bits, for the small squares
+#: The long contour uses the mean-value form only on segments this short (where halving
+#: no longer helps: near a multiple zero); longer ones are halved instead.
+CENTERED_BELOW = Fraction(1, 2**10)
 
 
 @dataclass(frozen=True)
@@ -113,7 +116,7 @@ def certify_band(ch: Characteristic, band: float, estimates: Sequence[complex]) 
     zeros = _refined(ch, estimates, float(omega))
     left = _left_edge(zeros)
     with ctx.workprec(ENCLOSURE_PRECISION):
-        squares = [enclose_zero(ch.box, z, real=z.imag == 0) for z in zeros if z.real > left]
+        squares = [enclose_zero(ch, z, real=z.imag == 0) for z in zeros if z.real > left]
     corners = None
     for attempt in range(4):
         top = omega * (1 + Fraction(attempt, 2**10))
@@ -125,7 +128,9 @@ def certify_band(ch: Characteristic, band: float, estimates: Sequence[complex]) 
         }
         try:
             with ctx.workprec(PRECISION):
-                corners = certify_path(ch.box, vertices, **steps)
+                corners = certify_path(
+                    ch.box, vertices, steps, tighter=ch.centered, tighter_below=CENTERED_BELOW
+                )
             break
         except CertificateError:
             continue

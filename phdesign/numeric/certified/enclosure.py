@@ -8,8 +8,11 @@ argument principle (:mod:`.contour`) to hold :math:`m \ge 1` zeros: the zeros li
 :math:`r` of the centre in each coordinate, so their real parts are known to :math:`2r`.
 A square on the real axis is symmetric and counted by its upper half
 (:func:`~.contour.symmetric_count`).  A multiple zero (a coalescence) is found so, with
-its multiplicity, only where Newton's linear convergence still reaches the square; the
-square then grows (by 16, up to :data:`MAX_RADIUS`) until it holds a zero.
+its multiplicity: Newton converges linearly there but still reaches the square, and the
+square's segments are certified by the mean-value form (:meth:`.Characteristic.centered`)
+where the direct enclosure, whose width carries every term's size, cannot separate
+:math:`\Delta \approx c(\lambda - \lambda_0)^m` from 0.  Where no zero is found, the
+square grows (by 16, up to :data:`MAX_RADIUS`) until it holds one.
 """
 
 from __future__ import annotations
@@ -20,8 +23,8 @@ from fractions import Fraction
 from typing import Any
 
 from phdesign.core.errors import CertificateError
+from phdesign.numeric.certified.characteristic import Characteristic
 from phdesign.numeric.certified.contour import (
-    Enclose,
     Point,
     Segment,
     certify_path,
@@ -85,7 +88,7 @@ def square_path(center: Point, r: Fraction, symmetric: bool) -> list[Point]:
     return [(x + r, y - r), (x + r, y + r), (x - r, y + r), (x - r, y - r), (x + r, y - r)]
 
 
-def enclose_zero(enclose: Enclose, estimate: complex, *, real: bool) -> Enclosure:
+def enclose_zero(ch: Characteristic, estimate: complex, *, real: bool) -> Enclosure:
     """Prove a square about ``estimate`` to hold zeros (module docstring).
 
     Raises
@@ -100,7 +103,9 @@ def enclose_zero(enclose: Enclose, estimate: complex, *, real: bool) -> Enclosur
     while r <= MAX_RADIUS:
         steps: dict[str, Any] = {"first_step": r / 2, "max_step": 2 * r, "min_step": r / 2**12}
         try:
-            segments = certify_path(enclose, square_path((x, y), r, real), **steps)
+            segments = certify_path(
+                ch.box, square_path((x, y), r, real), steps, tighter=ch.centered
+            )
         except CertificateError:
             r *= 16
             continue

@@ -158,7 +158,7 @@ def certify_whole_plane(ch: Characteristic, tau: Fraction) -> WholePlane:
             r = ROOT_RADIUS
             corners = square_path((x, y), r, symmetric=False)
             steps = {"first_step": r / 2, "max_step": 2 * r, "min_step": r / 2**12}
-            segments = certify_path(_shifted(p, x, y), corners, **steps)
+            segments = certify_path(_shifted(p, x, y), corners, steps)
             count = closed_count(segments)
             if count != multiplicity:
                 raise CertificateError(f"the square about the root {root} holds {count} roots")

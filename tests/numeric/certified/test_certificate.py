@@ -25,6 +25,9 @@ from phdesign.core.errors import CertificateError
 from phdesign.models import load_builtin
 from phdesign.numeric.bridge import to_numeric
 from phdesign.proofcheck import check_proof
+from phdesign.proofcheck.band import SQUARE_PRECISION
+from phdesign.proofcheck.contour import centered_over, delta_over, square_count
+from phdesign.proofcheck.system import derive
 from phdesign.symbolic.model import BCPHS
 
 WIDTH = 1e-10
@@ -141,6 +144,67 @@ def test_degenerate_cases_are_stated():
     holds(double, 0.5 * math.log(1 / 3))
     assert any("multiplicity 2" in n for n in double.notes)
     assert check_proof(double.proof) == []
+
+
+def twin_damped_strings(d: str) -> BCPHS:
+    """Two identical strings (ρ = T = 1 on [0, 1], fixed at 0) with viscous damping d."""
+    return BCPHS.define(
+        name="two damped strings",
+        interval=[0, 1],
+        order=1,
+        P={
+            0: [[f"-{d}", 0, 0, 0], [0, 0, 0, 0], [0, 0, f"-{d}", 0], [0, 0, 0, 0]],
+            1: [[0, 1, 0, 0], [1, 0, 0, 0], [0, 0, 0, 1], [0, 0, 1, 0]],
+        },
+        H=[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],
+        inputs=["e1(0)", "e3(0)", "e2(1)", "e4(1)"],
+        outputs=["-e2(0)", "-e4(0)", "e1(1)", "e3(1)"],
+    )
+
+
+@pytest.mark.slow
+def test_a_multiple_zero_in_a_band_is_enclosed_with_its_multiplicity():
+    # P0 ≠ 0 takes the band route (Δ is no polynomial in e^λ).  One string, momentum p and
+    # strain q: λp = q' - d p, λq = p', so q'' = κ² q with κ² = λ(λ + d); p(0) = 0 gives
+    # q = cosh κz, and the damper k at 1 (q(1) = -k p(1), p = q'/(λ + d)) gives
+    # f(λ) = (λ + d) cosh κ + k κ sinh κ = 0 (even in κ: entire in λ; λ = -d is a root of
+    # f but no eigenvalue unless kd = 1).  The twins' Δ is the square of one string's:
+    # every eigenvalue is double, and the direct enclosure, whose width carries every
+    # term's size, cannot separate Δ ≈ c(λ - λ0)² from 0 on a small square: the mean-value
+    # form must (before it, this certificate failed with "no zero could be enclosed").
+    d, k = 1, 0.5
+    cert = phd.Observer(twin_damped_strings("1"), sensors=[3, 4], gain=[k, k]).certify(band=3)
+    assert not cert.whole_plane
+    square = cert.proof["band"]["enclosures"][cert.proof["band"]["rightmost"][0]]
+    assert square["count"] == 2
+    assert any("multiple zero: 2 zeros" in n for n in cert.notes)
+    guess = complex(*(eval_fraction(x) for x in square["center"]))
+
+    def f(lam):
+        kappa = mpmath.sqrt(lam * (lam + d))
+        return (lam + d) * mpmath.cosh(kappa) + k * kappa * mpmath.sinh(kappa)
+
+    with mpmath.workdps(30):
+        root = mpmath.findroot(f, mpmath.mpc(guess))
+        assert abs(f(root)) < 1e-25
+    holds(cert, float(root.real))
+    assert check_proof(cert.proof) == []
+    # a proof that claims a simple zero there is rejected by the checker's own count (the
+    # square alone: the rectangle was verified above)
+    failures: list[str] = []
+    data = derive(cert.proof["system"], failures)
+    claimed_simple = {**square, "count": 1}
+    found = square_count(
+        delta_over(data),
+        claimed_simple,
+        symmetric=bool(square["symmetric"]),
+        failures=failures,
+        what="square",
+        prec=SQUARE_PRECISION,
+        tighter=centered_over(data),
+    )
+    assert found is None
+    assert failures == ["square holds 2 zeros, the proof says 1"]
 
 
 def test_z_dependent_models_are_refused_clearly():
