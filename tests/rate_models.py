@@ -1,7 +1,8 @@
 """Closed systems for the proved decay rate: exact error systems, and a transport.
 
-Shared by tests/numeric/certified/test_rate.py, tests/proofcheck/test_rate_check.py and
-benchmarks/rate.py.
+Shared by tests/numeric/certified/test_rate.py, test_rate_z.py,
+tests/proofcheck/test_rate_check.py and benchmarks/rate.py.  The z-dependent models'
+closed forms are derived in tests/numeric/certified/test_rate_z.py.
 """
 
 from __future__ import annotations
@@ -38,4 +39,27 @@ STRING_TWO_ENDS = BCPHS.define(
     H=[[1, 0], [0, 1]],
     inputs=["e2(0)", "e2(1)"],
     outputs=["-e1(0)", "e1(1)"],
+)
+
+# z-dependent coefficients (the proof of phdesign.numeric.certified.rate_poly)
+STRING_PORTS = {"inputs": ["e1(0)", "e2(1)"], "outputs": ["-e2(0)", "e1(1)"]}
+
+
+def string(name: str, H: list) -> BCPHS:
+    """A string fixed at 0 with a force input at 1 (u = e2(1), y = e1(1))."""
+    return BCPHS.define(
+        name=name, interval=[0, 1], order=1, P={1: [[0, 1], [1, 0]]}, H=H, **STRING_PORTS
+    )
+
+
+SPEED = string("string of speed 1 + z", [["1 + z", 0], [0, "1 + z"]])
+DENSITY = string("string of density 1 + z/2", [["1/(1 + z/2)", 0], [0, 1]])
+TRANSPORT_SPEED = BCPHS.define(
+    name="transport of speed 1 + z",
+    interval=[0, 1],
+    order=1,
+    P={1: [[1]]},
+    H=[["1 + z"]],
+    inputs=["e1(1) - e1(0)"],
+    outputs=["(e1(1) + e1(0))/2"],
 )

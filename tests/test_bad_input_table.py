@@ -28,6 +28,7 @@ from phdesign.core.errors import (
     ObserverError,
     OutputFileError,
     ParameterError,
+    RateProofError,
     SweepError,
 )
 
@@ -100,6 +101,12 @@ DAMPED_TIP = tomli_w.dumps(
         "performance": {"outputs": ["integral(e1)"]},
     }
 )
+
+
+def graded(H22: str) -> str:
+    """The graded string with its tension H22 replaced (the decay-rate refusals)."""
+    return GRADED.replace('"1 + z"', repr(H22).replace("'", '"'))
+
 
 BEAM_SENSORS = "classify euler-bernoulli --sensors"
 BEAM_GAIN = "classify euler-bernoulli --sensors 3,4 --gain"
@@ -1136,6 +1143,26 @@ COMMAND_ROWS = [
         "z-dependent coefficients",
         CertificateError,
         **{"graded.toml": GRADED},
+    ),
+    # the decay rate (issue 25, part 2): z-dependence only as rational functions of z with
+    # rational coefficients, order 1 only; refused before the SDP's work
+    row(
+        "certify {tmp}/sqrt.toml --sensors 2 --gain 1 --rate",
+        r"H\[2,2\] = sqrt\(z \+ 1\) is not a rational function of z",
+        RateProofError,
+        **{"sqrt.toml": graded("sqrt(1 + z)")},
+    ),
+    row(
+        "certify {tmp}/irrational.toml --sensors 2 --gain 1 --rate",
+        r"H\[2,2\] = .*sqrt\(2\).* has a coefficient that is not a rational number",
+        RateProofError,
+        **{"irrational.toml": graded("1 + sqrt(2)*z")},
+    ),
+    row(
+        "certify euler-bernoulli --sensors 3,4 --gain 0.1,1 --band 3 --rate",
+        "this model has order N = 2. For it phdesign proves the spectral bound",
+        RateProofError,
+        seconds=10,
     ),
     row("check {tmp}/missing.json", "cannot read the proof file", OutputFileError),
     row("check {tmp}/bad.json", "is not JSON", OutputFileError, **{"bad.json": "{not json"}),

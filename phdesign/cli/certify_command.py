@@ -123,7 +123,9 @@ def _verified_text(proof: dict) -> str:
     interval = claim.get("abscissa_interval")
     where = "the whole plane" if claim.get("whole_plane") else f"|Im λ| <= {claim.get('band')}"
     lines = ["verified: every claim of the proof file holds"]
-    if interval is None:
+    if "band" not in proof and "whole_plane" not in proof:
+        lines.append("  no spectrum section: the spectral abscissa is not claimed")
+    elif interval is None:
         lines.append(f"  no eigenvalue in {where} (right of the proof's left edge)")
     else:
         lo, hi = (float(Fraction(x)) for x in interval)

@@ -54,6 +54,12 @@ def certify_design(
     if band is not None:
         positive_number(band, "band")
     system = closed_system(plant.design_model, C_m, L)
+    if rate:  # refused before the spectrum's work
+        from phdesign.numeric.certified.rate_problem import require_first_order
+
+        require_first_order(system.name, system.order)
+    if rate and not system.constant:  # the decay rate alone (no spectrum certificate)
+        return certify(system, band=band, rate=rate)
     estimates: list[complex] = []
     beyond = ""
     whole = travel_time(characteristic(system), system.P[0].is_zero_matrix) is not None

@@ -16,10 +16,12 @@ def check_all(proof: dict) -> list[str]:
     if proof.get("version") != 1:
         return [f"unknown proof-file version {proof.get('version')!r}; this checker reads 1"]
     try:
+        claim = proof["claim"]
+        if "band" not in proof and "whole_plane" not in proof:
+            return _rate_only(proof, claim)
         data = derive(proof["system"], failures)
         if data is None:
             return failures
-        claim = proof["claim"]
         if "band" in proof:
             check_band(data, proof["band"], claim.get("abscissa_interval"), failures)
         if "whole_plane" in proof:
@@ -33,7 +35,20 @@ def check_all(proof: dict) -> list[str]:
     return failures
 
 
+def _rate_only(proof: dict, claim: dict) -> list[str]:
+    """Check a proof with no spectrum section (z-dependent coefficients): its rate alone."""
+    if "rate" not in proof:
+        return ["the proof file proves nothing: it has no band, whole-plane or rate section"]
+    if claim.get("abscissa_interval") is not None or claim.get("whole_plane"):
+        return ["the claim states a spectral abscissa, but the proof has no spectrum section"]
+    return _rate(proof["rate"])
+
+
 def _rate(section: dict) -> list[str]:
+    if isinstance(section, dict) and section.get("weight") == "polynomial":
+        from phdesign.proofcheck.rate_poly import check_rate_polynomial
+
+        return check_rate_polynomial(section)
     try:
         from phdesign.proofcheck.rate import check_rate
     except ImportError:

@@ -13,7 +13,9 @@ Either way the proof file (:mod:`.proof`) holds every ingredient, and
 ``phdesign check`` (:mod:`phdesign.proofcheck`) re-verifies it independently.  With
 ``rate=True`` the decay-rate prover of :mod:`phdesign.numeric.certified.rate` adds a
 proved :math:`\sigma` and :math:`M` with :math:`\|\tilde x(t)\| \le M e^{-\sigma t}
-\|\tilde x(0)\|`.
+\|\tilde x(0)\|`.  For z-dependent :math:`H` or :math:`P_0` only the rate is proved
+(the spectrum needs constant coefficients): the certificate then states no abscissa and
+says why.
 """
 
 from __future__ import annotations
@@ -120,9 +122,13 @@ def certify(
     Raises
     ------
     CertificateError
-        For z-dependent or irrational data, a singular :math:`P_N`, a system that is not
-        dissipative, a band certificate without a band, or a proof that fails.
+        z-dependent data (without ``rate``), irrational data, a singular :math:`P_N`, a
+        non-dissipative system, a band certificate without a band, or a failed proof.
+    RateProofError
+        With ``rate``: an order other than 1, or a rate that cannot be proved.
     """
+    if (alone := _rate_alone(system, rate, band)) is not None:
+        return alone
     ch = characteristic(system)
     _require_provable(system)
     proof: dict[str, Any] = {
@@ -167,6 +173,55 @@ def certify(
         whole_plane=tau is not None,
         rate=sigma,
         M=M,
+        assumptions=tuple(assumptions),
+        notes=tuple(notes),
+        system=system,
+        proof=proof,
+        rate_proof=rate_proof,
+    )
+
+
+#: Why a z-dependent system's certificate states no spectral abscissa.
+NO_SPECTRUM = (
+    "the spectrum is not certified: H or P0 depends on z, and the certified spectrum needs "
+    "constant coefficients (Δ = det(B_a + B_b e^{A(λ)ℓ})); only the decay rate is proved"
+)
+
+
+def _rate_alone(system: ExactClosedSystem, rate: bool, band: float | None) -> Certificate | None:
+    """Refuse an order other than 1 before any work; certify a z-dependent rate alone.
+
+    Without ``rate``, and for a constant system, None: the spectrum's certificate goes on.
+    """
+    if not rate:
+        return None
+    from phdesign.numeric.certified.rate_problem import require_first_order
+
+    require_first_order(system.name, system.order)
+    return None if system.constant else _rate_only(system, band)
+
+
+def _rate_only(system: ExactClosedSystem, band: float | None) -> Certificate:
+    """Certify a z-dependent system: the proved decay rate alone."""
+    rate_proof = _rate(system)
+    notes = [NO_SPECTRUM]
+    if band is not None:
+        notes.append(f"the band |Im λ| <= {band:g} asked for is not certified, for that reason")
+    assumptions = [COMMON[0], *rate_proof.assumptions]
+    proof: dict[str, Any] = {
+        "format": FORMAT,
+        "version": VERSION,
+        "system": system.to_dict(),
+        "claim": {"abscissa_interval": None, "band": None, "whole_plane": False},
+        "rate": rate_proof.to_json(),
+        "assumptions": assumptions,
+    }
+    return Certificate(
+        abscissa_interval=None,
+        band=None,
+        whole_plane=False,
+        rate=rate_proof.sigma,
+        M=rate_proof.M,
         assumptions=tuple(assumptions),
         notes=tuple(notes),
         system=system,

@@ -1,7 +1,9 @@
 r"""A proved decay rate for first-order closed systems: a Lyapunov functional checked exactly.
 
 For an :math:`N = 1` closed system with constant coefficients (strings, Timoshenko
-beams, coupled strings, transport; :mod:`.rate_problem`),
+beams, coupled strings, transport; :mod:`.rate_problem`; for :math:`z`-dependent
+:math:`\mathcal H(z)`, :math:`P_0(z)` the functional has a polynomial weight instead,
+:mod:`.rate_poly`),
 
 .. math::
 
@@ -51,6 +53,7 @@ proof file (:meth:`DecayRateProof.to_json`) is re-checked by
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from fractions import Fraction
 from typing import Any
@@ -68,10 +71,17 @@ from phdesign.numeric.certified.rate_exact import (
     mu_enclosure,
     to_fraction,
 )
+from phdesign.numeric.certified.rate_poly import PolynomialLyapunov, polynomial_basis
 from phdesign.numeric.certified.rate_problem import RateProblem, read_system
 from phdesign.numeric.certified.rate_sdp import Candidate, LyapunovProgram, search
 
-__all__ = ["ASSUMPTIONS", "DecayRateProof", "prove_decay_rate", "prove_rate"]
+__all__ = [
+    "ASSUMPTIONS",
+    "POLYNOMIAL_ASSUMPTIONS",
+    "DecayRateProof",
+    "prove_decay_rate",
+    "prove_rate",
+]
 
 #: What every proved rate rests on besides the exact inequalities.
 ASSUMPTIONS = (
@@ -82,6 +92,17 @@ ASSUMPTIONS = (
     "boundary of full rank); dV/dt is computed on classical solutions (initial states in "
     "the generator's domain) and the estimate extends to every initial state by density",
     "the norm is the energy norm ‖x‖² = ∫ xᵀ H x dz (twice the Hamiltonian)",
+)
+#: The same for z-dependent coefficients (:mod:`.rate_poly`).
+POLYNOMIAL_ASSUMPTIONS = (
+    "the closed system is the model's PDE with the exact matrices read here (parameter "
+    "defaults substituted): H(z) and P0(z) the rational functions of z written, smooth on "
+    "[a, b] (the proof shows that no denominator vanishes there)",
+    "the closed boundary condition generates a C0 semigroup on the energy space (Le Gorrec, "
+    "Zwart and Maschke, SIAM J. Control Optim. 44, 2005, for z-dependent H; a z-dependent "
+    "P0 is a bounded perturbation, Pazy 1983, Thm 3.1.1); dV/dt is computed on classical "
+    "solutions and the estimate extends to every initial state by density",
+    ASSUMPTIONS[2],
 )
 RETRIES = 5
 TAU_DENOMINATOR = 1000
@@ -98,9 +119,10 @@ class DecayRateProof:
         The exact closed system the proof is about.
     sigma, M : fractions.Fraction
         The proved rate and constant.
-    data : LyapunovData
+    data : LyapunovData or PolynomialLyapunov
         :math:`\Pi_\pm`, :math:`\tau`, the enclosure of :math:`\mu`, :math:`\sigma`,
-        :math:`c_1`, :math:`c_2` (exact rationals).
+        :math:`c_1`, :math:`c_2` (exact rationals); for z-dependent coefficients the
+        polynomial :math:`\Pi(z)`, :math:`\sigma`, :math:`c_1`, :math:`c_2`.
     inequalities : tuple of Inequality
         Every matrix inequality checked (all hold, exactly).
     assumptions : tuple of str
@@ -112,7 +134,7 @@ class DecayRateProof:
     problem: RateProblem
     sigma: Fraction
     M: Fraction
-    data: LyapunovData
+    data: LyapunovData | PolynomialLyapunov
     inequalities: tuple[Inequality, ...]
     assumptions: tuple[str, ...] = ASSUMPTIONS
     abscissa: float | None = None
@@ -149,7 +171,8 @@ def prove_decay_rate(system: ExactClosedSystem, *, target: float | None = None) 
     ----------
     system : ExactClosedSystem
         The exact closed plant or error system (:func:`~.exact_system.closed_system`), of
-        order 1 with constant rational coefficients.
+        order 1 with rational coefficients (:math:`H`, :math:`P_0`: rational functions of
+        z allowed).
     target : float, optional
         Prove this rate (rounded down to 6 decimals) instead of the best one found.
 
@@ -159,8 +182,8 @@ def prove_decay_rate(system: ExactClosedSystem, *, target: float | None = None) 
         ``system`` is not an :class:`~.exact_system.ExactClosedSystem`.
     RateProofError
         Order 2 or more (the message says what is proved instead: the spectral bound),
-        a z-dependent or irrational coefficient, no functional found, or ``target`` out
-        of reach.
+        an irrational coefficient or one that is not a rational function of z, no
+        functional found, or ``target`` out of reach.
 
     Examples
     --------
@@ -187,18 +210,47 @@ def prove_rate(problem: RateProblem, *, target: float | None = None) -> DecayRat
     """
     if target is not None and not (math.isfinite(target) and target > 0):
         raise RateProofError(f"target must be a finite positive rate; found {target!r}")
+    if not problem.constant:
+        return _prove_polynomial(problem, target)
     basis = lyapunov_basis(problem)
     program = LyapunovProgram(problem, basis)
     best_tau, best_sigma = search(program, target)
     tau = sympy.Rational(Fraction(best_tau).limit_denominator(TAU_DENOMINATOR))
     # the bisection's σ sits on the feasibility boundary: step inside before rounding
     sigma = _round_down(best_sigma if target is not None else best_sigma * (1 - 1e-4))
+
+    def rounded(sigma: sympy.Rational, attempt: int) -> LyapunovData | None:
+        candidate = program.solve(float(tau), float(sigma))
+        return None if candidate is None else _rational_data(problem, basis, candidate, tau, sigma)
+
+    return _first_proved(problem, sigma, target, rounded, "the SDP is infeasible at the rounded τ")
+
+
+def _first_proved(
+    problem: RateProblem,
+    sigma: sympy.Rational,
+    target: float | None,
+    rounded: Callable[[sympy.Rational, int], Any],
+    infeasible: str,
+) -> DecayRateProof:
+    """Prove the first of up to ``RETRIES`` rounded solutions that the exact check passes.
+
+    ``rounded(σ, attempt)`` is the rational data of the SDP's solution at σ (``None``:
+    infeasible); each retry lowers σ (a ``target`` is tried once).
+
+    Raises
+    ------
+    RateProofError
+        Every attempt fails the exact check (the last failures are named).
+    """
+    from phdesign.numeric.certified.rate_poly import failures as polynomial_failures
+
     last: list[str] = []
     for attempt in range(RETRIES):
-        candidate = program.solve(float(tau), float(sigma))
-        if candidate is not None:
-            data = _rational_data(problem, basis, candidate, tau, sigma)
-            last = failures(problem, data)
+        data = rounded(sigma, attempt)
+        if data is not None:
+            found = failures if isinstance(data, LyapunovData) else polynomial_failures
+            last = found(problem, data)
             if not last:
                 return _proof(problem, data)
         if target is not None:
@@ -206,9 +258,58 @@ def prove_rate(problem: RateProblem, *, target: float | None = None) -> DecayRat
         sigma = _round_down(float(sigma) * (1 - 1e-3 * 4**attempt))
     raise RateProofError(
         f"{problem.name}: the SDP's functional, rounded to rationals, fails the exact "
-        f"check ({'; '.join(last) or 'the SDP is infeasible at the rounded τ'}); no rate "
-        "is claimed"
+        f"check ({'; '.join(last) or infeasible}); no rate is claimed"
     )
+
+
+def _prove_polynomial(problem: RateProblem, target: float | None) -> DecayRateProof:
+    """Prove the z-dependent case (:mod:`.rate_poly`): search, round, decide exactly."""
+    from phdesign.numeric.certified.rate_poly_sdp import PolynomialProgram, search_polynomial
+
+    basis = polynomial_basis(problem)
+    program = PolynomialProgram(problem, basis)
+    found = search_polynomial(program, target)
+
+    def rounded(sigma: sympy.Rational, attempt: int) -> PolynomialLyapunov | None:
+        # the first attempt keeps the search's solution: a rounded-down σ stays feasible
+        # (lowering σ subtracts 2Δσ Π ≻ 0 from G)
+        candidate = found if attempt == 0 else program.solve(float(sigma))
+        if candidate is None:
+            return None
+        Pi = _combine(problem, basis, candidate.coordinates, 2**36)
+        return PolynomialLyapunov(Pi, sigma, sympy.Integer(1), _round_up(candidate.c2))
+
+    return _first_proved(
+        problem, _round_down(found.sigma), target, rounded, "the SDP is infeasible"
+    )
+
+
+def _combine(
+    problem: RateProblem,
+    basis: tuple[sympy.ImmutableMatrix, ...],
+    coordinates: tuple[float, ...],
+    common: int | None = None,
+) -> sympy.ImmutableMatrix:
+    """Return the rational combination of ``basis`` near the float ``coordinates``.
+
+    Each coordinate is the nearest rational of denominator at most 2⁴⁰, or with
+    ``common`` the nearest multiple of ``1/common`` (one denominator keeps the
+    polynomial weight's coefficients short).
+    """
+
+    def rational(c: float) -> sympy.Rational:
+        if common is None:
+            return sympy.Rational(Fraction(c).limit_denominator(2**40))
+        return sympy.Rational(round(c * common), common)
+
+    total = sympy.zeros(problem.size, problem.size)
+    for c, E in zip(coordinates, basis, strict=True):
+        total += rational(c) * E
+    return sympy.ImmutableMatrix(total.applyfunc(sympy.expand))
+
+
+def _round_up(c2: float) -> sympy.Rational:
+    return sympy.Rational(math.ceil(c2 * 10**9), 10**9)
 
 
 def _round_down(value: float) -> sympy.Rational:
@@ -223,30 +324,28 @@ def _rational_data(
     tau: sympy.Rational,
     sigma: sympy.Rational,
 ) -> LyapunovData:
-    def rational(x: float) -> sympy.Rational:
-        return sympy.Rational(Fraction(x).limit_denominator(2**40))
-
-    def combine(coordinates: tuple[float, ...]) -> sympy.ImmutableMatrix:
-        total = sympy.zeros(problem.size, problem.size)
-        for c, E in zip(coordinates, basis, strict=True):
-            total += rational(c) * E
-        return sympy.ImmutableMatrix(total)
-
-    c2 = sympy.Rational(math.ceil(found.c2 * 10**9), 10**9)
     mu = mu_enclosure(tau, problem.length)
+    Pi_minus, Pi_plus = (_combine(problem, basis, c) for c in (found.minus, found.plus))
     one = sympy.Integer(1)
-    return LyapunovData(combine(found.minus), combine(found.plus), tau, mu, sigma, one, c2)
+    return LyapunovData(Pi_minus, Pi_plus, tau, mu, sigma, one, _round_up(found.c2))
 
 
-def _proof(problem: RateProblem, data: LyapunovData) -> DecayRateProof:
+def _proof(problem: RateProblem, data: LyapunovData | PolynomialLyapunov) -> DecayRateProof:
     ratio = to_fraction(data.c2) / to_fraction(data.c1)
     M = Fraction(math.ceil(math.sqrt(ratio) * 10**6), 10**6)
     while ratio > M * M:  # round up: M ≥ √(c₂/c₁), exactly
         M += Fraction(1, 10**6)
+    if isinstance(data, PolynomialLyapunov):
+        from phdesign.numeric.certified.rate_poly import inequalities as polynomial_inequalities
+
+        checked = polynomial_inequalities(problem, data)
+    else:
+        checked = inequalities(problem, data)
     return DecayRateProof(
         problem=problem,
         sigma=to_fraction(data.sigma),
         M=M,
         data=data,
-        inequalities=inequalities(problem, data),
+        inequalities=checked,
+        assumptions=ASSUMPTIONS if problem.constant else POLYNOMIAL_ASSUMPTIONS,
     )

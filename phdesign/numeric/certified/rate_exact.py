@@ -41,7 +41,9 @@ between rational matrices (:func:`inequalities`):
   :math:`z \in [a, b]` and the true :math:`\mu`.
 
 Definiteness is decided by Sylvester's criterion on exact leading principal minors
-(sympy's ``DomainMatrix`` over QQ); the independent checker
+(sympy's ``DomainMatrix`` over QQ); for a matrix of rational functions of :math:`z`
+(the proof of :mod:`.rate_poly`) on all of an interval, by the same criterion with
+polynomial minors and Sturm's root count (:func:`positive_on`).  The independent checker
 (:mod:`phdesign.proofcheck.rate`) decides it by an LDLᵀ factorization in
 :class:`fractions.Fraction`.
 """
@@ -61,10 +63,12 @@ __all__ = [
     "CORNERS",
     "Inequality",
     "LyapunovData",
+    "boundary_form",
     "failures",
     "inequalities",
     "lyapunov_basis",
     "mu_enclosure",
+    "positive_on",
     "to_fraction",
 ]
 
@@ -74,18 +78,25 @@ CORNERS = (("lo", "1"), ("lo", "tau^2"), ("hi", "1"), ("hi", "tau^2"))
 
 @dataclass(frozen=True)
 class Inequality:
-    """One matrix inequality of the proof: ``matrix`` is claimed ``claim`` definite."""
+    """One matrix inequality of the proof: ``matrix`` is claimed ``claim`` definite.
+
+    With an ``interval``, ``matrix`` is a rational function of ``z`` and the claim is
+    for every ``z`` in the closed interval.
+    """
 
     name: str
     claim: str  # "positive" or "negative"
     matrix: sympy.ImmutableMatrix
     meaning: str
+    interval: tuple[sympy.Rational, sympy.Rational] | None = None
 
     @property
     def holds(self) -> bool:
         """Whether the claim holds, by Sylvester's criterion on exact minors."""
         sign = 1 if self.claim == "positive" else -1
-        return _positive_definite(sign * self.matrix)
+        if self.interval is None:
+            return _positive_definite(sign * self.matrix)
+        return positive_on(sign * self.matrix, self.interval)
 
 
 @dataclass(frozen=True)
@@ -112,11 +123,42 @@ def _positive_definite(M: sympy.ImmutableMatrix) -> bool:
     return all(dm[:k, :k].det() > 0 for k in range(1, n + 1))
 
 
-def lyapunov_basis(problem: RateProblem) -> tuple[sympy.ImmutableMatrix, ...]:
-    r"""Return a rational basis of the symmetric Π with :math:`\Pi P_1\mathcal H` symmetric.
+def positive_on(M: sympy.MatrixBase, interval: tuple[sympy.Rational, sympy.Rational]) -> bool:
+    r"""Whether the symmetric rational-function matrix :math:`M(z) \succ 0` on all of ``interval``.
 
-    The nullspace (over the rationals) of the linear map from the upper triangle of
-    :math:`\Pi` to the antisymmetric part of :math:`\Pi P_1 \mathcal H`.
+    With :math:`M = M_p/d` (:math:`d` the least common denominator, :math:`M_p` a
+    polynomial matrix), :math:`M(z) \succ 0` for every :math:`z \in [a, b]` iff
+    :math:`d` has no zero on :math:`[a, b]` and every leading principal minor
+    :math:`m_k` of :math:`\operatorname{sign}(d)\,M_p` is a polynomial without a zero on
+    :math:`[a, b]` and positive at :math:`a` (Sylvester's criterion at each z; a
+    polynomial that keeps its sign on the interval).  The zeros are counted exactly by
+    Sturm's theorem (sympy's ``count_roots``).
+    """
+    a, b = interval
+    z = next(iter(M.free_symbols), sympy.Symbol("z"))
+    entries = [sympy.fraction(sympy.cancel(x)) for x in M]
+    d = sympy.Poly(sympy.lcm([den for _, den in entries]), z)
+    if d.count_roots(a, b) != 0 or M != M.T:
+        return False
+    sign = 1 if d.eval(a) > 0 else -1
+    Mp = sympy.Matrix(M.rows, M.cols, [sign * sympy.cancel(x * d.as_expr()) for x in M])
+    ring = sympy.QQ[z]
+    dm = DomainMatrix.from_Matrix(Mp).convert_to(ring)
+    for k in range(1, M.rows + 1):
+        minor = sympy.Poly(ring.to_sympy(dm[:k, :k].det()), z)
+        if minor.is_zero or minor.count_roots(a, b) != 0 or minor.eval(a) <= 0:
+            return False
+    return True
+
+
+def lyapunov_basis(problem: RateProblem) -> tuple[sympy.ImmutableMatrix, ...]:
+    r"""Return a basis of the symmetric Π with :math:`\Pi P_1\mathcal H` symmetric.
+
+    The nullspace of the linear map from the upper triangle of :math:`\Pi` to the
+    antisymmetric part of :math:`\Pi P_1 \mathcal H`: over the rationals for a constant
+    :math:`\mathcal H`; over the rational functions of :math:`z` for a z-dependent one,
+    each vector then multiplied by the least common denominator of its entries, so that
+    every :math:`B_k(z)` is a polynomial matrix (:mod:`.rate_poly`).
     """
     n = problem.size
     unknowns = [(i, j) for i in range(n) for j in range(i, n)]
@@ -128,9 +170,17 @@ def lyapunov_basis(problem: RateProblem) -> tuple[sympy.ImmutableMatrix, ...]:
     rows = [S[i, j] - S[j, i] for i in range(n) for j in range(i + 1, n)]
     A = sympy.Matrix([[sympy.diff(r, s) for s in symbols] for r in rows])
     null = A.nullspace() if rows else [sympy.eye(len(symbols))[:, k] for k in range(len(symbols))]
+    null = [_cleared(v, problem.z) if v.has(problem.z) else v for v in null]
     return tuple(
         sympy.ImmutableMatrix(Pi.xreplace(dict(zip(symbols, v, strict=True)))) for v in null
     )
+
+
+def _cleared(v: sympy.MatrixBase, z: sympy.Symbol) -> sympy.Matrix:
+    """``v`` times the least common denominator of its entries (polynomials in ``z``)."""
+    v = v.applyfunc(sympy.cancel)
+    scale = sympy.lcm([sympy.fraction(x)[1] for x in v])
+    return v.applyfunc(lambda x: sympy.expand(sympy.cancel(x * scale)))
 
 
 def mu_enclosure(
@@ -175,12 +225,25 @@ def _pointwise(problem: RateProblem, data: LyapunovData, mu: sympy.Rational, s: 
     return sympy.ImmutableMatrix(part(data.Pi_minus, 1) + s * part(data.Pi_plus, -1))
 
 
-def _boundary(problem: RateProblem, data: LyapunovData) -> sympy.ImmutableMatrix:
-    H_inv = problem.H.inv()
-    at_b = H_inv * (data.Pi_minus / data.tau + data.tau * data.Pi_plus) * problem.P1
-    at_a = H_inv * (data.Pi_minus + data.Pi_plus) * problem.P1
+def boundary_form(
+    problem: RateProblem, Pi_b: sympy.MatrixBase, Pi_a: sympy.MatrixBase
+) -> sympy.ImmutableMatrix:
+    r"""Return the boundary term of :math:`\dot V` on the admissible traces :math:`v = K_b w`.
+
+    :math:`K_b^\top \operatorname{diag}\big(\mathcal H(b)^{-1}\Pi(b)P_1,
+    -\mathcal H(a)^{-1}\Pi(a)P_1\big) K_b`, from ``Pi_b`` :math:`= \Pi(b)` and
+    ``Pi_a`` :math:`= \Pi(a)`.
+    """
+    a, b = problem.interval
+    at_b = problem.H.subs(problem.z, b).inv() * Pi_b * problem.P1
+    at_a = problem.H.subs(problem.z, a).inv() * Pi_a * problem.P1
     form = sympy.diag(at_b, -at_a)
     return sympy.ImmutableMatrix(problem.kernel.T * form * problem.kernel)
+
+
+def _boundary(problem: RateProblem, data: LyapunovData) -> sympy.ImmutableMatrix:
+    Pi_b = data.Pi_minus / data.tau + data.tau * data.Pi_plus
+    return boundary_form(problem, Pi_b, data.Pi_minus + data.Pi_plus)
 
 
 def inequalities(problem: RateProblem, data: LyapunovData) -> tuple[Inequality, ...]:

@@ -1,24 +1,27 @@
 r"""The exact data a decay-rate proof reads from a closed first-order system.
 
-A closed system of order :math:`N = 1` with constant coefficients is
+A closed system of order :math:`N = 1` is
 
 .. math::
 
-    \partial_t x = P_1 \mathcal H\, \partial_z x + P_0 \mathcal H x
+    \partial_t x = P_1 \partial_z (\mathcal H x) + P_0 \mathcal H x
     \quad\text{on } [a, b], \qquad
     \mathcal B v = 0, \quad v = (e(b); e(a)), \quad e = \mathcal H x ,
 
 where :math:`\mathcal B = U + G Y` (``n x 2n``) is the closed boundary condition (the
 observer's injection and the plant's dampers) and the columns of :math:`K_b`
 (``2n x n``) span its kernel, the admissible traces.  :class:`RateProblem` holds these
-matrices as exact rationals (sympy); the prover (:mod:`.rate`) and the proof file read
-nothing else of the model.
+matrices exactly (sympy); the prover (:mod:`.rate`) and the proof file read nothing else
+of the model.
 
 Only what the proof can honour is accepted: the order must be 1 (for the beam,
-:math:`N = 2`, the message says what is proved instead), :math:`\mathcal H` and
-:math:`P_0` must not depend on :math:`z` (the pointwise inequality is then checked at
-finitely many exact corners; for a :math:`z`-dependent one phdesign has no rigorous
-bound and refuses rather than sample :math:`z`), and every entry must be rational.
+:math:`N = 2`, the message says what is proved instead); :math:`\mathcal H(z)` and
+:math:`P_0(z)` may depend on :math:`z`, but only as **rational functions of z with
+rational coefficients** (``1/(1 + z/2)``, ``1 + z**2``): the proof then decides every
+pointwise inequality on all of :math:`[a, b]` exactly, by Sturm sequences of
+polynomials (:mod:`.rate_poly`), and ``sqrt(z)``, ``exp(z)`` or an irrational
+coefficient would leave the rationals; :math:`P_1`, the interval, the boundary rows and
+the kernel must be rational numbers.
 """
 
 from __future__ import annotations
@@ -30,13 +33,16 @@ import sympy
 
 from phdesign.core.errors import ArgumentError, RateProofError
 from phdesign.numeric.certified.exact_system import ExactClosedSystem
+from phdesign.symbolic.expressions import Z
 
 __all__ = [
     "BEAM_REFUSAL",
     "RateProblem",
+    "exact_rational_function_matrix",
     "exact_rational_matrix",
     "rate_problem",
     "read_system",
+    "require_first_order",
 ]
 
 #: What is proved for a model of order N >= 2 instead of a decay rate.
@@ -51,7 +57,7 @@ BEAM_REFUSAL = (
 
 @dataclass(frozen=True)
 class RateProblem:
-    r"""An :math:`N = 1` closed system with constant rational coefficients.
+    r"""An :math:`N = 1` closed system with rational (or rational-function) coefficients.
 
     Attributes
     ----------
@@ -60,8 +66,9 @@ class RateProblem:
     interval : tuple of sympy.Rational
         :math:`(a, b)`.
     H, P1, P0 : sympy.ImmutableMatrix
-        ``n x n`` rational matrices: :math:`\mathcal H` (symmetric positive definite),
-        :math:`P_1` (symmetric, invertible), :math:`P_0`.
+        ``n x n``: :math:`\mathcal H` (symmetric positive definite) and :math:`P_0`,
+        rational or rational functions of :data:`z`; :math:`P_1` (symmetric,
+        invertible), rational.
     boundary : sympy.ImmutableMatrix
         :math:`\mathcal B`, ``n x 2n``, over :math:`v = (e(b); e(a))`.
     kernel : sympy.ImmutableMatrix
@@ -76,6 +83,13 @@ class RateProblem:
     boundary: sympy.ImmutableMatrix
     kernel: sympy.ImmutableMatrix
 
+    z: sympy.Symbol = Z
+
+    @property
+    def constant(self) -> bool:
+        r"""Whether :math:`\mathcal H` and :math:`P_0` are constant (the exponential proof)."""
+        return not (self.H.has(self.z) or self.P0.has(self.z))
+
     @property
     def size(self) -> int:
         """The number :math:`n` of state components."""
@@ -85,6 +99,18 @@ class RateProblem:
     def length(self) -> sympy.Rational:
         """:math:`b - a`."""
         return sympy.Rational(self.interval[1] - self.interval[0])
+
+
+def require_first_order(name: str, order: int) -> None:
+    """Refuse a decay-rate proof for an order other than 1, saying what is proved instead.
+
+    Raises
+    ------
+    RateProofError
+        ``order`` is not 1.
+    """
+    if order != 1:
+        raise RateProofError(f"{name}: {BEAM_REFUSAL.format(order=order)}")
 
 
 def exact_rational_matrix(name: str, matrix: Any, model: str) -> sympy.ImmutableMatrix:
@@ -105,13 +131,48 @@ def exact_rational_matrix(name: str, matrix: Any, model: str) -> sympy.Immutable
             continue
         names = {s.name for s in getattr(entry, "free_symbols", set())}
         why = (
-            "depends on z: for a z-dependent coefficient phdesign has no rigorous bound on "
-            "the pointwise inequality over [a, b] and refuses rather than sample z"
+            "depends on z: only H and P0 may depend on z in a decay-rate proof"
             if "z" in names
             else "is not a rational number (the exact check works in the rationals)"
         )
         raise RateProofError(
             f"{model}: cannot prove a decay rate: {name}[{i + 1},{j + 1}] = {entry} {why}"
+        )
+    return sympy.ImmutableMatrix(M)
+
+
+def exact_rational_function_matrix(
+    name: str, matrix: Any, model: str, z: sympy.Symbol = Z
+) -> sympy.ImmutableMatrix:
+    """Return ``matrix`` with every entry a rational function of ``z`` over the rationals.
+
+    Raises
+    ------
+    RateProofError
+        An entry is not a rational function of ``z`` (``sqrt(z)``, ``exp(z)``), has
+        another free symbol, or an irrational coefficient; the message names the entry.
+    """
+    M = sympy.Matrix(matrix)
+    for (i, j), entry in sorted(M.todok().items()):
+        exact = entry.xreplace({f: sympy.Rational(str(f)) for f in entry.atoms(sympy.Float)})
+        value = sympy.cancel(exact)
+        numerator, denominator = sympy.fraction(value)
+        polynomial = exact.free_symbols <= {z} and exact.is_rational_function(z)
+        if polynomial and all(
+            c.is_Rational
+            for part in (numerator, denominator)
+            for c in sympy.Poly(part, z).coeffs()
+        ):
+            M[i, j] = value
+            continue
+        why = (
+            "has a coefficient that is not a rational number"
+            if polynomial
+            else "is not a rational function of z with rational coefficients"
+        )
+        raise RateProofError(
+            f"{model}: cannot prove a decay rate: {name}[{i + 1},{j + 1}] = {entry} {why} "
+            "(the exact proof decides polynomial inequalities in the rationals)"
         )
     return sympy.ImmutableMatrix(M)
 
@@ -134,15 +195,16 @@ def rate_problem(
     Raises
     ------
     RateProofError
-        The order is not 1 (the message says what is proved instead), or an entry is
-        z-dependent or irrational.
+        The order is not 1 (the message says what is proved instead), an entry of
+        :math:`H` or :math:`P_0` is not a rational function of z over the rationals, or
+        another entry is z-dependent or irrational.
     """
-    if order != 1:
-        raise RateProofError(f"{name}: {BEAM_REFUSAL.format(order=order)}")
+    require_first_order(name, order)
     exact = {
-        label: exact_rational_matrix(label, value, name)
-        for label, value in (("H", H), ("P0", P[0]), ("P1", P[1]))
+        label: exact_rational_function_matrix(label, value, name)
+        for label, value in (("H", H), ("P0", P[0]))
     }
+    exact["P1"] = exact_rational_matrix("P1", P[1], name)
     ends = exact_rational_matrix("interval", [list(interval)], name)
     return RateProblem(
         name=name,
@@ -173,8 +235,7 @@ def read_system(system: ExactClosedSystem) -> RateProblem:
             "system must be an ExactClosedSystem (phdesign.numeric.certified.exact_system."
             f"closed_system(model, C_m, L)); found {type(system).__name__}"
         )
-    if system.order != 1:
-        raise RateProofError(f"{system.name}: {BEAM_REFUSAL.format(order=system.order)}")
+    require_first_order(system.name, system.order)
     boundary = exact_rational_matrix("boundary matrix U + G Y", system.boundary, system.name)
     null = boundary.nullspace()
     if len(null) != system.size:  # pragma: no cover - closed_system checked dim K = Nn

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -31,7 +32,14 @@ import sympy
 from phdesign.core.errors import RateProofError
 from phdesign.numeric.certified.rate_problem import RateProblem
 
-__all__ = ["Candidate", "LyapunovProgram", "search"]
+__all__ = [
+    "Candidate",
+    "LyapunovProgram",
+    "largest_feasible",
+    "require_reached",
+    "search",
+    "solved",
+]
 
 #: Margin of every strict inequality, relative to the problem's scale (c₁ = 1).
 MARGIN = 1e-6
@@ -132,36 +140,49 @@ class LyapunovProgram:
         )
 
     def _solved(self, fallback: bool) -> bool:
-        cp, problem = self._cp, self.problem
-        solvers: tuple[tuple[str, dict[str, Any]], ...] = (
-            (cp.CLARABEL, {}),
-            (cp.SCS, {"eps": 1e-7, "max_iters": 2000}),
-        )
-        for solver, options in solvers[: 2 if fallback else 1]:
-            try:
-                with warnings.catch_warnings():  # an inaccurate status is judged below
-                    warnings.simplefilter("ignore", UserWarning)
-                    problem.solve(solver=solver, **options)
-            except cp.SolverError:
-                continue  # Clarabel failed (it does on the feasibility boundary): SCS tries
-            # an inaccurate answer counts as infeasible: the bisection stays on the safe side
-            return bool(problem.status == cp.OPTIMAL)
-        return False
+        return solved(self.problem, fallback)
 
     def best_sigma(self, tau: float) -> float:
         """Return the largest feasible σ at ``tau`` (bisection; 0 when none is found)."""
-        lo, hi = 0.0, math.log(tau) / self.length * self.speed
-        for _ in range(6):
-            if self.solve(tau, hi, fallback=False) is None:
-                break
-            lo, hi = hi, 2 * hi
-        else:
-            return lo
-        for _ in range(BISECTION_STEPS):
-            mid = (lo + hi) / 2
-            feasible = self.solve(tau, mid, fallback=False) is not None
-            lo, hi = (mid, hi) if feasible else (lo, mid)
+        start = math.log(tau) / self.length * self.speed
+        return largest_feasible(lambda s: self.solve(tau, s, fallback=False) is not None, start)
+
+
+def solved(problem: Any, fallback: bool) -> bool:
+    """Solve the cvxpy ``problem`` with Clarabel (then SCS with ``fallback``): optimal or not.
+
+    An inaccurate answer counts as infeasible, so a bisection stays on the safe side.
+    """
+    import cvxpy as cp
+
+    solvers: tuple[tuple[str, dict[str, Any]], ...] = (
+        (cp.CLARABEL, {}),
+        (cp.SCS, {"eps": 1e-7, "max_iters": 2000}),
+    )
+    for solver, options in solvers[: 2 if fallback else 1]:
+        try:
+            with warnings.catch_warnings():  # an inaccurate status is judged below
+                warnings.simplefilter("ignore", UserWarning)
+                problem.solve(solver=solver, **options)
+        except cp.SolverError:
+            continue  # Clarabel failed (it does on the feasibility boundary): SCS tries
+        return bool(problem.status == cp.OPTIMAL)
+    return False
+
+
+def largest_feasible(feasible: Callable[[float], bool], start: float) -> float:
+    """Return the largest σ with ``feasible(σ)``: doubling from ``start``, then bisection."""
+    lo, hi = 0.0, start
+    for _ in range(6):
+        if not feasible(hi):
+            break
+        lo, hi = hi, 2 * hi
+    else:
         return lo
+    for _ in range(BISECTION_STEPS):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if feasible(mid) else (lo, mid)
+    return lo
 
 
 def search(program: LyapunovProgram, target: float | None = None) -> tuple[float, float]:
@@ -182,17 +203,33 @@ def search(program: LyapunovProgram, target: float | None = None) -> tuple[float
     lo = math.log(LOG_TAU_GRID[max(i - 1, 0)])
     hi = math.log(LOG_TAU_GRID[min(i + 1, len(LOG_TAU_GRID) - 1)])
     best_sigma, best_x = _golden(program, lo, hi, (best_sigma, best_x))
-    if best_sigma <= 0:
+    require_reached(
+        best_sigma,
+        target,
+        "of the Bastin–Coron form",
+        " for every weight ratio τ tried",
+        f" (at ln τ = {best_x:.4g})",
+    )
+    return math.exp(best_x), best_sigma if target is None else target
+
+
+def require_reached(best: float, target: float | None, form: str, tried: str, at: str) -> None:
+    """Refuse when the search found no positive σ, or when ``target`` is above ``best``.
+
+    Raises
+    ------
+    RateProofError
+        With the functional's ``form``, what was ``tried`` and where the best σ is ``at``.
+    """
+    if best <= 0:
         raise RateProofError(
-            "no Lyapunov functional of the Bastin–Coron form was found: the SDP is "
-            "infeasible for every weight ratio τ tried, even at σ = 0"
+            f"no Lyapunov functional {form} was found: the SDP is infeasible{tried}, even at σ = 0"
         )
-    if target is not None and target > best_sigma:
+    if target is not None and target > best:
         raise RateProofError(
             f"the decay rate target = {target:g} is above the best rate the SDP reaches, "
-            f"σ = {best_sigma:.6g} (at ln τ = {best_x:.4g})"
+            f"σ = {best:.6g}{at}"
         )
-    return math.exp(best_x), best_sigma if target is None else target
 
 
 def _golden(

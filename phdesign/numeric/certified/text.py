@@ -20,6 +20,8 @@ def _system_line(cert: Certificate) -> str:
 
 
 def _scope(cert: Certificate) -> str:
+    if "band" not in cert.proof and not cert.whole_plane:
+        return "proved for: the decay rate only (no spectrum section)"
     if cert.whole_plane:
         section = cert.proof["whole_plane"]
         return (
@@ -44,7 +46,9 @@ def certificate_text(cert: Certificate) -> str:
     """Return the certificate as the command line prints it."""
     lines = [_system_line(cert)]
     interval = cert.abscissa_interval
-    if interval is None:
+    if "band" not in cert.proof and not cert.whole_plane:
+        lines.append("spectral abscissa: not certified (see the notes)")
+    elif interval is None:
         lines.append("spectral abscissa: no eigenvalue found (see the notes)")
     else:
         lo, hi = interval

@@ -3,30 +3,14 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import pytest
-from paths import ROOT
+from checker_blocked import run_blocked
 
 pytest.importorskip("flint", reason="certificates need the extra 'certify' (python-flint)")
 
 import phdesign as phd
 from phdesign.models import load_builtin
-
-BLOCKED = """
-import sys
-class Block:
-    def find_spec(self, name, path=None, target=None):
-        if name.split(".")[0] in ("flint", "numpy", "sympy", "scipy"):
-            raise ImportError(f"{name} is blocked for the checker")
-        return None
-sys.meta_path.insert(0, Block())
-from phdesign.proofcheck import check_file
-failures = [f for path in sys.argv[1:] for f in check_file(path)]
-loaded = sorted(m for m in sys.modules if m.split(".")[0] in ("flint", "numpy", "sympy"))
-print(repr((failures, loaded)))
-"""
 
 
 def test_the_checker_verifies_proofs_with_flint_numpy_and_sympy_blocked(tmp_path):
@@ -38,13 +22,6 @@ def test_the_checker_verifies_proofs_with_flint_numpy_and_sympy_blocked(tmp_path
         path = tmp_path / f"{name}.json"
         path.write_text(json.dumps(cert.to_dict()))
         paths.append(str(path))
-    done = subprocess.run(
-        [sys.executable, "-c", BLOCKED, *paths],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"},
-        check=False,
-    )
+    done = run_blocked(paths)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == repr(([], []))

@@ -47,7 +47,6 @@ from phdesign.numeric.certified.exact_system import closed_system
 from phdesign.numeric.certified.rate import prove_decay_rate
 from phdesign.numeric.certified.rate_exact import failures
 from phdesign.numeric.certified.rate_problem import rate_problem
-from phdesign.symbolic.model import BCPHS
 from phdesign.symbolic.observer import sensor_matrix
 
 pytest.importorskip("cvxpy", reason="the proved decay rate needs the certify extra")
@@ -125,20 +124,6 @@ def test_a_timoshenko_beam_with_tip_dampers_gets_a_rate_below_its_abscissa():
     assert 0 < proof.sigma <= abs(spectrum.spectral_abscissa)
     compared = proof.compared(spectrum.spectral_abscissa, "converged spectrum")
     assert "sigma/|alpha|" in str(compared)
-
-
-def test_a_z_dependent_density_is_refused_with_a_message():
-    string = BCPHS.define(
-        name="string of density 1 + z/2",
-        interval=[0, 1],
-        order=1,
-        P={1: [[0, 1], [1, 0]]},
-        H=[["1/(1 + z/2)", 0], [0, 1]],
-        inputs=["e1(0)", "e2(1)"],
-        outputs=["-e2(0)", "e1(1)"],
-    )
-    with pytest.raises(RateProofError, match=r"H\[1,1\] = .*depends on z.*rather than sample"):
-        prove_decay_rate(closed(string, [2], "1"))
 
 
 def test_the_beam_is_refused_saying_what_is_proved_instead():
