@@ -75,7 +75,7 @@ def _pderiv(p: Poly) -> Poly:
     return _trim([i * p[i] for i in range(1, len(p))])
 
 
-def _peval(p: Poly, x: Fraction) -> Fraction:
+def _value(p: Poly, x: Fraction) -> Fraction:
     total = Fraction(0)
     for c in reversed(p):
         total = total * x + c
@@ -93,7 +93,7 @@ def _pdivmod(p: Poly, q: Poly) -> tuple[Poly, Poly]:
 
 def _zero_free(p: Poly, a: Fraction, b: Fraction) -> bool:
     """Whether ``p`` has no zero on [a, b] (Sturm: distinct zeros in (a, b] = V(a) − V(b))."""
-    if not p or _peval(p, a) == 0 or _peval(p, b) == 0:
+    if not p or _value(p, a) == 0 or _value(p, b) == 0:
         return False
     sequence = [p, _pderiv(p)]
     while len(sequence[-1]) > 1:
@@ -103,7 +103,7 @@ def _zero_free(p: Poly, a: Fraction, b: Fraction) -> bool:
         sequence.append(_pscale(-1 / abs(rest[-1]), rest))  # a positive scale keeps the signs
 
     def changes(x: Fraction) -> int:
-        signs = [v > 0 for v in (_peval(q, x) for q in sequence if q) if v != 0]
+        signs = [v > 0 for v in (_value(q, x) for q in sequence if q) if v != 0]
         return sum(s != t for s, t in pairwise(signs))
 
     return changes(a) == changes(b)
@@ -152,7 +152,7 @@ def _fequal(f: Function, g: Function) -> bool:
 
 
 def _fat(f: Function, x: Fraction) -> Fraction:
-    return _peval(f[0], x) / _peval(f[1], x)
+    return _value(f[0], x) / _value(f[1], x)
 
 
 def _mmul(A: Matrix, B: Matrix) -> Matrix:
@@ -199,7 +199,7 @@ def _positive_on(M: Matrix, a: Fraction, b: Fraction) -> bool:
             D = _common(D, d)
     if not _zero_free(D, a, b):
         return False
-    sign = Fraction(1 if _peval(D, a) > 0 else -1)
+    sign = Fraction(1 if _value(D, a) > 0 else -1)
     W = []
     for row in M:
         out = []
@@ -211,7 +211,7 @@ def _positive_on(M: Matrix, a: Fraction, b: Fraction) -> bool:
     previous = ONE
     for k in range(len(W)):  # Bareiss: the k-th pivot is the leading minor of order k + 1
         pivot = W[k][k]
-        if not _zero_free(pivot, a, b) or _peval(pivot, a) <= 0:
+        if not _zero_free(pivot, a, b) or _value(pivot, a) <= 0:
             return False
         for i in range(k + 1, len(W)):
             for j in range(k + 1, len(W)):
