@@ -134,3 +134,19 @@ def test_the_exported_observer_carries_the_mass_and_its_spectrum(tmp_path):
     assert np.array(json.loads((tmp_path / "obs.json").read_text())["A"]).shape == (d.dim, d.dim)
     exported.write(str(tmp_path / "c"), "c")
     assert f"#define PHD_OBSERVER_N {d.dim} " in (tmp_path / "c" / "observer.h").read_text()
+
+
+def test_verification_states_meet_the_static_part_of_a_boundary_system():
+    # The Maxwell end at rest (e_c = 0) leaves u_p = -K y_p with K = d: e2(1) = -d e1(1).
+    # A verification state has one component, so the condition forces e1(1) = 0 on e1's
+    # states and e2(1) = 0 on e2's (without K, e1(1) would be left free: not in the domain).
+    from string_models import string_with_maxwell_end
+
+    from phdesign.numeric.sampled.state_set import boundary_states
+
+    nm = phd.to_numeric(string_with_maxwell_end(d=3))
+    states = boundary_states(nm)
+    assert {s.text.split(" ")[0] for s in states} == {"e1", "e2"}
+    for state in states:
+        e = np.einsum("mij,mj->mi", nm.H_at(np.array([1.0])), state.function(np.array([1.0])))
+        assert np.all(np.abs(e[0]) < 1e-12), (state.text, e)

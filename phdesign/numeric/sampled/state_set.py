@@ -12,7 +12,9 @@ default verification set is the export's own initial state followed by
 of the lowest degrees whose traces meet the plant's boundary conditions with the inputs at
 rest: :math:`U v = 0` on the external ports, :math:`(U_c + K Y_c) v = 0` on the ports a
 model's ``[feedback]`` closes (:math:`u_c = -K y_c`), with v the trace vector of e
-(:func:`~phdesign.symbolic.ports.trace_index`). At each new degree q the state is the
+(:func:`~phdesign.symbolic.ports.trace_index`), and :math:`(U_p + K Y_p) v = 0` on the
+ports a boundary system joins, at rest (:math:`u_p = -K y_p + F e_c` with
+:math:`e_c = 0`). At each new degree q the state is the
 polynomial of degree q, top coefficient 1, that meets them with the smallest coefficient
 norm (unique: a least-norm solution). Such states are smooth and in the domain of the
 plant's operator, so the plant resolves them: their floors measure the observer, not the
@@ -47,9 +49,12 @@ class InitialState:
 def _boundary_rows(nm: NumericModel) -> np.ndarray:
     """Rows over the trace vector that vanish when the inputs are at rest (module docstring)."""
     rows = np.array(nm.U, dtype=float)
-    if nm.feedback is not None:
-        closed = list(nm.feedback.closed)
-        rows[closed] = rows[closed] + nm.feedback.gain @ np.asarray(nm.Y, dtype=float)[closed]
+    Y = np.asarray(nm.Y, dtype=float)
+    closures = [] if nm.feedback is None else [(list(nm.feedback.closed), nm.feedback.gain)]
+    # a boundary system at rest (e_c = 0) leaves its static part u_p = -K y_p
+    closures += [(list(b.joined), b.K) for b in nm.boundary]
+    for closed, K in closures:
+        rows[closed] = rows[closed] + K @ Y[closed]
     return rows
 
 
