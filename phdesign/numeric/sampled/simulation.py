@@ -44,6 +44,9 @@ __all__ = ["embedding", "simulate_sampled"]
 def embedding(observer: DiscretePHS, plant: DiscretePHS) -> np.ndarray:
     """Return P with ``plant.effort_basis(z) @ P == observer.effort_basis(z)``.
 
+    A coupled model's boundary states are no part of the field bases: they map to each
+    other by the identity (:mod:`phdesign.numeric.discretization.coupled`).
+
     Raises
     ------
     NumericError
@@ -62,6 +65,9 @@ def embedding(observer: DiscretePHS, plant: DiscretePHS) -> np.ndarray:
             f"{observer.resolution}) is not contained in the plant's ({plant.method}, "
             f"resolution {plant.resolution}): use Galerkin, or equal resolutions"
         )
+    if "boundary_states" in observer.info and "boundary_states" in plant.info:
+        (fo, k), (fp, _) = observer.info["boundary_states"], plant.info["boundary_states"]
+        P[fp : fp + k, fo : fo + k] = np.eye(k)
     return np.asarray(P)
 
 
