@@ -8,7 +8,10 @@ resolutions; the gain report solves one Lyapunov equation per source and searche
 peak of each source besides the total's.  The ratio of process CPU seconds is the target
 (the machine is shared: wall seconds are printed beside).  Printed, not a target: the
 report with the optimal estimators (``optimal=True``: a Riccati equation per bisection
-step of the H∞-optimal level).
+step of the H∞-optimal level), and the gain design against the disturbances:
+``tune_noise(objective="hinf")`` against ``tune_noise(objective="rms")`` (each its own
+search and verification) on the string under a uniform force, tip velocity measured, the
+total momentum judged (its gain report and its noise report at each evaluation).
 
 Run:  python benchmarks/gain.py   (exit 1 if the target is missed)
 """
@@ -73,7 +76,36 @@ def main() -> int:
     print(f"  gain / noise (wall): {ratio('gain', 'noise', 1):.2f}x")
     optimal = ratio("gain, optimal", "noise", 0)
     print(f"  gain with the optimal estimators / noise (CPU): {optimal:.2f}x")
+    tuning()
     return 0 if ok else 1
+
+
+def string_under_force() -> phd.BCPHS:
+    data = model_to_dict(load_builtin("wave"))
+    data["disturbances"] = {"B": [[1], [0]]}
+    data["performance"] = {"outputs": ["integral(e1)"]}
+    return model_from_dict(data)
+
+
+def tuning() -> None:
+    """Print ``tune --objective hinf`` against ``tune --objective rms`` (same run, 3 rounds)."""
+    obs = phd.Observer(string_under_force(), sensors=[2])
+    calls = {
+        "tune rms": lambda: obs.tune_noise(
+            objective="rms", min_decay=0.5, intensity=0.01, performance="x1: 1"
+        ),
+        "tune hinf": lambda: obs.tune_noise(objective="hinf", intensity=0.01),
+    }
+    cpu: dict[str, list[float]] = {name: [] for name in calls}
+    for _ in range(3):
+        for name, fn in calls.items():
+            start = time.process_time()
+            fn()
+            cpu[name].append(time.process_time() - start)
+    for name, values in cpu.items():
+        print(f"  {name}: median {1e3 * statistics.median(values):.0f} ms CPU")
+    ratios = [h / r for h, r in zip(cpu["tune hinf"], cpu["tune rms"], strict=True)]
+    print(f"  tune hinf / tune rms (CPU): {statistics.median(ratios):.2f}x (printed, no target)")
 
 
 if __name__ == "__main__":

@@ -82,3 +82,17 @@ def wave_h2_squared(k: float) -> float:
     c = [1.0, (r - 1) / 2, -r]
     terms = [(c[j] ** 2 + c[j] * c[j + 1] + c[j + 1] ** 2) / 3 for j in (0, 1)]
     return sum(terms) / (1 - r**2)
+
+
+def string_under_force(c: float):
+    """The built-in string with ρ = T = c (inputs e1(0), e2(1)) under a uniform force w1.
+
+    ∫₀¹ e1 dz is judged.  With sensor y2 = e1(1) and gain k the estimation error is the
+    damped-tip string: dividing by c, u_tt = u_zz + w/c and u_z(1) = -(k/c) u_t(1), so its
+    norms are those of the unit string with damper k/c, divided by c.
+    """
+    data = model_to_dict(load_builtin("wave"))
+    data["parameters"] = {"rho": c, "T": c}
+    data["disturbances"] = {"B": [[1], [0]]}
+    data["performance"] = {"outputs": ["integral(e1)"]}
+    return model_from_dict(data)

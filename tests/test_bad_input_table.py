@@ -1190,6 +1190,57 @@ COMMAND_ROWS = [
         ParameterError,
     ),
     row(
+        "tune {tmp}/dtw.toml --sensors 1 --objective unknown",
+        "argument --objective: invalid choice: 'unknown'",
+        None,
+        **{"dtw.toml": DAMPED_TIP},
+    ),
+    row(
+        "tune {tmp}/dtw.toml --sensors 1 --max-hinf -1",
+        "--max-hinf must be a finite positive number; found -1.0",
+        NumericError,
+        **{"dtw.toml": DAMPED_TIP},
+    ),
+    row(
+        "tune {tmp}/dtw.toml --sensors 1 --max-hinf 0",
+        "--max-hinf must be a finite positive number; found 0.0",
+        NumericError,
+        **{"dtw.toml": DAMPED_TIP},
+    ),
+    row(
+        "tune {tmp}/dtw.toml --sensors 1 --objective hinf --max-hinf 1",
+        "--max-hinf bounds the abscissa objective; --objective hinf takes --min-decay",
+        NumericError,
+        **{"dtw.toml": DAMPED_TIP},
+    ),
+    row(
+        "tune {tmp}/dtw.toml --sensors 1 --objective h2 --at 1",
+        "--at does not go with the disturbance objectives",
+        NumericError,
+        **{"dtw.toml": DAMPED_TIP},
+    ),
+    row(
+        "tune {tmp}/dtw.toml --sensors 1 --performance integral(e1)",
+        "--performance needs --objective hinf or h2, or --max-hinf",
+        NumericError,
+        **{"dtw.toml": DAMPED_TIP},
+    ),
+    row(
+        "tune wave --sensors 2 --objective hinf --performance integral(e1)",
+        "model 'wave' has no disturbance",
+        NumericError,
+    ),
+    row(
+        "tradeoff wave --sensors 2 --against hinf --at 1",
+        "--at belongs to the RMS trade-off",
+        NumericError,
+    ),
+    row(
+        "tradeoff wave --sensors 2 --against hinf --scales 0.5:1:2",
+        "the disturbance gain needs performance outputs",
+        NumericError,
+    ),
+    row(
         "simulate {tmp}/dtw.toml --disturbance-noise -1",
         "--disturbance-noise: intensities must be finite and non-negative",
         NumericError,

@@ -25,8 +25,11 @@ __all__ = [
     "add_quiet_argument",
     "add_simulation_outputs",
     "check_finite_series",
+    "check_positive",
+    "comma_numbers",
     "emit",
     "emit_json",
+    "intensities",
     "load_model",
     "non_negative_int",
     "parse_parameter_overrides",
@@ -235,6 +238,24 @@ def emit_json(value: Any) -> None:
     from phdesign.io import dumps_json
 
     emit(dumps_json(value))
+
+
+def comma_numbers(text: str, flag: str) -> list[float]:
+    """Return the comma-separated numbers of option ``flag`` (``0.01,0.04``), or refuse."""
+    values = []
+    for part in str(text).split(","):
+        try:
+            values.append(float(part))
+        except ValueError:
+            raise NumericError(
+                f"{flag}: expected comma-separated numbers like 0.01,0.04; found {part.strip()!r}"
+            ) from None
+    return values
+
+
+def intensities(text: str | None, flag: str) -> list[float] | None:
+    """Return the numbers of a noise intensity option (the design checks count and signs)."""
+    return None if text is None else comma_numbers(text, flag)
 
 
 def check_positive(option: str, value: float | int | None) -> None:

@@ -18,6 +18,7 @@ from phdesign.cli.common import (
     add_quiet_argument,
     check_positive,
     emit_result,
+    intensities,
     load_model,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
@@ -67,7 +68,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _gain(args: argparse.Namespace) -> int:
-    from phdesign.cli.noise_commands import intensities
     from phdesign.design.plant import Plant
 
     for option in ("--resolution", "--max-resolution", "--tol"):

@@ -32,13 +32,21 @@ from phdesign.cli.common import (
     add_model_argument,
     add_quiet_argument,
     check_positive,
+    comma_numbers,
     emit_result,
+    intensities,
     load_model,
     result_text,
     run_outputs,
     split_items,
 )
 from phdesign.cli.design_arguments import add_observer_arguments, observer_from_args
+from phdesign.cli.disturbance_arguments import (
+    add_against_arguments,
+    add_disturbance_tuning_arguments,
+    disturbance_tradeoff_inputs,
+    disturbance_tuning,
+)
 from phdesign.core.errors import NumericError, ObserverError, ParameterError
 from phdesign.core.limits import check_tradeoff_gains
 
@@ -132,6 +140,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     tr.add_argument(
         "--scales", metavar="LO:HI:N", help="scales s of the ray, log-spaced (default 0.1:10:12)"
     )
+    add_against_arguments(tr)
     add_noise_arguments(tr)
     add_discretization_arguments(tr)
     fmt = tr.add_mutually_exclusive_group()
@@ -145,23 +154,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 # ----------------------------------------------------------------------------- parsing
-def _numbers(text: str, flag: str) -> list[float]:
-    values = []
-    for part in str(text).split(","):
-        try:
-            values.append(float(part))
-        except ValueError:
-            raise NumericError(
-                f"{flag}: expected comma-separated numbers like 0.01,0.04; found {part.strip()!r}"
-            ) from None
-    return values
-
-
-def intensities(text: str | None, flag: str) -> list[float] | None:
-    """Return the numbers of a noise intensity option (the design checks count and signs)."""
-    return None if text is None else _numbers(text, flag)
-
-
 def _performance(args: argparse.Namespace) -> list[str] | None:
     """Return the performance outputs of ``--at``, ``--trace`` and ``--integral`` as text."""
     points = split_items(args.at) if args.at is not None else []
@@ -229,11 +221,11 @@ def _range(text: str, flag: str) -> Any:
 
     parts = str(text).split(":")
     if len(parts) == 1:
-        value = _numbers(parts[0], flag)[0]
+        value = comma_numbers(parts[0], flag)[0]
         return np.array([value])
     if len(parts) != 3:
         raise NumericError(f"{flag}: expected lo:hi:count or one value; found {text!r}")
-    lo, hi = (_numbers(p, flag)[0] for p in parts[:2])
+    lo, hi = (comma_numbers(p, flag)[0] for p in parts[:2])
     try:
         count = int(parts[2])
     except ValueError:
@@ -247,6 +239,15 @@ def _range(text: str, flag: str) -> Any:
     return np.geomspace(lo, hi, count)
 
 
+def _tradeoff_inputs(args: argparse.Namespace) -> dict[str, Any]:
+    """Return the figures' options: the noise's (``--against rms``) or the gain report's."""
+    if args.against == "hinf":
+        return disturbance_tradeoff_inputs(args)
+    if args.performance is not None:
+        raise NumericError("--performance goes with --against hinf; the RMS takes --at")
+    return _noise_inputs(args)
+
+
 def _tradeoff(args: argparse.Namespace) -> int:
     observer = _observer(args, "tradeoff")
     q = observer.q
@@ -254,7 +255,7 @@ def _tradeoff(args: argparse.Namespace) -> int:
         raise NumericError("--scales belongs to a ray; a --grid gives its own values")
     direction = None
     if args.direction is not None:
-        direction = _numbers(args.direction, "--direction")
+        direction = comma_numbers(args.direction, "--direction")
         if len(direction) not in (1, q) or min(direction) <= 0:
             raise NumericError(
                 f"--direction: expected {q} positive values (one per sensor) or one; "
@@ -268,7 +269,7 @@ def _tradeoff(args: argparse.Namespace) -> int:
     # the table and the picture are checked now and written together: both or neither
     with run_outputs(args) as commit:
         result = observer.tradeoff(
-            direction=direction, scales=scales, grid=grid, **_noise_inputs(args)
+            direction=direction, scales=scales, grid=grid, **_tradeoff_inputs(args)
         )
         commit(_text(args, result), result)
     return 0
@@ -324,16 +325,11 @@ def noise_options(args: argparse.Namespace) -> dict[str, Any]:
     if args.noise_intensity is not None and sensors is None:
         raise ObserverError("--noise-intensity needs an observer: give --sensors or --cm")
     return {
-        "noise_intensity": _listedintensities(args.noise_intensity, "--noise-intensity"),
-        "input_intensity": _listedintensities(args.input_noise, "--input-noise"),
-        "disturbance_intensity": _listedintensities(args.disturbance_noise, "--disturbance-noise"),
+        "noise_intensity": intensities(args.noise_intensity, "--noise-intensity"),
+        "input_intensity": intensities(args.input_noise, "--input-noise"),
+        "disturbance_intensity": intensities(args.disturbance_noise, "--disturbance-noise"),
         "seed": args.seed,
     }
-
-
-def _listedintensities(text: str | None, flag: str) -> list[float] | None:
-    """Return the numbers of an intensity option (the simulation options check them)."""
-    return None if text is None else _numbers(text, flag)
 
 
 # ----------------------------------------------------------------------------- tune
@@ -347,21 +343,28 @@ def add_noise_tuning_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--objective",
-        choices=("abscissa", "rms"),
+        choices=("abscissa", "rms", "hinf", "h2"),
         default="abscissa",
-        help="what to minimize (rms: the error RMS, with --min-decay)",
+        help="what to minimize (rms: the error RMS, with --min-decay; hinf, h2: the norms "
+        "of phdesign gain from the disturbances and sensor noise to the error of the "
+        "performance outputs, with --min-decay optional)",
     )
     parser.add_argument(
         "--min-decay",
         type=float,
         metavar="A",
-        help="with --objective rms: require the spectral abscissa <= -A",
+        help="with --objective rms, hinf or h2: require the spectral abscissa <= -A",
     )
+    add_disturbance_tuning_arguments(parser)
     add_noise_arguments(parser)
 
 
 def noise_tuning(args: argparse.Namespace) -> int | None:
-    """Run the noise-aware tuning when its options are given; None otherwise."""
+    """Run the noise- or disturbance-aware tuning when its options are given; None otherwise."""
+    if args.objective in ("hinf", "h2") or args.max_hinf is not None:
+        return disturbance_tuning(args)
+    if args.performance is not None:
+        raise NumericError("--performance needs --objective hinf or h2, or --max-hinf")
     wanted = args.max_rms is not None or args.objective == "rms" or args.min_decay is not None
     extras = [
         flag

@@ -33,6 +33,8 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     import sympy
 
     from phdesign.numeric.noise.disturbance_report import GainReport
+    from phdesign.numeric.noise.disturbance_tradeoff import DisturbanceTradeoff
+    from phdesign.numeric.noise.disturbance_tuning import DisturbanceTuneResult
     from phdesign.numeric.noise.metrics import Metric
     from phdesign.numeric.noise.report import NoiseReport
     from phdesign.numeric.noise.tradeoff import Tradeoff
@@ -174,8 +176,9 @@ class ObserverNoise:
         intensity: float | Sequence[float] | None = None,
         input_intensity: float | Sequence[float] | None = None,
         performance: str | Sequence[str] | None = None,
+        against: str = "rms",
         progress: Progress | None = None,
-    ) -> Tradeoff:
+    ) -> Tradeoff | DisturbanceTradeoff:
         r"""Decay rate against error RMS for these sensors, over a ray or a grid of gains.
 
         Along the ray :math:`L(s) = s L_0` (or over a grid of diagonal gains) each gain
@@ -195,11 +198,18 @@ class ObserverNoise:
             Per-sensor gain values, every combination a diagonal gain (instead of a ray).
         intensity, input_intensity, performance, progress
             As for :meth:`noise`.
+        against : {"rms", "hinf"}
+            ``"hinf"``: the decay rate against the H∞ norm of :meth:`gain` from the model's
+            ``[disturbances]`` and the sensor noise of ``intensity`` (default 1) to the error
+            of its ``[performance]`` outputs (``performance`` in that grammar;
+            ``input_intensity`` does not apply): a
+            :class:`~phdesign.numeric.noise.disturbance_tradeoff.DisturbanceTradeoff`
+            (:func:`phdesign.numeric.noise.disturbance_tradeoff.disturbance_tradeoff`).
 
         Returns
         -------
-        Tradeoff
-            ``.points`` (gain, decay rate, rms, Pareto flag), ``.pareto_points``,
+        Tradeoff or DisturbanceTradeoff
+            ``.points`` (gain, decay rate, rms or H∞, Pareto flag), ``.pareto_points``,
             ``.to_csv()``, ``.plot()``; ``str()`` is what ``phdesign tradeoff`` prints.
 
         Examples
@@ -226,6 +236,24 @@ class ObserverNoise:
                     f"direction (the gain L_0 of the ray s L_0): {error}"
                 ) from None
             direction = numeric_matrix(exact, "direction", "tradeoff")
+        if against not in ("rms", "hinf"):
+            raise ObserverError(f"against must be 'rms' or 'hinf'; found {against!r}")
+        if against == "hinf":
+            from phdesign.numeric.noise.disturbance_tradeoff import disturbance_tradeoff
+
+            if input_intensity is not None:
+                raise ObserverError("input_intensity belongs to the RMS trade-off (against='rms')")
+            return disturbance_tradeoff(
+                self.plant.numeric,
+                C,
+                model=self.plant.design_model,
+                direction=direction,
+                scales=scales,
+                grid=grid,
+                intensity=intensity,
+                performance=[performance] if isinstance(performance, str) else performance,
+                method=self.plant.method,
+            )
         return tradeoff(
             self.plant.numeric,
             C,
@@ -311,12 +339,13 @@ class ObserverNoise:
         objective: str = "abscissa",
         max_rms: float | None = None,
         min_decay: float | None = None,
+        max_hinf: float | None = None,
         intensity: float | Sequence[float] | None = None,
         input_intensity: float | Sequence[float] | None = None,
         performance: str | Sequence[str] | None = None,
         progress: Progress | None = None,
-    ) -> NoiseTuneResult:
-        """Tune a positive diagonal gain for these sensors under a noise budget.
+    ) -> NoiseTuneResult | DisturbanceTuneResult:
+        r"""Tune a positive diagonal gain for these sensors under a noise or disturbance budget.
 
         ``objective="abscissa"`` minimizes the converged spectral abscissa subject to the
         error RMS of the performance outputs at most ``max_rms``; ``"rms"`` minimizes the
@@ -324,17 +353,60 @@ class ObserverNoise:
         (:func:`phdesign.numeric.noise.tuning.tune_noise`).  ``intensity``,
         ``input_intensity``, ``performance`` and ``progress`` are those of :meth:`noise`.
 
+        Against the model's ``[disturbances]`` (:meth:`gain`'s figures, sensor noise of
+        ``intensity`` included): ``"hinf"`` (``"h2"``) minimizes the H∞ (H₂) norm to the
+        error of the ``[performance]`` outputs, subject to the abscissa at most
+        ``-min_decay`` when given; ``"abscissa"`` with ``max_hinf`` minimizes the abscissa
+        subject to the H∞ norm at most ``max_hinf``
+        (:func:`phdesign.numeric.noise.disturbance_tuning.tune_disturbance`).  There
+        ``performance`` is in the ``[performance]`` grammar (``"integral(e1)"``; default
+        the model's) and ``input_intensity`` does not apply.
+
         Returns
         -------
-        NoiseTuneResult
-            ``.gain``, the abscissa and RMS it reaches; ``str()`` is what ``phdesign tune
-            --max-rms`` prints.
+        NoiseTuneResult or DisturbanceTuneResult
+            ``.gain`` and the figures it reaches, verified; ``str()`` is what ``phdesign
+            tune --max-rms`` (``--objective hinf``, ``--max-hinf``) prints.
+
+        Examples
+        --------
+        >>> from phdesign import Observer
+        >>> from phdesign.io import model_from_dict, model_to_dict
+        >>> from phdesign.models import load_builtin
+        >>> data = model_to_dict(load_builtin("wave"))  # the string under a uniform force
+        >>> data["disturbances"] = {"B": [[1], [0]]}
+        >>> data["performance"] = {"outputs": ["integral(e1)"]}
+        >>> string = Observer(model_from_dict(data), sensors=[2])
+        >>> tuned = string.tune_noise(objective="hinf", intensity=0)
+        >>> round(float(tuned.gain[0, 0]), 2), round(tuned.hinf, 4)  # the damped tip k*
+        (0.96, 0.5349)
         """
+        C = numeric_matrix(self.C_m, "C_m", "tune")
+        if objective in ("hinf", "h2") or max_hinf is not None:
+            from phdesign.numeric.noise.disturbance_tuning import tune_disturbance
+
+            if max_rms is not None or input_intensity is not None:
+                given = "max_rms" if max_rms is not None else "input_intensity"
+                raise ObserverError(
+                    f"{given} belongs to the noise objectives; the disturbance objectives "
+                    "(hinf, h2, max_hinf) take the sensor noise as intensity"
+                )
+            return tune_disturbance(
+                self.plant.numeric,
+                C,
+                model=self.plant.design_model,
+                objective=objective,
+                max_hinf=max_hinf,
+                min_decay=min_decay,
+                intensity=intensity,
+                performance=[performance] if isinstance(performance, str) else performance,
+                method=self.plant.method,
+            )
         from phdesign.numeric.noise.tuning import tune_noise
 
         return tune_noise(
             self.plant.numeric,
-            numeric_matrix(self.C_m, "C_m", "tune"),
+            C,
             objective=objective,
             max_rms=max_rms,
             min_decay=min_decay,

@@ -30,11 +30,15 @@ def plot_tradeoff(
     force: bool = False,
     annotate: str = "pareto",
 ) -> Figure:
-    """Decay rate −α against the error RMS; Pareto-optimal gains joined and annotated.
+    """Decay rate −α against a figure of the error; Pareto-optimal gains joined and annotated.
+
+    The figure is each point's ``figure`` (the RMS of a :class:`~phdesign.numeric.noise.
+    tradeoff.Tradeoff`, the H∞ norm of a :class:`~phdesign.numeric.noise.
+    disturbance_tradeoff.DisturbanceTradeoff`), named by the result's ``figure_label``.
 
     Parameters
     ----------
-    result : Tradeoff
+    result : Tradeoff or DisturbanceTradeoff
     path : path-like, optional
         Write the figure there (suffix picks the format).
     force : bool
@@ -48,12 +52,12 @@ def plot_tradeoff(
 
 
 def _draw_tradeoff(ax: Axes, result: Any, annotate: str) -> None:
-    pts = [p for p in result.points if p.rms is not None and p.decay_rate is not None]
+    pts = [p for p in result.points if p.figure is not None and p.decay_rate is not None]
     others = [p for p in pts if not p.pareto]
-    front = sorted((p for p in pts if p.pareto), key=lambda p: p.rms)
+    front = sorted((p for p in pts if p.pareto), key=lambda p: p.figure)
     if others:
         ax.scatter(
-            [p.rms for p in others],
+            [p.figure for p in others],
             [p.decay_rate for p in others],
             color="0.6",
             label="dominated",
@@ -61,7 +65,7 @@ def _draw_tradeoff(ax: Axes, result: Any, annotate: str) -> None:
         )
     if front:
         ax.plot(
-            [p.rms for p in front],
+            [p.figure for p in front],
             [p.decay_rate for p in front],
             "-o",
             color="tab:red",
@@ -71,7 +75,7 @@ def _draw_tradeoff(ax: Axes, result: Any, annotate: str) -> None:
     loose = [p for p in pts if not p.abscissa_converged]
     if loose:
         ax.scatter(
-            [p.rms for p in loose],
+            [p.figure for p in loose],
             [p.decay_rate for p in loose],
             facecolors="none",
             edgecolors="black",
@@ -83,21 +87,18 @@ def _draw_tradeoff(ax: Axes, result: Any, annotate: str) -> None:
     for p in _spread(labelled):
         ax.annotate(
             gain_text(p.gain),
-            (p.rms, p.decay_rate),
+            (p.figure, p.decay_rate),
             textcoords="offset points",
             xytext=(6, 4),
             fontsize=8,
         )
     ax.set_xscale("log")
-    unit = getattr(result, "performance_unit", "")
     rate = getattr(result, "time_unit", "") or "s"
     ax.set(
-        xlabel=literal(
-            f"RMS of the estimation error of {result.performance}" + (f" [{unit}]" if unit else "")
-        ),
+        xlabel=literal(result.figure_label),
         ylabel=f"decay rate −α [1/{rate}]",
         title=literal(
-            f"{result.model}, sensors {measured_text(result.sensors)}: speed against noise"
+            f"{result.model}, sensors {measured_text(result.sensors)}: {result.figure_title}"
         ),
     )
     ax.grid(True, which="both", alpha=0.3)
@@ -106,10 +107,10 @@ def _draw_tradeoff(ax: Axes, result: Any, annotate: str) -> None:
 
 
 def _spread(points: list[Any], gap: float = 0.035) -> list[Any]:
-    """Drop labels that would overlap the previous one (log rms, linear decay, relative)."""
+    """Drop labels that would overlap the previous one (log figure, linear decay, relative)."""
     if not points:
         return []
-    lx = np.log10([p.rms for p in points])
+    lx = np.log10([p.figure for p in points])
     y = np.array([p.decay_rate for p in points])
     sx, sy = max(float(np.ptp(lx)), 1e-12), max(float(np.ptp(y)), 1e-12)
     kept = [0]

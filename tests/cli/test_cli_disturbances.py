@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
@@ -53,3 +54,62 @@ def test_simulate_disturbance_noise_names_its_intensity(damped, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["noise"] == "disturbance intensity 0.5"
     assert out["H"][-1] > 0  # driven from rest
+
+
+#: The string with ρ = T = 2 under a uniform force, ∫ e1 judged: with sensor y2 and gain k
+#: its error is the damped-tip string of damper k/2 scaled by 1/2
+#: (tests/numeric/noise/test_disturbance_tuning.py)
+STRING = """
+name = "string under a force"
+interval = [0, 1]
+order = 1
+[parameters]
+rho = 2
+T = 2
+[matrices]
+P1 = [[0, 1], [1, 0]]
+H = [["1/rho", 0], [0, "T"]]
+[ports]
+inputs = ["e1(0)", "e2(1)"]
+outputs = ["-e2(0)", "e1(1)"]
+[disturbances]
+B = [[1], [0]]
+[performance]
+outputs = ["integral(e1)"]
+"""
+
+
+@pytest.fixture
+def string(tmp_path):
+    path = tmp_path / "string.toml"
+    path.write_text(STRING)
+    return str(path)
+
+
+@pytest.mark.slow
+def test_tune_objective_hinf_prints_the_gain_report_of_its_gain(string, capsys):
+    from phdesign import Observer, load
+
+    argv = ["tune", string, "--sensors", "2", "--objective", "hinf", "--intensity", "0"]
+    assert main([*argv, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    # recomputed from scratch at the printed gain: the same number, no worse than L = I
+    again = Observer(load(string), sensors=[2], gain=out["gain"]).gain(intensity=0)
+    assert out["hinf"] == again.hinf.value
+    assert out["hinf"] < out["start"]["hinf"]
+    assert out["objective"] == "hinf"
+    assert out["feasible"] is True
+
+
+def test_tradeoff_against_hinf_is_the_damped_strings_closed_form(string, capsys):
+    from disturbance_models import wave_hinf
+
+    argv = ["tradeoff", string, "--sensors", "2", "--against", "hinf", "--intensity", "0"]
+    assert main([*argv, "--scales", "0.5:1.5:2", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for point, k in zip(out["points"], (0.5, 1.5), strict=True):
+        r = k / 2  # the damper of the unit string
+        # -α = ½ ln|(1 + r)/(1 - r)| (to the abscissa's 1e-10) and γ = γ₁(r)/2 (to 1e-8)
+        assert point["decay_rate"] == pytest.approx(0.5 * math.log((1 + r) / (1 - r)), abs=1e-9)
+        assert point["hinf"] == pytest.approx(wave_hinf(r)[0] / 2, rel=1e-8)
+    assert out["pareto"] == [1]  # k = 1.5 decays faster and lets less through

@@ -21,7 +21,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from itertools import product
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -34,14 +34,12 @@ from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.functionals import Functional, parse_functionals
 from phdesign.numeric.discretization.registry import DiscretePHS, feedback_matrix
 from phdesign.numeric.noise.figures import noise, sensor_rows
+from phdesign.numeric.noise.pareto import ParetoFamily, pareto_mask
 from phdesign.numeric.noise.report import NoiseReport
 from phdesign.numeric.noise.settle import finite_or_none
 from phdesign.numeric.spectrum.converged import SpectrumReport, spectrum
 from phdesign.numeric.spectrum.refinement import Discretizations
 from phdesign.numeric.threads import limited_threads
-
-if TYPE_CHECKING:  # pragma: no cover - typing only
-    from matplotlib.figure import Figure
 
 __all__ = ["Tradeoff", "TradeoffPoint", "gain_family", "pareto_mask", "tradeoff"]
 
@@ -82,6 +80,11 @@ class TradeoffPoint:
         """RMS of the first performance output's error (None unless converged)."""
         return self.noise.rms()
 
+    @property
+    def figure(self) -> float | None:
+        """The figure traded against the decay rate: the RMS."""
+        return self.rms
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready row of the table."""
         g = self.noise.l2_gain
@@ -105,8 +108,11 @@ class TradeoffPoint:
 
 
 @dataclass(frozen=True)
-class Tradeoff:
+class Tradeoff(ParetoFamily):
     """Result of :func:`tradeoff`: one row per gain, Pareto-optimal rows marked.
+
+    ``.pareto_points`` (by increasing RMS) and ``.plot()`` (decay rate against the RMS)
+    are those of :class:`~phdesign.numeric.noise.pareto.ParetoFamily`.
 
     Attributes
     ----------
@@ -140,10 +146,15 @@ class Tradeoff:
     time_unit: str = ""
 
     @property
-    def pareto_points(self) -> tuple[TradeoffPoint, ...]:
-        """The Pareto-optimal points, by increasing RMS."""
-        best = [p for p in self.points if p.pareto]
-        return tuple(sorted(best, key=lambda p: p.rms if p.rms is not None else math.inf))
+    def figure_label(self) -> str:
+        """What the figure of the points is (the plot's axis)."""
+        unit = f" [{self.performance_unit}]" if self.performance_unit else ""
+        return f"RMS of the estimation error of {self.performance}{unit}"
+
+    @property
+    def figure_title(self) -> str:
+        """What is traded, in the plot's title."""
+        return "speed against noise"
 
     def _columns(self) -> list[str]:
         q = self.sensors.shape[0]
@@ -250,12 +261,6 @@ class Tradeoff:
             repr(self),
         )
 
-    def plot(self, path: Any = None, *, force: bool = False, annotate: str = "pareto") -> Figure:
-        """Decay rate against error RMS, Pareto front drawn and gains annotated."""
-        from phdesign.plots.noise import plot_tradeoff
-
-        return plot_tradeoff(self, path, force=force, annotate=annotate)
-
 
 def _figure_text(point: TradeoffPoint, spec: str, *, l2: bool = False) -> str:
     """Return a point's rms (or L2-gain) for the table; ``0.6095*`` if not converged."""
@@ -268,38 +273,6 @@ def _figure_text(point: TradeoffPoint, spec: str, *, l2: bool = False) -> str:
         return "—"
     shown = est.rounded() if l2 else est.rounded(math.sqrt(max(est.values[-1], 0.0)))
     return "—" if shown is None else f"{shown}*"
-
-
-def pareto_mask(
-    decay: Sequence[float | None],
-    rms: Sequence[float | None],
-    decay_tol: float = 1e-8,
-    rms_tol: float = 1e-6,
-) -> list[bool]:
-    """Mark the points no other point beats in both (larger decay, smaller rms).
-
-    Values closer than the relative tolerances (the figures' own accuracy under
-    refinement) count as equal: a gain is not Pareto-optimal for a decay rate that beats
-    another's by round-off.  Points with a missing figure are never Pareto-optimal.
-
-    Examples
-    --------
-    >>> pareto_mask([1.0, 2.0, 1.5, None, 1.0 + 1e-12], [0.1, 0.3, 0.4, 0.0, 0.2])
-    [True, True, False, False, False]
-    """
-    pts = [(d, r) for d, r in zip(decay, rms, strict=True)]
-
-    def beats(a: tuple[float, float], b: tuple[float, float]) -> bool:
-        td = decay_tol * max(1.0, abs(b[0]))
-        tr = rms_tol * abs(b[1])
-        no_worse = a[0] >= b[0] - td and a[1] <= b[1] + tr
-        return no_worse and (a[0] > b[0] + td or a[1] < b[1] - tr)
-
-    known = [(d, r) for d, r in pts if d is not None and r is not None]
-    return [
-        d is not None and r is not None and not any(beats(o, (d, r)) for o in known)
-        for d, r in pts
-    ]
 
 
 def gain_family(

@@ -29,7 +29,7 @@ and rms = (σ² k/2)^{1/2}, so ``max_rms=R`` gives :math:`k^* = 2R^2/\sigma^2` (
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from itertools import product
 from typing import Any
@@ -54,7 +54,14 @@ from phdesign.numeric.spectrum.drift import pair_spectrum
 from phdesign.numeric.spectrum.report import SpectrumReport
 from phdesign.numeric.threads import limited_threads
 
-__all__ = ["NoiseTuneResult", "tune_noise"]
+__all__ = [
+    "NoiseTuneResult",
+    "PenaltyMerit",
+    "SearchBest",
+    "positive_bound",
+    "search_gain",
+    "tune_noise",
+]
 
 _PENALTY = 100.0  # weight of a normalized constraint violation in the merit function
 
@@ -209,9 +216,9 @@ def tune_noise(
     q = C.shape[0]
     feedback_matrix(C, np.eye(q), nm.n_ports)
     if objective == "abscissa":
-        bound = _positive(max_rms, "max_rms", "the abscissa objective needs an RMS budget")
+        bound = positive_bound(max_rms, "max_rms", "the abscissa objective needs an RMS budget")
     elif objective == "rms":
-        bound = _positive(min_decay, "min_decay", "the RMS objective needs a decay rate")
+        bound = positive_bound(min_decay, "min_decay", "the RMS objective needs a decay rate")
     else:
         raise NumericError(f"objective must be 'abscissa' or 'rms'; found {objective!r}")
     sigma, w_in = noise_intensities(nm, q, intensity, input_intensity)
@@ -223,8 +230,10 @@ def tune_noise(
         )
     problem = _Problem(nm, C, sigma, w_in, tuple(functionals), objective, bound)
     with stage("tune: the figures at L = I"):
-        merit = _Merit(problem, _Figures.at_converged_resolutions(problem))
-    best = _search(merit, q, log_range, maxiter)
+        figures = _Figures.at_converged_resolutions(problem)
+        minimized = "abscissa" if problem.objective == "abscissa" else "figure"
+        merit = PenaltyMerit(figures, minimized, problem.bound)
+    best = search_gain(merit, q, log_range, maxiter)
     with stage("tune: verifying the best gain"):
         return _verified(problem, best, merit.evaluations, maxiter)
 
@@ -305,28 +314,45 @@ class _Figures:
         return alpha, math.sqrt(max(stats.variance(r) for r in self.rows))
 
 
-class _Merit:
-    """The exact penalty f + μ max(0, g) of the normalized constraint g (module docstring)."""
+class PenaltyMerit:
+    r"""The exact penalty f + μ max(0, g) of the normalized constraint g (module docstring).
 
-    def __init__(self, problem: _Problem, figures: _Figures) -> None:
-        self.problem, self.figures = problem, figures
+    ``figures(x)`` returns the abscissa α (None: unresolved or not computed) and a figure
+    (an RMS, an H∞ or H₂ norm; inf: no steady state) at L = diag(e^x).  ``minimized``
+    ``"abscissa"`` minimizes α subject to figure <= ``bound``; ``"figure"`` minimizes the
+    figure subject to α <= -``bound`` (unconstrained when ``bound`` is None).  Each call
+    is counted and reported as a ``label`` search's progress.
+    """
+
+    def __init__(
+        self,
+        figures: Callable[[np.ndarray], tuple[float | None, float]],
+        minimized: str,
+        bound: float | None,
+        label: str = "noise-aware",
+    ) -> None:
+        self.figures, self.minimized, self.bound, self.label = figures, minimized, bound, label
         self.evaluations = 0
 
     def __call__(self, x: np.ndarray) -> float:
         """Return the merit at L = diag(e^x), counting the evaluation."""
         self.evaluations += 1
-        report(f"tune: noise-aware search, {self.evaluations} evaluations")
-        alpha, rms = self.figures(x)
-        if alpha is None:  # nothing resolved: leave the region
+        report(f"tune: {self.label} search, {self.evaluations} evaluations")
+        alpha, value = self.figures(x)
+        bound = self.bound
+        if not math.isfinite(value):  # no steady state: leave the region
             return 1e6
-        bound = self.problem.bound
-        if self.problem.objective == "abscissa":
-            return alpha + _PENALTY * max(1.0, abs(alpha)) * max(0.0, rms / bound - 1.0)
-        return rms + _PENALTY * max(rms, 1e-300) * max(0.0, (alpha + bound) / bound)
+        if self.minimized == "figure" and bound is None:
+            return value
+        if alpha is None or bound is None:  # nothing resolved: leave the region
+            return 1e6
+        if self.minimized == "abscissa":
+            return alpha + _PENALTY * max(1.0, abs(alpha)) * max(0.0, value / bound - 1.0)
+        return value + _PENALTY * max(value, 1e-300) * max(0.0, (alpha + bound) / bound)
 
 
 @dataclass(frozen=True)
-class _Best:
+class SearchBest:
     """The best point of the search, its merit, and whether its search was cut short."""
 
     x: np.ndarray
@@ -334,12 +360,14 @@ class _Best:
     unsettled: bool = False
 
 
-def _search(merit: _Merit, q: int, log_range: tuple[float, float], maxiter: int) -> _Best:
+def search_gain(
+    merit: Callable[[np.ndarray], float], q: int, log_range: tuple[float, float], maxiter: int
+) -> SearchBest:
     """Grid of starts, then Brent (one gain) or Nelder-Mead from the two best starts."""
     grid = _start_grid(q, log_range)
     scores = [merit(x) for x in grid]
     order = np.argsort(scores)
-    best = _Best(grid[int(order[0])], float(scores[int(order[0])]))
+    best = SearchBest(grid[int(order[0])], float(scores[int(order[0])]))
     if q == 1:  # Brent between the grid neighbours of the best start
         k = int(order[0])
         lo, hi = grid[max(k - 1, 0)][0], grid[min(k + 1, len(grid) - 1)][0]
@@ -350,7 +378,7 @@ def _search(merit: _Merit, q: int, log_range: tuple[float, float], maxiter: int)
             options={"xatol": 1e-6},
         )
         if found.fun < best.merit:
-            best = _Best(np.array([found.x]), float(found.fun))
+            best = SearchBest(np.array([found.x]), float(found.fun))
         return best
     for i in order[:2]:
         found = minimize(
@@ -360,11 +388,13 @@ def _search(merit: _Merit, q: int, log_range: tuple[float, float], maxiter: int)
             options={"maxiter": maxiter * q, "xatol": 1e-5, "fatol": 1e-9},
         )
         if found.fun < best.merit:  # unsettled: stopped by its iteration limit
-            best = _Best(found.x, float(found.fun), not found.success)
+            best = SearchBest(found.x, float(found.fun), not found.success)
     return best
 
 
-def _verified(problem: _Problem, best: _Best, evaluations: int, maxiter: int) -> NoiseTuneResult:
+def _verified(
+    problem: _Problem, best: SearchBest, evaluations: int, maxiter: int
+) -> NoiseTuneResult:
     """Verify the best gain with the adaptive spectrum and noise figures; say what failed."""
     L = np.diag(np.exp(best.x))
     spec = spectrum(problem.nm, problem.C, L)
@@ -414,7 +444,8 @@ def _first_agreeing(est: Any, tol: float) -> int | None:
     return None
 
 
-def _positive(value: float | None, name: str, why: str) -> float:
+def positive_bound(value: float | None, name: str, why: str) -> float:
+    """Return ``value`` as a positive finite float; refuse None (saying ``why``) or others."""
     if value is None:
         raise NumericError(f"{why}: give {name}")
     v = float(value)
