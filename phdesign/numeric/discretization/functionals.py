@@ -95,8 +95,9 @@ class Functional:
     def row(self, d: DiscretePHS) -> np.ndarray:
         """Return ``c`` with the functional equal to ``c @ ê`` on the discretization ``d``.
 
-        A displacement's row is built once per discretization and point, and shared
-        (read-only).
+        A displacement's row is built once per discretization and point, an integral's
+        against a weight with a ``key`` (a :class:`~phdesign.numeric.inputs.Profile`) once
+        per discretization and weight, and shared (read-only).
         """
         if self.kind == "displacement":
             basis = _basis(d, self.field_name, self.name)
@@ -112,7 +113,12 @@ class Functional:
                 )
             return np.asarray(self.trace @ T, dtype=float)
         if self.kind == "integral" and self.weight is not None:
-            return _integral_row(d, self.weight)
+            weight = self.weight
+            key = getattr(weight, "key", None)  # a Profile: the same weight, the same row
+            if key is None:
+                return _integral_row(d, weight)
+            build = lambda: _read_only(_integral_row(d, weight)[None, :])  # noqa: E731
+            return _ROWS.get(d, ("integral", key), build)
         if self.kind == "sum":
             return np.asarray(sum(c * f.row(d) for f, c in self.parts))
         raise NumericError(f"unknown kind of functional {self.kind!r}")  # pragma: no cover
