@@ -11,7 +11,8 @@ Timoshenko beam with tip dampers, sensors y3, y4, L = I), in this process:
   against the proof itself.
 
 The z-dependent models (tests/rate_models.py: the string of speed 1 + z, whose true rate
-ln(3)/(2 ln 2) has a closed form, and the string of density 1 + z/2) are proved by the
+ln(3)/(2 ln 2) has a closed form, the string of density 1 + z/2, and the Timoshenko beam
+with K = EI = 1 + z/2) are proved by the
 polynomial weight (phdesign.numeric.certified.rate_poly: an SDP on a grid, decided exactly
 by Sturm sequences on all of [a, b]) and re-checked by phdesign.proofcheck.rate_poly; for
 them the proof's time is also printed against the constant string's proof in this run.
@@ -48,13 +49,18 @@ from phdesign.proofcheck.check import _rate as check_rate
 from phdesign.symbolic.observer import sensor_matrix
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from rate_models import DENSITY, SPEED
+from rate_models import DENSITY, SPEED, TAPERED_TIMOSHENKO
 
 CASES = {
     "string, damper k = 1/2": (lambda: load_builtin("wave"), [2], ["1/2"]),
     "Timoshenko, tip dampers L = I": (lambda: load_builtin("timoshenko"), [3, 4], ["1", "1"]),
     "string of speed 1 + z, damper k = 1/2": (lambda: SPEED, [2], ["1/2"]),
     "string of density 1 + z/2, damper k = 1/2": (lambda: DENSITY, [2], ["1/2"]),
+    "tapered Timoshenko (K = EI = 1 + z/2), tip dampers L = I": (
+        lambda: TAPERED_TIMOSHENKO,
+        [3, 4],
+        ["1", "1"],
+    ),
 }
 #: The constant case the z-dependent proofs are compared with.
 CONSTANT = "string, damper k = 1/2"

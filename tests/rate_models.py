@@ -63,3 +63,26 @@ TRANSPORT_SPEED = BCPHS.define(
     inputs=["e1(1) - e1(0)"],
     outputs=["(e1(1) + e1(0))/2"],
 )
+# x_t = x_z - z x (P0 = -z, H = 1): damping that grows along the interval
+DAMPED_TRANSPORT = BCPHS.define(
+    name="transport damped by z",
+    interval=[0, 1],
+    order=1,
+    P={1: [[1]], 0: [["-z"]]},
+    H=[[1]],
+    inputs=["e1(1) - e1(0)"],
+    outputs=["(e1(1) + e1(0))/2"],
+)
+# the Timoshenko beam (phdesign's built-in, parameters 1) with K = EI = 1 + z/2: tapered
+TAPERED_TIMOSHENKO = BCPHS.define(
+    name="tapered Timoshenko beam",
+    interval=[0, 1],
+    order=1,
+    P={
+        0: [[0, 0, 0, -1], [0, 0, 0, 0], [0, 0, 0, 0], [1, 0, 0, 0]],
+        1: [[0, 1, 0, 0], [1, 0, 0, 0], [0, 0, 0, 1], [0, 0, 1, 0]],
+    },
+    H=[["1 + z/2", 0, 0, 0], [0, 1, 0, 0], [0, 0, "1 + z/2", 0], [0, 0, 0, 1]],
+    inputs=["e2(0)", "e4(0)", "e1(1)", "e3(1)"],
+    outputs=["-e1(0)", "-e3(0)", "e2(1)", "e4(1)"],
+)

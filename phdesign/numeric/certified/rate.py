@@ -276,8 +276,11 @@ def _prove_polynomial(problem: RateProblem, target: float | None) -> DecayRatePr
         candidate = found if attempt == 0 else program.solve(float(sigma))
         if candidate is None:
             return None
+        if attempt:  # the constants c₁, c₂ that the fine grid asks for
+            candidate = program.violations(candidate)[1]
         Pi = _combine(problem, basis, candidate.coordinates, 2**36)
-        return PolynomialLyapunov(Pi, sigma, sympy.Integer(1), _round_up(candidate.c2))
+        c1 = sympy.Rational(math.floor(candidate.c1 * 10**9), 10**9)
+        return PolynomialLyapunov(Pi, sigma, c1, _round_up(candidate.c2))
 
     return _first_proved(
         problem, _round_down(found.sigma), target, rounded, "the SDP is infeasible"

@@ -24,6 +24,11 @@ r = (2 - k)/(2 + k); e = Hx travels from 1 to 0 along dz/dt = -(1 + z) in the ti
 int_0^1 dz/(1 + z) = ln 2, so e(0, t + ln 2) = r e(0, t) and the rate is
 -ln|r| / ln 2 = ln(5/3)/ln 2 = 0.73697 for k = 1/2.
 
+Transport x_t = x_z - z x (H = 1, P0(z) = -z), the same ports and closing: along a
+characteristic (speed 1, from 1 to 0 in unit time) e is damped by exp(-int_0^1 z dz) =
+exp(-1/2), so e(0, t + 1) = r e^(-1/2) e(0, t) and the rate is ln(5/3) + 1/2 = 1.01083
+for k = 1/2.
+
 String of density rho = 1 + z/2, T = 1 (H = diag(1/(1 + z/2), 1)), fixed at 0, damper
 k = 1/2 at 1: the impedance varies, so there is no closed form for the low modes; the
 characteristic determinant Delta(lambda) = f(1) + k v(1) of the shooting solution
@@ -46,7 +51,14 @@ import mpmath
 import pytest
 import sympy
 from checker_blocked import run_blocked
-from rate_models import DENSITY, SPEED, STRING_PORTS, TRANSPORT_SPEED, string
+from rate_models import (
+    DAMPED_TRANSPORT,
+    DENSITY,
+    SPEED,
+    STRING_PORTS,
+    TRANSPORT_SPEED,
+    string,
+)
 
 from phdesign.cli import main
 from phdesign.core.errors import RateProofError
@@ -117,6 +129,13 @@ def test_the_string_of_speed_1_plus_z_reaches_its_closed_form_rate(speed_proof):
 def test_a_transport_with_ports_at_both_ends_reaches_its_closed_form_rate():
     true = math.log(5 / 3) / math.log(2)
     proof = prove_decay_rate(damped(TRANSPORT_SPEED))
+    assert 0.99 * true <= proof.sigma < true, (float(proof.sigma), true)  # measured 0.999
+    assert check_rate_polynomial(json.loads(json.dumps(proof.to_json()))) == []
+
+
+def test_a_transport_damped_by_a_z_dependent_p0_reaches_its_closed_form_rate():
+    true = math.log(5 / 3) + 0.5
+    proof = prove_decay_rate(damped(DAMPED_TRANSPORT))
     assert 0.99 * true <= proof.sigma < true, (float(proof.sigma), true)  # measured 0.999
     assert check_rate_polynomial(json.loads(json.dumps(proof.to_json()))) == []
 
