@@ -15,16 +15,22 @@ ln(3)/(2 ln 2) has a closed form, the string of density 1 + z/2, and the Timoshe
 with K = EI = 1 + z/2) are proved by the
 polynomial weight (phdesign.numeric.certified.rate_poly: an SDP on a grid, decided exactly
 by Sturm sequences on all of [a, b]) and re-checked by phdesign.proofcheck.rate_poly; for
-them the proof's time is also printed against the constant string's proof in this run.
+them the proof's time is also printed against its constant counterpart's proof in this run
+(the strings against the constant string, the tapered beam against the constant beam).
 
 Targets: the proof takes at most 150x one cold converged spectrum, the re-check at most
-0.5x the proof.  The proof solves about two hundred small SDPs (a bisection in σ at each
-of about twenty weight ratios τ); Clarabel spends about 0.3 ms on each, cvxpy's
-parameter update and result unpacking 10-20 ms (measured with cProfile under a load of
-14 on two processors), so the search's cost is cvxpy's overhead: first measured at 60x
-(Timoshenko) and 110x (string), when the target was set.  Also printed: the proved σ against
-the converged abscissa (σ/|α|, the method's conservatism).  The machine's load is printed
-before and after: under load the ratios stay meaningful, the absolute times do not.
+0.5x the proof.  For the z-dependent models the proof's target is against the constant
+counterpart instead: at most 5x for the strings (first measured 1.4x and 2.1x), at most
+20x for the tapered beam (first measured 13x: its 4 x 4 minors have degree about 30, and
+the SDP needs nine cutting-plane rounds where the strings need none); their spectrum
+ratio is printed, not judged.  The constant proof solves about two hundred small SDPs (a
+bisection in σ at each of about twenty weight ratios τ); Clarabel spends about 0.3 ms on
+each, cvxpy's parameter update and result unpacking 10-20 ms (measured with cProfile
+under a load of 14 on two processors), so the search's cost is cvxpy's overhead: first
+measured at 60x (Timoshenko) and 110x (string), when the target was set.  Also printed:
+the proved σ against the converged abscissa (σ/|α|, the method's conservatism).  The
+machine's load is printed before and after: under load the ratios stay meaningful, the
+absolute times do not.
 
 Run:  python benchmarks/rate.py            (exit status 1 if a target is missed)
 """
@@ -51,24 +57,25 @@ from phdesign.symbolic.observer import sensor_matrix
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from rate_models import DENSITY, SPEED, TAPERED_TIMOSHENKO
 
+STRING, BEAM = "string, damper k = 1/2", "Timoshenko, tip dampers L = I"
+#: label: (model, sensors, gains, the constant counterpart and the target against it)
 CASES = {
-    "string, damper k = 1/2": (lambda: load_builtin("wave"), [2], ["1/2"]),
-    "Timoshenko, tip dampers L = I": (lambda: load_builtin("timoshenko"), [3, 4], ["1", "1"]),
-    "string of speed 1 + z, damper k = 1/2": (lambda: SPEED, [2], ["1/2"]),
-    "string of density 1 + z/2, damper k = 1/2": (lambda: DENSITY, [2], ["1/2"]),
+    STRING: (lambda: load_builtin("wave"), [2], ["1/2"], None),
+    BEAM: (lambda: load_builtin("timoshenko"), [3, 4], ["1", "1"], None),
+    "string of speed 1 + z, damper k = 1/2": (lambda: SPEED, [2], ["1/2"], (STRING, 5.0)),
+    "string of density 1 + z/2, damper k = 1/2": (lambda: DENSITY, [2], ["1/2"], (STRING, 5.0)),
     "tapered Timoshenko (K = EI = 1 + z/2), tip dampers L = I": (
         lambda: TAPERED_TIMOSHENKO,
         [3, 4],
         ["1", "1"],
+        (BEAM, 20.0),
     ),
 }
-#: The constant case the z-dependent proofs are compared with.
-CONSTANT = "string, damper k = 1/2"
 PROOF_TARGET = 150.0
 CHECK_TARGET = 0.5
 
 
-def _case(label: str, make, sensors: list[int], gain: list[str], proofs: dict) -> bool:
+def _case(label: str, make, sensors: list[int], gain: list[str], against, proofs: dict) -> bool:
     model = make()
     C = sensor_matrix(sensors, model.n_ports)
     system = closed_system(model, C, gain)
@@ -86,24 +93,23 @@ def _case(label: str, make, sensors: list[int], gain: list[str], proofs: dict) -
     proofs[label] = statistics.median(walls)
     proof_ratio = statistics.median(walls) / statistics.median(base)
     check_ratio = statistics.median(checks) / statistics.median(walls)
-    ok = proof_ratio <= PROOF_TARGET and check_ratio <= CHECK_TARGET and not failures
+    if against is None:
+        ok, judged = proof_ratio <= PROOF_TARGET, f" (target <= {PROOF_TARGET:g}x)"
+    else:
+        relative = proofs[label] / proofs[against[0]]
+        ok = relative <= against[1]
+        judged = f"; {relative:.2f}x the proof of {against[0]} (target <= {against[1]:g}x)"
+    ok = ok and check_ratio <= CHECK_TARGET and not failures
     print(
         f"{label}: prove_decay_rate median {statistics.median(walls):.2f} s, one converged "
-        f"spectrum() {statistics.median(base):.3f} s: {proof_ratio:.1f}x (target <= "
-        f"{PROOF_TARGET:g}x); check_rate {statistics.median(checks):.3f} s: "
-        f"{check_ratio:.3f}x the proof (target <= {CHECK_TARGET:g}x); "
-        f"{'met' if ok else 'MISSED'}"
+        f"spectrum() {statistics.median(base):.3f} s: {proof_ratio:.1f}x{judged}; check_rate "
+        f"{statistics.median(checks):.3f} s: {check_ratio:.3f}x the proof (target <= "
+        f"{CHECK_TARGET:g}x); {'met' if ok else 'MISSED'}"
     )
     print(
         f"  sigma = {float(proof.sigma):.6f}, M = {float(proof.M):.4f}, abscissa "
         f"{report.spectral_abscissa:.6f}: sigma/|alpha| = "
         f"{float(proof.sigma) / abs(report.spectral_abscissa):.4f}"
-        + (
-            ""
-            if proof.problem.constant
-            else f"; the proof takes {proofs[label] / proofs[CONSTANT]:.2f}x the constant "
-            "string's proof"
-        )
     )
     return ok
 

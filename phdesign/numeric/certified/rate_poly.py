@@ -59,6 +59,7 @@ trusted before :func:`failures` is empty.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import sympy
@@ -110,9 +111,10 @@ def interior_form(problem: RateProblem, Pi: sympy.MatrixBase) -> sympy.Immutable
     r"""Return :math:`G - 2\sigma\Pi`, the σ-free part of the pointwise form (linear in Π)."""
     z, H, P1 = problem.z, problem.H, problem.P1
     parts = -_sym(Pi.diff(z) * P1 * H) + _sym(Pi * P1 * H.diff(z)) + 2 * _sym(Pi * problem.P0 * H)
-    return sympy.ImmutableMatrix(parts.applyfunc(sympy.cancel))
+    return sympy.ImmutableMatrix(parts)  # not cancelled: its readers cancel once
 
 
+@functools.lru_cache(maxsize=4)  # the exact check and the proof ask for the same data
 def inequalities(problem: RateProblem, data: PolynomialLyapunov) -> tuple[Inequality, ...]:
     """Return every matrix inequality of the estimate (the module docstring's list)."""
     z, H, Pi = problem.z, problem.H, data.Pi
