@@ -19,8 +19,9 @@ with a second implementation that shares no arithmetic with the first:
 
 It imports neither python-flint nor numpy nor sympy, nor anything of phdesign outside
 this package (``tests/test_layers.py`` and a test that runs it with those modules
-blocked); the decay-rate check (:mod:`.rate`) uses the standard library alone.  A mistake
-in the prover cannot pass the checker by sharing its code.
+blocked); the decay-rate checks (:mod:`.rate`; :mod:`.rate_poly` for z-dependent
+coefficients, with its own polynomial arithmetic and Sturm sequences) use the standard
+library alone.  A mistake in the prover cannot pass the checker by sharing its code.
 """
 
 from __future__ import annotations
