@@ -96,3 +96,17 @@ def string_under_force(c: float):
     data["disturbances"] = {"B": [[1], [0]]}
     data["performance"] = {"outputs": ["integral(e1)"]}
     return model_from_dict(data)
+
+
+def string_with_unknown_tip_force(performance: list[str]):
+    """The unit string (inputs e1(0), e2(1)) whose tip stress u2 is an unknown input."""
+    return BCPHS.define(
+        name="string with an unknown tip force",
+        interval=(0, 1),
+        order=1,
+        P={1: [[0, 1], [1, 0]]},
+        H=[[1, 0], [0, 1]],
+        inputs=["e1(0)", "e2(1)"],
+        disturbances={"unknown": [2]},
+        performance=performance,
+    )

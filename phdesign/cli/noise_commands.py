@@ -293,8 +293,8 @@ def add_stochastic_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--disturbance-noise",
         metavar="W",
-        help="white noise on the disturbance channels w1..wq of the model's [disturbances], "
-        "of these intensities (one per channel or one for all); the observer does not know it",
+        help="white noise on the disturbance channels (those of --w), of these intensities "
+        "(one per channel or one for all); the observer does not know it",
     )
     parser.add_argument("--seed", type=int, help="seed of the noise (with the noise options)")
 

@@ -150,8 +150,9 @@ def _add_simulate(subparsers: argparse._SubParsersAction) -> None:
     sim.add_argument(
         "--w",
         metavar="EXPRS",
-        help="disturbances in t on the model's [disturbances] B, which the observer does not "
-        "know, e.g. 'w1: sin(3*t)'; default zero",
+        help="disturbances in t, which the observer does not know: w1..wq on the columns of "
+        "the model's [disturbances] B, u<j> on its inputs marked unknown, e.g. "
+        "'w1: sin(3*t)'; default zero",
     )
     sim.add_argument(
         "--tol",

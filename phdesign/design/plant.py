@@ -294,8 +294,9 @@ class Plant:
         sampled or lower-order observer, :func:`~phdesign.numeric.time.stochastic.simulate_noisy`
         for noise, else :func:`~phdesign.numeric.time.simulation.simulate`.  ``labels`` name
         the design in the result (presentation only: the plots' titles and the JSON).
-        ``w`` drives the model's ``[disturbances]`` B, as does ``disturbance_intensity``
-        (white) of the options: the observer knows neither.
+        ``w`` drives the model's disturbance channels (``w1..wq``: the columns of
+        ``[disturbances]`` B; ``u<j>``: the inputs marked unknown), as does
+        ``disturbance_intensity`` (white) of the options: the observer knows neither.
 
         Raises
         ------
@@ -331,25 +332,25 @@ class Plant:
 
     def _disturbance_inputs(self, w: Any, opts: SimulationOptions) -> dict[str, Any]:
         """Return the simulator's ``w`` and ``disturbance`` B(z) (none: no disturbance)."""
-        from phdesign.numeric.disturbance_inputs import disturbance_inputs, disturbance_signal
+        from phdesign.numeric.disturbance_inputs import disturbance_channels, disturbance_signal
 
         text = _text_or_function(w, "w", "'w1: sin(3*t)'", "t")
         signal = w if text is None else disturbance_signal(text, self.numeric, self.design_model)
         if signal is None and opts.disturbance_intensity is None:
             return {}
-        B = disturbance_inputs(self.design_model, self.numeric)[0]
-        if B is None:
+        channels = disturbance_channels(self.design_model, self.numeric)
+        if channels is None:
             raise ParameterError(
                 f"{'`w`' if signal is not None else 'disturbance_intensity'}: model "
                 f"{self.model.name!r} has no disturbance channel: add a [disturbances] "
-                "section with B (n x q)"
+                "section with B (n x q), or mark external inputs unknown"
             )
         if opts.kind == "sampled":
             raise ObserverError(
                 "a disturbance `w` runs with the continuous observer; dt, sampler and "
                 "observer_resolution ask for a sampled one: give one or the other"
             )
-        return {"w": signal, "disturbance": B}
+        return {"w": signal, "disturbance": channels}
 
     def input_signal(self, u: str | Callable[[float], Any] | None) -> Any:
         """Return plant inputs as a function of t (text ``"u2: sin(2*t)"`` is parsed)."""

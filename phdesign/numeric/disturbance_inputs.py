@@ -14,11 +14,12 @@ sections (:mod:`phdesign.symbolic.disturbances`, :mod:`phdesign.symbolic.perform
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from phdesign.core.errors import ParameterError
+from phdesign.core.errors import NumericError, ParameterError
 from phdesign.numeric.bridge import NumericModel, _parameter_values
 from phdesign.numeric.inputs import (
     Signals,
@@ -28,7 +29,13 @@ from phdesign.numeric.inputs import (
     trace_expression_row,
 )
 
-__all__ = ["disturbance_count", "disturbance_inputs", "disturbance_signal", "performance_terms"]
+__all__ = [
+    "DisturbanceChannels",
+    "disturbance_channels",
+    "disturbance_inputs",
+    "disturbance_signal",
+    "performance_terms",
+]
 
 
 def disturbance_inputs(model: Any, nm: NumericModel) -> tuple[Any, tuple[int, ...]]:
@@ -87,32 +94,75 @@ def performance_terms(model: Any, nm: NumericModel, outputs: Any = None) -> list
     return out
 
 
-def disturbance_count(model: Any) -> int:
-    """Return q, the number of columns of the model's ``[disturbances]`` B (0 without)."""
+@dataclass(frozen=True)
+class DisturbanceChannels:
+    r"""Where the disturbances enter a discretization: B's columns, then the unknown inputs.
+
+    Channel ``w<k>`` is column k of :math:`B(z)` (:math:`B_d = \int \Psi^\top B\, dz`),
+    channel ``u<j>`` the external input j marked unknown (column j of the discretization's
+    B): the plant sees them, the observer does not, so both rows of a simulation
+    (:mod:`phdesign.numeric.time.simulation`) are driven by :meth:`columns`.
+    """
+
+    B: Callable[[np.ndarray], np.ndarray] | None
+    q: int
+    unknown: tuple[int, ...]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The channels' names: ``w1..wq``, then ``u<j>`` (1-based external inputs)."""
+        return (*(f"w{k + 1}" for k in range(self.q)), *(f"u{j + 1}" for j in self.unknown))
+
+    def columns(self, d: Any) -> np.ndarray:
+        """Return the input columns ``[B_d, B[:, unknown]]`` on the discretization ``d``.
+
+        Raises
+        ------
+        NumericError
+            An unknown input feeds through into the outputs (D ≠ 0 there): the observer's
+            measurements would see it, which the simulation does not model.
+        """
+        from phdesign.numeric.discretization.functionals import disturbance_matrix
+
+        unknown = list(self.unknown)
+        if unknown and np.any(d.D[:, unknown]):
+            raise NumericError(
+                "an unknown input feeds through into the outputs on this discretization "
+                f"(D[:, u{unknown[0] + 1}] is not zero): use the galerkin method"
+            )
+        Bd = np.zeros((d.dim, 0)) if self.B is None else disturbance_matrix(d, self.B)
+        return np.hstack([Bd, d.B[:, unknown]])
+
+
+def disturbance_channels(model: Any, nm: NumericModel) -> DisturbanceChannels | None:
+    """Return the model's disturbance channels (None: neither B nor unknown inputs)."""
+    B, unknown = disturbance_inputs(model, nm)
     dist = getattr(model, "disturbances", None)
-    return 0 if dist is None else int(dist.q)
+    q = 0 if dist is None else int(dist.q)
+    return None if B is None and not unknown else DisturbanceChannels(B, q, unknown)
 
 
 def disturbance_signal(
     text: str | None, nm: NumericModel, model: Any
 ) -> Callable[[float], np.ndarray] | None:
-    """Parse disturbances ``'w1: sin(3*t)'`` into ``w(t) -> (q,)`` (B's columns ``w1..wq``).
+    """Parse disturbances ``'w1: sin(3*t)'`` into ``w(t)`` over the disturbance channels.
 
-    The grammar of the inputs u (:func:`phdesign.numeric.inputs.input_function`); channels
-    not named are zero.
+    The grammar of the inputs u (:func:`phdesign.numeric.inputs.input_function`); the
+    channels are those of :class:`DisturbanceChannels` (``w1..wq``, then the unknown
+    inputs ``u<j>``); channels not named are zero.
 
     Raises
     ------
     ParameterError
-        The model has no ``[disturbances]`` B, or a channel it does not have.
+        The model has no disturbance channel, or a channel it does not have.
     """
     if text is None or not text.strip():
         return None
-    q = disturbance_count(model)
-    if not q:
+    channels = disturbance_channels(model, nm)
+    if channels is None:
         raise ParameterError(
             f"`w`: model {nm.name!r} has no disturbance channel: add a [disturbances] "
-            "section with B (n x q) to drive w1..wq"
+            "section with B (n x q), or mark external inputs unknown ([ports] unknown = [j])"
         )
-    channels = Signals("w", "disturbance", tuple(f"w{j + 1}" for j in range(q)))
-    return input_function(text, nm, model=model, channels=channels)
+    kind = Signals("w", "disturbance", channels.names)
+    return input_function(text, nm, model=model, channels=kind)

@@ -13,15 +13,17 @@ coupled system is block triangular,
     E \dot{\hat e} = (J - R)\hat e + B u, \qquad
     E \dot{\tilde e} = (J - R - B G B^\top)\tilde e, \qquad G = (I + K D)^{-1} K,
 
-and a disturbance :math:`B_d w(t)` of the model's ``[disturbances]``
-(:func:`~phdesign.numeric.discretization.functionals.disturbance_matrix`), which the
-observer does not know, drives both rows: :math:`E \dot{\hat e} = \dots + B_d w` and
-:math:`E \dot{\tilde e} = \dots + B_d w`.  So the error system is stepped on its own
-and :math:`\tilde H = \tfrac12 \tilde e^\top E \tilde e` is computed from
+and a disturbance :math:`B_w w(t)` (the model's ``[disturbances]``, :math:`B_d = \int
+\Psi^\top B\, dz`, and its inputs marked unknown, :math:`B_{:,j}`:
+:class:`~phdesign.numeric.disturbance_inputs.DisturbanceChannels`), which the observer
+does not know, drives both rows: :math:`E \dot{\hat e} = \dots + B_w w` and :math:`E
+\dot{\tilde e} = \dots + B_w w` (an unknown input with no feedthrough, :math:`D_{:,j} =
+0`, reaches the error through :math:`B M e_j = B e_j`). So the error system is stepped on
+its own and :math:`\tilde H = \tfrac12 \tilde e^\top E \tilde e` is computed from
 :math:`\tilde e` itself: no cancellation of plant minus observer (that difference loses
-all relative accuracy once :math:`\tilde H` is
-:math:`10^{-11}` of :math:`\tilde H(0)`).  The observer is :math:`\hat e - \tilde e`
-and :math:`\hat y = y - \tilde y`, :math:`\tilde y = (I - D G) B^\top \tilde e`.
+all relative accuracy once :math:`\tilde H` is :math:`10^{-11}` of :math:`\tilde H(0)`).
+The observer is :math:`\hat e - \tilde e` and :math:`\hat y = y - \tilde y`, :math:`\tilde
+y = (I - D G) B^\top \tilde e`.
 Time stepping (:mod:`phdesign.numeric.time.stepping`): exact (``"expm"``, default) or implicit
 midpoint with its own step control (``"midpoint"``, error below ``tol``).
 
@@ -55,10 +57,11 @@ from phdesign.numeric.boundary_start import difference
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.checks import check_simulate_arguments
 from phdesign.numeric.discretization.coupled import boundary_series
-from phdesign.numeric.discretization.functionals import Functional, disturbance_matrix
+from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.phs import ClosedLoop
 from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
+from phdesign.numeric.disturbance_inputs import DisturbanceChannels
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.threads import limited_threads
 from phdesign.numeric.time.options import SimulationOptions
@@ -155,7 +158,7 @@ def simulate(
     options: SimulationOptions | None = None,
     discrete: DiscretePHS | None = None,
     w: Callable[[float], np.ndarray] | None = None,
-    disturbance: Callable[[np.ndarray], np.ndarray] | None = None,
+    disturbance: DisturbanceChannels | None = None,
 ) -> SimulationResult:
     """Simulate the plant, and the continuous observer when sensors are given.
 
@@ -178,10 +181,12 @@ def simulate(
     discrete : DiscretePHS, optional
         A ready discretization (overrides ``options.method``/``options.resolution``).
     w : callable, optional
-        Disturbance ``w(t) -> (q,)``, sampled like ``u``; the observer does not know it.
-    disturbance : callable, optional
-        :math:`B(z)`, ``f(z) -> (m, n, q)`` (:func:`phdesign.numeric.disturbance_inputs.
-        disturbance_inputs`); needed with ``w``.
+        Disturbances ``w(t)``, one value per channel, sampled like ``u``; the observer
+        does not know them.
+    disturbance : DisturbanceChannels, optional
+        Where they enter: B's columns, then the unknown inputs
+        (:func:`phdesign.numeric.disturbance_inputs.disturbance_channels`); needed with
+        ``w``.
 
     Returns
     -------
@@ -219,33 +224,32 @@ def simulate(
 
 @dataclass(frozen=True)
 class _Disturbance:
-    """The disturbance :math:`B(z)` and its samples ``W`` on the output grid (or none)."""
+    """The disturbance channels and their samples ``W`` on the output grid (or none)."""
 
-    B: Callable[[np.ndarray], np.ndarray] | None = None
+    channels: DisturbanceChannels | None = None
     W: np.ndarray | None = None
 
     @classmethod
-    def of(cls, w: Any, B: Any, t: np.ndarray) -> _Disturbance:
-        """Sample ``w`` on ``t`` (``B`` is needed with it)."""
+    def of(cls, w: Any, channels: DisturbanceChannels | None, t: np.ndarray) -> _Disturbance:
+        """Sample ``w`` on ``t`` (the channels are needed with it)."""
         if w is None:
             return cls()
-        if B is None:
-            raise NumericError("w needs the disturbance matrix B(z) of the model's [disturbances]")
+        if channels is None:
+            raise NumericError("w needs the model's disturbance channels ([disturbances] B)")
         if not callable(w):
             raise ArgumentError(
                 f"w must be a function of t returning the disturbances; found {w!r}"
             )
-        q = np.asarray(B(np.zeros(1))).shape[-1]
-        return cls(B, input_samples(w, t, q, "w"))
+        return cls(channels, input_samples(w, t, len(channels.names), "w"))
 
     def joined(
         self, d: DiscretePHS, B: np.ndarray, U: np.ndarray | None
     ) -> tuple[np.ndarray, np.ndarray | None]:
-        """Return the input matrix ``[B, B_d]`` and samples ``[U, W]`` (unchanged without w)."""
-        if self.B is None or self.W is None:
+        """Return the input matrix ``[B, B_w]`` and samples ``[U, W]`` (unchanged without w)."""
+        if self.channels is None or self.W is None:
             return B, U
         inputs = np.zeros((self.W.shape[0], B.shape[1])) if U is None else U
-        return np.hstack([B, disturbance_matrix(d, self.B)]), np.hstack([inputs, self.W])
+        return np.hstack([B, self.channels.columns(d)]), np.hstack([inputs, self.W])
 
 
 def _zero(nm: NumericModel) -> InitialState:

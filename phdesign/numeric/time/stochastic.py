@@ -13,12 +13,12 @@ the plant input carries :math:`w` (intensity :math:`\Sigma_w`), the observer rec
     N_2 = \begin{bmatrix} 0 & B \Sigma_w^{1/2} \\
     B M C_m^\top L \Sigma_\nu^{1/2} & B G D \Sigma_w^{1/2} \end{bmatrix},
 
-n unit white noise; white disturbances :math:`B_d \Sigma_d^{1/2} n_d` of the model's
-``[disturbances]`` enter the plant's row only (the observer does not know them), so the
-error's variance is :math:`\operatorname{tr}(C_p P C_p^\top)`, P the Lyapunov covariance of
-:mod:`phdesign.numeric.noise.disturbance`.  (The difference of the two rows is the error
-system's noise input :math:`B M [-C_m^\top L \Sigma_\nu^{1/2}, \Sigma_w^{1/2}]`, since
-:math:`I - GD = M`.)
+n unit white noise; white disturbances :math:`B_w \Sigma_d^{1/2} n_d` of the model's
+``[disturbances]`` and unknown inputs enter the plant's row only (the observer does not
+know them), so the error's variance is :math:`\operatorname{tr}(C_p P C_p^\top)`, P the
+Lyapunov covariance of :mod:`phdesign.numeric.noise.disturbance`. (The difference of the
+two rows is the error system's noise input :math:`B M [-C_m^\top L \Sigma_\nu^{1/2},
+\Sigma_w^{1/2}]`, since :math:`I - GD = M`.)
 
 The sampled system is exact (Van Loan 1978): over a step Δt,
 :math:`X_{k+1} = \Phi X_k + \Gamma u + \eta_k` with :math:`\Phi = e^{F \Delta t}`,
@@ -55,9 +55,10 @@ from phdesign.core.errors import NumericError, ObserverError
 from phdesign.core.progress import report
 from phdesign.numeric.bridge import NumericModel
 from phdesign.numeric.discretization.coupled import boundary_series
-from phdesign.numeric.discretization.functionals import Functional, disturbance_matrix
+from phdesign.numeric.discretization.functionals import Functional
 from phdesign.numeric.discretization.points import point_outputs, point_series
 from phdesign.numeric.discretization.registry import DiscretePHS, discretize, feedback_matrix
+from phdesign.numeric.disturbance_inputs import DisturbanceChannels
 from phdesign.numeric.inputs import input_samples
 from phdesign.numeric.noise.figures import check_intensity, noise_intensities
 from phdesign.numeric.threads import limited_threads
@@ -152,7 +153,7 @@ def simulate_noisy(
     options: SimulationOptions | None = None,
     discrete: DiscretePHS | None = None,
     w: Callable[[float], np.ndarray] | None = None,
-    disturbance: Callable[[np.ndarray], np.ndarray] | None = None,
+    disturbance: DisturbanceChannels | None = None,
 ) -> SimulationResult:
     """One sample path of plant and observer with sensor, input and disturbance noise.
 
@@ -165,7 +166,8 @@ def simulate_noisy(
         the noise: ``noise_intensity`` (sensor intensities
         σᵢ², one per sensor or one for all; needs sensors), ``input_intensity`` (plant
         input intensities, one per input or one for all), ``disturbance_intensity`` (white
-        noise on the channels of ``disturbance``, one per channel or one for all; needs
+        noise on the channels of ``disturbance`` (B's columns, then the unknown inputs),
+        one per channel or one for all; needs
         ``disturbance``) and ``seed`` (the same seed gives
         the same path).  The stepping is exact (``scheme="expm"``): implicit midpoint does
         not apply to a noisy run.
@@ -202,7 +204,7 @@ def simulate_noisy(
     report("simulate: the noise's sample path")
     columns = None
     if white is not None and disturbance is not None:
-        columns = disturbance_matrix(d, disturbance) @ np.diag(np.sqrt(white))
+        columns = disturbance.columns(d) @ np.diag(np.sqrt(white))
     extra = _noise_paths(d, C_m, L, sigma, w_in, base.t, opts.seed, columns)
     U = None if u is None else input_samples(u, base.t, d.n_ports)
     described = []
@@ -221,8 +223,10 @@ def simulate_noisy(
     return replace(base, info=info, **_noisy_series(d, C_m, L, base, extra, U, at))
 
 
-def _white_disturbance(opts: SimulationOptions, disturbance: Any) -> np.ndarray | None:
-    """Return the white disturbances' intensities, one per channel of B (None: none)."""
+def _white_disturbance(
+    opts: SimulationOptions, disturbance: DisturbanceChannels | None
+) -> np.ndarray | None:
+    """Return the white disturbances' intensities, one per channel (None: none)."""
     if opts.disturbance_intensity is None:
         return None
     if disturbance is None:
@@ -230,8 +234,8 @@ def _white_disturbance(opts: SimulationOptions, disturbance: Any) -> np.ndarray 
             "disturbance_intensity needs the disturbance matrix B(z) of the model's "
             "[disturbances]: the model has none"
         )
-    q = np.asarray(disturbance(np.zeros(1))).shape[-1]
-    return check_intensity(opts.disturbance_intensity, q, "disturbance_intensity")
+    count = len(disturbance.names)
+    return check_intensity(opts.disturbance_intensity, count, "disturbance_intensity")
 
 
 def _noise_paths(

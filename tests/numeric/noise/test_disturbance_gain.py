@@ -10,6 +10,7 @@ import pytest
 from disturbance_models import (
     beam_under_load,
     damped_tip_wave,
+    string_with_unknown_tip_force,
     wave_h2_squared,
     wave_hinf,
     wave_transfer,
@@ -25,7 +26,6 @@ from phdesign.numeric.bridge import to_numeric
 from phdesign.numeric.discretization.functionals import disturbance_matrix
 from phdesign.numeric.discretization.registry import discretize
 from phdesign.numeric.disturbance_inputs import disturbance_inputs
-from phdesign.symbolic.model import BCPHS
 
 
 def test_the_hand_derivations_agree_with_each_other():
@@ -154,16 +154,7 @@ def test_a_trace_driven_at_the_boundary_has_no_h2_norm():
     so its H₂ norm is infinite and the report says so (diverging, no number), while the
     total momentum ∫ẽ1 has a finite one.
     """
-    string = BCPHS.define(
-        name="string with an unknown tip force",
-        interval=(0, 1),
-        order=1,
-        P={1: [[0, 1], [1, 0]]},
-        H=[[1, 0], [0, 1]],
-        inputs=["e1(0)", "e2(1)"],
-        disturbances={"unknown": [2]},
-        performance=["integral(e1)", "e1(1)"],
-    )
+    string = string_with_unknown_tip_force(["integral(e1)", "e1(1)"])
     report = Observer(string, sensors=[2], gain=0.5).gain(intensity=0)
     assert report.sources == ("u2",)
     momentum, tip = report.h2_outputs

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from disturbance_models import damped_tip_wave, wave_transfer
+from disturbance_models import damped_tip_wave, string_with_unknown_tip_force, wave_transfer
 
 from phdesign import Observer
 from phdesign.core.errors import ObserverError, ParameterError
@@ -81,6 +81,26 @@ def test_the_observers_error_under_a_sinusoidal_force_is_the_transfer_function()
     np.testing.assert_allclose(error[late], exact, rtol=0, atol=2e-5)
     # the plant (lossless, free at 1) is driven too: the observer does not see w
     assert np.max(np.abs(run.states @ performance_row(obs.plant))) > 0.1
+
+
+def test_an_unknown_tip_force_reaches_the_error_by_its_hand_derived_transfer_function():
+    r"""The string with its tip stress input u2 marked unknown, y2 = e1(1) measured, gain k.
+
+    The observer does not know u2: its error obeys ẽ1(0) = 0 and u_z(1) = -k u_t(1) + w_b.
+    Laplace in t from rest: U = A sinh(sz), A s cosh s = -k s A sinh s + W, so
+    Z = ∫₀¹ sU dz = A (cosh s - 1) and G_b(s) = (cosh s - 1)/(s (cosh s + k sinh s)).
+    Under w_b = sin(3t), z̃_p(t) → Im(G_b(3i) e^{3it}); tolerance 2e-5 as for the force
+    (the same sampling and transient).
+    """
+    k, omega = 0.5, 3.0
+    string = string_with_unknown_tip_force(["integral(e1)"])
+    obs = Observer(string, sensors=[2], gain=k)
+    run = obs.simulate(w="u2: sin(3*t)", t_end=30.0, samples=12001)
+    error = (run.states - run.states_hat) @ performance_row(obs.plant)
+    s = 1j * omega
+    G = (np.cosh(s) - 1) / (s * (np.cosh(s) + k * np.sinh(s)))
+    late = run.t >= 28.0
+    np.testing.assert_allclose(error[late], (G * np.exp(s * run.t[late])).imag, atol=2e-5)
 
 
 def test_white_disturbances_have_the_gain_reports_variance():
