@@ -306,6 +306,8 @@ class Plant:
             ``w`` on a model without disturbances, or a channel it does not have.
         """
         opts = self.simulation_options(options)
+        if C_m is not None:
+            _refuse_unknown_inputs_in_u(u, self.model)
         inputs = {
             "x0": self.initial_state(x0, "x0"),
             "xhat0": self.initial_state(xhat0, "xhat0"),
@@ -370,6 +372,29 @@ class Plant:
         extra = f", parameters={self.parameters}" if self.parameters else ""
         text = f"Plant(model={self.model.name!r}{extra}, method={self.method!r})"
         return shorten(text, REPR_LIMIT)
+
+
+def _refuse_unknown_inputs_in_u(u: Any, model: BCPHS) -> None:
+    """Refuse ``u`` text that drives an input marked unknown, when an observer runs.
+
+    The observer copies every input ``u`` gives it (û = u + C_mᵀL(y_m − ŷ_m)), so an
+    unknown input driven through ``u`` would be known to it: such a signal is a
+    disturbance, given through ``w`` (the same ``'u<j>: ...'`` text).
+    """
+    import re
+
+    dist = model.disturbances
+    if not isinstance(u, str) or dist is None or not dist.unknown:
+        return
+    named = [int(j) for j in re.findall(r"\bu(\d+)\s*:", u)]
+    clash = [j for j in named if j in dist.unknown]
+    if clash:
+        j = clash[0]
+        raise ParameterError(
+            f"u{j} is marked unknown in [ports] (the observer does not know it), so `u` "
+            f"cannot drive it in an observer's run; give it as a disturbance: w = 'u{j}: ...' "
+            "(--w on the command line)"
+        )
 
 
 def _text_or_function(value: Any, name: str, example: str, variable: str) -> str | None:

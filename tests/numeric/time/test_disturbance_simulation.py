@@ -103,6 +103,20 @@ def test_an_unknown_tip_force_reaches_the_error_by_its_hand_derived_transfer_fun
     np.testing.assert_allclose(error[late], (G * np.exp(s * run.t[late])).imag, atol=2e-5)
 
 
+def test_an_unknown_input_is_no_known_input_of_an_observer():
+    # the observer copies every input of u (û = u + C_mᵀL(y_m − ŷ_m)): u2, marked unknown,
+    # cannot be driven through u in an observer's run (it would be known); w drives it.
+    # The plant alone has no observer to hide it from: there u drives it as any input.
+    string = string_with_unknown_tip_force(["integral(e1)"])
+    obs = Observer(string, sensors=[2], gain=0.5)
+    with pytest.raises(ParameterError, match=r"u2 is marked unknown .* w = 'u2: \.\.\.'"):
+        obs.simulate(u="u2: sin(3*t)", t_end=1.0)
+    by_u = Plant(string).simulate(u="u2: sin(3*t)", t_end=1.0, samples=11)
+    by_w = Plant(string).simulate(w="u2: sin(3*t)", t_end=1.0, samples=11)
+    # the same column of the same system, the same solver: equal to round-off
+    np.testing.assert_allclose(by_u.states, by_w.states, atol=1e-12)
+
+
 def test_white_disturbances_have_the_gain_reports_variance():
     r"""Var z_p = s ‖G‖₂² at the simulation's resolution (the gain report's Lyapunov value).
 
