@@ -331,6 +331,16 @@ BAD_MODELS = [
         r"'mass' ports\[1\] = 5 is not an input of the model; expected an index in 1..4",
     ),
     (
+        {"boundary_systems": [tip_mass(states=["x1"])]},
+        ModelError,
+        r"the label 'x1' is a name phdesign reads already \(x<i> and e<i> are the field's",
+    ),
+    (
+        {"boundary_systems": [tip_mass(states=["t"])]},
+        ModelError,
+        r"the label 't' is a name phdesign reads already",
+    ),
+    (
         {"boundary_systems": [tip_mass(), tip_mass(name="other")]},
         ModelError,
         r"'other' ports\[1\] = 4 is already closed by boundary system 'mass'",

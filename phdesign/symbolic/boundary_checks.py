@@ -9,6 +9,7 @@ minor), and the coupled energy identity, derived with symbols and checked exactl
 
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING
 
 import sympy
@@ -24,6 +25,9 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from phdesign.symbolic.model import BCPHS
 
 __all__ = ["check_boundary_systems"]
+
+#: Labels a boundary system may not take: what x0, input and disturbance texts already name.
+RESERVED_LABEL = re.compile(r"[xeuyw]\d+|z|t")
 
 
 def check_boundary_systems(model: BCPHS) -> list[str]:
@@ -65,6 +69,14 @@ def check_boundary_systems(model: BCPHS) -> list[str]:
         raise ModelError(
             f"boundary systems: the labels {', '.join(repeated)} are used twice; expected "
             "distinct state and input names"
+        )
+    reserved = sorted(x for x in set(labels) if RESERVED_LABEL.fullmatch(x))
+    if reserved:
+        raise ModelError(
+            f"boundary systems: the label {reserved[0]!r} is a name phdesign reads already "
+            "(x<i> and e<i> are the field's states and efforts, u<j>, y<j>, w<j> the ports and "
+            "disturbances, z and t the variables: an x0 or input text would be ambiguous); "
+            "expected another name, such as 'mass momentum'"
         )
     return checks
 
