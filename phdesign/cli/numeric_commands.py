@@ -243,7 +243,7 @@ def _simulate(args: argparse.Namespace) -> int:
     # read the initial states and inputs before the (possibly long) simulation
     x0 = plant.initial_state(args.x0, "x0")
     xhat0 = plant.initial_state(args.xhat0, "xhat0")
-    u = plant.input_signal(args.u)
+    u = plant.input_signal(args.u, observed=observer is not None)
     # how to run: a sampled or lower-order observer (--dt, --sampler,
     # --observer-resolution), a noisy run (--noise-intensity, --input-noise), else the
     # continuous noiseless one; the design object picks the simulator from the options

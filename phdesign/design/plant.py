@@ -306,12 +306,10 @@ class Plant:
             ``w`` on a model without disturbances, or a channel it does not have.
         """
         opts = self.simulation_options(options)
-        if C_m is not None:
-            _refuse_unknown_inputs_in_u(u, self.model)
         inputs = {
             "x0": self.initial_state(x0, "x0"),
             "xhat0": self.initial_state(xhat0, "xhat0"),
-            "u": self.input_signal(u),
+            "u": self.input_signal(u, observed=C_m is not None),
             **self._disturbance_inputs(w, opts),
         }
         if opts.kind == "sampled":
@@ -354,11 +352,19 @@ class Plant:
             )
         return {"w": signal, "disturbance": channels}
 
-    def input_signal(self, u: str | Callable[[float], Any] | None) -> Any:
-        """Return plant inputs as a function of t (text ``"u2: sin(2*t)"`` is parsed)."""
+    def input_signal(
+        self, u: str | Callable[[float], Any] | None, *, observed: bool = False
+    ) -> Any:
+        """Return plant inputs as a function of t (text ``"u2: sin(2*t)"`` is parsed).
+
+        ``observed``: an observer runs too and copies these inputs, so text that drives an
+        input marked unknown is refused (it is a disturbance: ``w``).
+        """
         from phdesign.numeric.inputs import input_function
 
         text = _text_or_function(u, "u", "'u2: sin(2*t)'", "t")
+        if observed:
+            _refuse_unknown_inputs_in_u(text, self.model)
         return u if text is None else input_function(text, self.numeric, model=self.model)
 
     def labelled(self, result: SimulationResult, **labels: str) -> SimulationResult:
@@ -392,8 +398,8 @@ def _refuse_unknown_inputs_in_u(u: Any, model: BCPHS) -> None:
         j = clash[0]
         raise ParameterError(
             f"u{j} is marked unknown in [ports] (the observer does not know it), so `u` "
-            f"cannot drive it in an observer's run; give it as a disturbance: w = 'u{j}: ...' "
-            "(--w on the command line)"
+            f"cannot drive it in an observer's run; give it as a disturbance, through `w` "
+            f"(the same 'u{j}: ...' text)"
         )
 
 

@@ -113,3 +113,18 @@ def test_tradeoff_against_hinf_is_the_damped_strings_closed_form(string, capsys)
         assert point["decay_rate"] == pytest.approx(0.5 * math.log((1 + r) / (1 - r)), abs=1e-9)
         assert point["hinf"] == pytest.approx(wave_hinf(r)[0] / 2, rel=1e-8)
     assert out["pareto"] == [1]  # k = 1.5 decays faster and lets less through
+
+
+def test_an_unknown_input_driven_by_u_in_an_observers_run_is_refused(tmp_path, capsys):
+    # the tip stress u2 marked unknown: --u would hand it to the observer, --w does not
+    text = DAMPED.replace('[feedback]\ninputs = [2]\ngain = [["k"]]\n', "")
+    path = tmp_path / "unknown.toml"
+    path.write_text(text.replace('outputs = "conjugate"', 'outputs = "conjugate"\nunknown = [2]'))
+    argv = ["simulate", str(path), "--sensors", "2", "--t-end", "1", "--samples", "3"]
+    assert main([*argv, "--u", "u2: sin(t)"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert "u2 is marked unknown in [ports]" in err
+    assert "--u cannot drive it" in err
+    assert "through --w (the same 'u2: ...' text)" in err
+    assert main([*argv, "--w", "u2: sin(t)"]) == 0
