@@ -18,7 +18,11 @@ by Sturm sequences on all of [a, b]) and re-checked by phdesign.proofcheck.rate_
 them the proof's time is also printed against its constant counterpart's proof in this run
 (the strings against the constant string, the tapered beam against the constant beam).
 
-Targets: the proof takes at most 150x one cold converged spectrum, the re-check at most
+Targets: the proof takes at most 150x one cold converged spectrum per Lyapunov weight it
+tries (``prove_decay_rate``'s default ``weight="best"`` tries both the exponential and the
+polynomial weight on constant coefficients and keeps the larger σ: 300x for the constant
+models; on the Timoshenko beam the polynomial weight proves σ = 0.408 where the
+exponential one proves 0.196, first measured at 208x together), the re-check at most
 0.5x the proof.  For the z-dependent models the proof's target is against the constant
 counterpart instead: at most 5x for the strings (first measured 1.4x and 2.1x), at most
 20x for the tapered beam (first measured 13x: its 4 x 4 minors have degree about 30, and
@@ -71,7 +75,7 @@ CASES = {
         (BEAM, 20.0),
     ),
 }
-PROOF_TARGET = 150.0
+PROOF_TARGET = 150.0  # per weight tried: twice this for the constant models (docstring)
 CHECK_TARGET = 0.5
 
 
@@ -93,8 +97,9 @@ def _case(label: str, make, sensors: list[int], gain: list[str], against, proofs
     proofs[label] = statistics.median(walls)
     proof_ratio = statistics.median(walls) / statistics.median(base)
     check_ratio = statistics.median(checks) / statistics.median(walls)
-    if against is None:
-        ok, judged = proof_ratio <= PROOF_TARGET, f" (target <= {PROOF_TARGET:g}x)"
+    if against is None:  # constant coefficients: "best" tries both weights
+        target = 2 * PROOF_TARGET
+        ok, judged = proof_ratio <= target, f" (target <= {target:g}x: two weights)"
     else:
         relative = proofs[label] / proofs[against[0]]
         ok = relative <= against[1]

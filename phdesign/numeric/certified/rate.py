@@ -60,6 +60,7 @@ from typing import Any
 
 import sympy
 
+from phdesign.core.checks import choice
 from phdesign.core.errors import RateProofError
 from phdesign.numeric.certified.exact_system import ExactClosedSystem
 from phdesign.numeric.certified.rate_exact import (
@@ -105,6 +106,8 @@ POLYNOMIAL_ASSUMPTIONS = (
     ASSUMPTIONS[2],
 )
 RETRIES = 5
+#: The Lyapunov weights of :func:`prove_decay_rate`.
+WEIGHTS = ("best", "exponential", "polynomial")
 TAU_DENOMINATOR = 1000
 SIGMA_DIGITS = 6
 
@@ -164,7 +167,9 @@ class DecayRateProof:
         return proof_text(self)
 
 
-def prove_decay_rate(system: ExactClosedSystem, *, target: float | None = None) -> DecayRateProof:
+def prove_decay_rate(
+    system: ExactClosedSystem, *, target: float | None = None, weight: str = "best"
+) -> DecayRateProof:
     r"""Prove :math:`\|\tilde x(t)\| \le M e^{-\sigma t}\|\tilde x(0)\|` for a closed system.
 
     Parameters
@@ -175,6 +180,14 @@ def prove_decay_rate(system: ExactClosedSystem, *, target: float | None = None) 
         z allowed).
     target : float, optional
         Prove this rate (rounded down to 6 decimals) instead of the best one found.
+    weight : {"best", "exponential", "polynomial"}
+        The Lyapunov weight Π(z): the exponential one of Bastin and Coron
+        (:math:`t^{-1}\Pi_- + t\Pi_+`, constant coefficients only), the polynomial one
+        (:mod:`.rate_poly`, decided exactly by Sturm sequences), or ``"best"``: for
+        constant coefficients both, keeping the larger proved σ (on strings they agree to
+        2e-4; on the Timoshenko beam with tip dampers the polynomial weight proves twice
+        the exponential one's σ), with a ``target`` the first that proves it; for
+        z-dependent ones the polynomial weight.
 
     Raises
     ------
@@ -196,22 +209,50 @@ def prove_decay_rate(system: ExactClosedSystem, *, target: float | None = None) 
     >>> proof.sigma
     Fraction(1, 2)
     """
-    return prove_rate(read_system(system), target=target)
+    return prove_rate(read_system(system), target=target, weight=weight)
 
 
-def prove_rate(problem: RateProblem, *, target: float | None = None) -> DecayRateProof:
-    """Find and prove exactly the best rate of the Bastin–Coron form (or ``target``).
+def prove_rate(
+    problem: RateProblem, *, target: float | None = None, weight: str = "best"
+) -> DecayRateProof:
+    """Find and prove exactly the best rate of ``weight`` (or ``target``); see prove_decay_rate.
 
     Raises
     ------
     RateProofError
-        The SDP finds no functional, ``target`` is out of reach, or the rounded
-        solution fails the exact check ``RETRIES`` times (each retry lowers σ).
+        An unknown ``weight``, the exponential weight for z-dependent coefficients, the
+        SDP finds no functional, ``target`` is out of reach, or the rounded solution fails
+        the exact check ``RETRIES`` times (each retry lowers σ).
     """
+    choice(weight, "weight", WEIGHTS, RateProofError)
     if target is not None and not (math.isfinite(target) and target > 0):
         raise RateProofError(f"target must be a finite positive rate; found {target!r}")
     if not problem.constant:
+        if weight == "exponential":
+            raise RateProofError(
+                f"{problem.name}: the exponential weight needs constant H and P0; H or P0 "
+                "depends on z here: use weight 'polynomial' (or 'best')"
+            )
         return _prove_polynomial(problem, target)
+    if weight != "best":
+        return (_prove_exponential if weight == "exponential" else _prove_polynomial)(
+            problem, target
+        )
+    proofs, refusals = [], []
+    for prove in (_prove_exponential, _prove_polynomial):
+        try:
+            proofs.append(prove(problem, target))
+        except RateProofError as error:
+            refusals.append(str(error))
+        if proofs and target is not None:
+            break  # the target is proved: another weight cannot prove more of it
+    if not proofs:
+        raise RateProofError(" / ".join(refusals))
+    return max(proofs, key=lambda proof: proof.sigma)
+
+
+def _prove_exponential(problem: RateProblem, target: float | None) -> DecayRateProof:
+    """Prove the constant case with the Bastin–Coron weight: search, round, decide exactly."""
     basis = lyapunov_basis(problem)
     program = LyapunovProgram(problem, basis)
     best_tau, best_sigma = search(program, target)
@@ -263,7 +304,10 @@ def _first_proved(
 
 
 def _prove_polynomial(problem: RateProblem, target: float | None) -> DecayRateProof:
-    """Prove the z-dependent case (:mod:`.rate_poly`): search, round, decide exactly."""
+    """Prove with the polynomial weight (:mod:`.rate_poly`): search, round, decide exactly.
+
+    Any first-order problem; the only weight for z-dependent coefficients.
+    """
     from phdesign.numeric.certified.rate_poly_sdp import PolynomialProgram, search_polynomial
 
     basis = polynomial_basis(problem)

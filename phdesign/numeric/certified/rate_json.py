@@ -129,7 +129,7 @@ def proof_text(proof: DecayRateProof) -> str:
     data = proof.data
     tau = getattr(data, "tau", None)
     functional = (
-        "  V = int x^T Pi(z) x dz, Pi(z) a polynomial matrix (H or P0 depends on z)"
+        "  V = int x^T Pi(z) x dz, Pi(z) a polynomial matrix in z (the polynomial weight)"
         if tau is None
         else "  V = int x^T Pi(z) x dz, Pi(z) = exp(-mu (z-a)) Pi_- + exp(mu (z-a)) Pi_+, "
         f"tau = exp(mu (b-a)) = {rational_text(tau)}"

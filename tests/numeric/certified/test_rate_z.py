@@ -217,6 +217,12 @@ def test_non_rational_z_dependence_is_refused_naming_the_entry(H, message):
         prove_decay_rate(damped(string("bad", H)))
 
 
+def test_the_exponential_weight_is_refused_for_z_dependent_coefficients():
+    # t^-1 Π₋ + t Π₊ makes the pointwise form affine in e^{2μz} only for constant H
+    with pytest.raises(RateProofError, match=r"exponential weight needs constant H and P0"):
+        prove_decay_rate(damped(SPEED), weight="exponential")
+
+
 @pytest.mark.slow
 def test_certify_rate_writes_a_proof_that_check_verifies(tmp_path, capsys):
     import tomli_w
