@@ -9,6 +9,7 @@ symbols with a message that says what to do.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -387,8 +388,6 @@ def _refuse_unknown_inputs_in_u(u: Any, model: BCPHS) -> None:
     unknown input driven through ``u`` would be known to it: such a signal is a
     disturbance, given through ``w`` (the same ``'u<j>: ...'`` text).
     """
-    import re
-
     dist = model.disturbances
     if not isinstance(u, str) or dist is None or not dist.unknown:
         return

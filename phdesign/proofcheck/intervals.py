@@ -295,22 +295,19 @@ def _exp_small(Y: list, Y1: list | None, prec: int) -> tuple[list, list | None]:
     norm = _row_sum_norm(Y if Y1 is None else _beside(Y, Y1))
     if norm >= m + 2:  # never with the scaling above; the geometric tail needs it
         raise ValueError(f"Taylor remainder: expected ||Y|| < {m + 2}; found {float(norm):.3g}")
-    one = _real(Fraction(1), prec)
-    zero = (L.mpi_zero, L.mpi_zero)
-    T = [[one if i == j else zero for j in range(size)] for i in range(size)]
-    Tp = None if Y1 is None else [[zero] * size for _ in range(size)]
+    identity = _identity(size, prec)
+    T = identity
+    Tp = None if Y1 is None else [[(L.mpi_zero, L.mpi_zero)] * size for _ in range(size)]
     for j in range(m, 0, -1):
         inv = _real(Fraction(1, j), prec)
         if Tp is not None and Y1 is not None:
             Tp = _times(_add(_matmul(Y, Tp, prec), _matmul(Y1, T, prec), prec), inv, prec)
-        T = _add(_identity(size, prec), _times(_zero_filled(_matmul(Y, T, prec)), inv, prec), prec)
+        T = _add(identity, _times(_zero_filled(_matmul(Y, T, prec)), inv, prec), prec)
     bound = norm ** (m + 1) / math.factorial(m + 1) / (1 - norm / (m + 2))
     rho = interval(bound, prec)[1]
     pad = ((mpf_neg(rho), rho), (mpf_neg(rho), rho))
-    T = [[L.mpci_add(x, pad, prec) for x in row] for row in T]
-    if Tp is not None:
-        Tp = [[L.mpci_add(x, pad, prec) for x in row] for row in Tp]
-    return T, Tp
+    padding = [[pad] * size] * size  # the remainder, in every entry
+    return _add(T, padding, prec), None if Tp is None else _add(Tp, padding, prec)
 
 
 def _identity(size: int, prec: int) -> list:

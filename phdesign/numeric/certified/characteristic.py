@@ -222,11 +222,10 @@ class Characteristic:
         """
         from flint import acb
 
-        c = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
-        log2_sigma = self.scale(_size(a, b))
-        at_centre = self.evaluate(acb(_q(c[0]), _q(c[1])), log2_sigma)
-        _, slope = self.evaluate_with_slope(_ball(a, b), log2_sigma)
-        return at_centre + slope * (_ball(a, b) - acb(_q(c[0]), _q(c[1])))
+        centre = acb(_q((a[0] + b[0]) / 2), _q((a[1] + b[1]) / 2))
+        ball, log2_sigma = _ball(a, b), self.scale(_size(a, b))
+        _, slope = self.evaluate_with_slope(ball, log2_sigma)
+        return self.evaluate(centre, log2_sigma) + slope * (ball - centre)
 
     def point(self, lam: Any) -> Any:
         r"""Enclose :math:`\Delta` at the ``acb`` point ``lam``."""
