@@ -63,6 +63,11 @@ def test_a_mode_started_with_its_mass_stays_that_mode():
     velocity = (lam * np.sinh(lam) * np.exp(lam * run.t)).real
     assert run.output_labels[-1] == "mass velocity"
     assert np.max(np.abs(run.y[:, -1] - velocity)) < 1e-10 * np.max(np.abs(velocity))
+    # the mass's position u(1, t) = Re(sinh(lam) e^{lam t}): the [displacement] integrates
+    # the strain from the fixed end (u(0) = 0); the same 1e-10 of the peak
+    position = (np.sinh(lam) * np.exp(lam * run.t)).real
+    assert run.z_w[-1] == 1.0
+    assert np.max(np.abs(run.w[:, -1] - position)) < 1e-10 * np.max(np.abs(position))
     energy = np.array([mode_energy(lam, M, t) for t in run.t])
     np.testing.assert_allclose(run.H, energy, rtol=1e-10)
     # the energy audit of H + H_c against the closed form: H(t) = H(0) - c int_0^t u_t(1)^2
